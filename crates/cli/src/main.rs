@@ -1,0 +1,43 @@
+//! `hikari`: the command-line renderer.
+
+mod progress_bar;
+mod render_cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "hikari", version, about = "Global illumination by photon mapping: caustics, indirect light and light in fog")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image.
+    Render(render_cmd::RenderArgs),
+    /// List the built-in scenes.
+    Scenes,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Render(args) => render_cmd::run(&args),
+        Command::Scenes => {
+            for name in hikari_core::scene::builtin::NAMES {
+                let default = if *name == hikari_core::scene::builtin::DEFAULT { "  (default)" } else { "" };
+                println!("{name}{default}");
+            }
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

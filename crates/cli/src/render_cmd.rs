@@ -1,0 +1,152 @@
+//! `hikari render`: load a scene, trace photons, render, write the image.
+
+use crate::progress_bar::TerminalProgress;
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use hikari_core::output::write_image;
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::render::{path, photon_cpu};
+use hikari_core::scene::{Scene, builtin};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum RendererKind {
+    /// The seed's fixed-radius photon mapping on the CPU.
+    PhotonCpu,
+    /// Path tracer (ground truth; slow to converge).
+    Path,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A built-in scene name (see `hikari scenes`) or a path to a .toml scene file.
+    #[arg(default_value = builtin::DEFAULT)]
+    pub scene: String,
+    /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB).
+    #[arg(short, long, default_value = "hikari.png")]
+    pub output: PathBuf,
+    #[arg(long, value_enum, default_value_t = RendererKind::PhotonCpu)]
+    pub renderer: RendererKind,
+    /// Photon paths emitted from the lights.
+    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..))]
+    pub photons: u64,
+    /// Global-map radius r in scene units [default: 3% of the scene diagonal].
+    #[arg(long)]
+    pub radius: Option<f32>,
+    /// Caustic-map radius in scene units [default: 1% of the scene diagonal].
+    #[arg(long)]
+    pub caustic_radius: Option<f32>,
+    /// Samples per pixel [default: 4 for photon-cpu, 64 for path].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    pub spp: Option<u32>,
+    /// Override the scene's resolution, e.g. 1280x720.
+    #[arg(long, value_parser = parse_resolution)]
+    pub resolution: Option<(u32, u32)>,
+    /// Random seed: the same seed gives the same image whatever the thread count.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Exposure in stops applied before PNG tone mapping.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Shadow-ray samples per area light at each shaded point (photon-cpu).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+    pub area_light_samples: u32,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("`{s}`: each side must be between 1 and 16384"));
+    }
+    Ok((w, h))
+}
+
+fn positive(name: &str, v: Option<f32>) -> Result<()> {
+    match v {
+        Some(r) if !(r.is_finite() && r > 0.0) => bail!("--{name} {r}: must be a positive, finite length"),
+        _ => Ok(()),
+    }
+}
+
+pub fn run(args: &RenderArgs) -> Result<()> {
+    positive("radius", args.radius)?;
+    positive("caustic-radius", args.caustic_radius)?;
+    if !args.exposure.is_finite() {
+        bail!("--exposure {}: must be finite", args.exposure);
+    }
+    let ext = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if !matches!(ext.as_deref(), Some("png" | "exr")) {
+        bail!("{}: unsupported image type (use .png or .exr)", args.output.display());
+    }
+    if let Some(threads) = args.threads {
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().context("setting the thread count")?;
+    }
+
+    let mut scene = Scene::load(&args.scene)?;
+    if let Some((w, h)) = args.resolution {
+        scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
+    }
+    let progress = TerminalProgress::new(args.quiet);
+    let start = Instant::now();
+    let (image, nonfinite) = match args.renderer {
+        RendererKind::PhotonCpu => {
+            let trace_start = Instant::now();
+            let traced = trace_photons(&scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, &progress);
+            let trace_time = trace_start.elapsed().as_secs_f64();
+            let settings = photon_cpu::PhotonCpuSettings {
+                radius: args.radius,
+                caustic_radius: args.caustic_radius,
+                spp: args.spp.unwrap_or(4),
+                seed: args.seed,
+                area_light_samples: args.area_light_samples,
+                ..Default::default()
+            };
+            let build_start = Instant::now();
+            let renderer = photon_cpu::PhotonCpuRenderer::new(&scene, &traced, &settings);
+            let build_time = build_start.elapsed().as_secs_f64();
+            let render_start = Instant::now();
+            let result = renderer.render(&progress);
+            let render_time = render_start.elapsed().as_secs_f64();
+            eprintln!(
+                "photons: {} emitted, {} stored in the global map ({} indirect), {} in the caustic map; {:.2} M paths/s",
+                traced.stats.emitted,
+                traced.global.len(),
+                renderer.global_map().len(),
+                traced.caustic.len(),
+                traced.stats.emitted as f64 / trace_time / 1e6
+            );
+            eprintln!(
+                "radius {:.4}, caustic radius {:.4}; trace {:.2} s, kd-trees {:.2} s, render {:.2} s ({} spp)",
+                renderer.global_params.radius, renderer.caustic_params.radius, trace_time, build_time, render_time, settings.spp
+            );
+            result
+        }
+        RendererKind::Path => {
+            let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
+            let result = path::render(&scene, &settings, &progress);
+            eprintln!("path tracing: {} spp", settings.spp);
+            result
+        }
+    };
+    if nonfinite > 0 {
+        eprintln!("warning: {nonfinite} non-finite samples were dropped");
+    }
+    write_image(&args.output, &image, args.exposure)?;
+    eprintln!(
+        "wrote {} ({}x{}) in {:.2} s total",
+        args.output.display(),
+        image.width,
+        image.height,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

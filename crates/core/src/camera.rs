@@ -1,0 +1,95 @@
+//! Pinhole camera. Right-handed, +y up; pixel (0,0) is the top-left corner and
+//! pixel coordinates are continuous, pixel (i,j) covering [i,i+1)×[j,j+1).
+
+use crate::geometry::Ray;
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Debug)]
+pub struct Camera {
+    pub position: Vec3,
+    pub look_at: Vec3,
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub fov_y: f32,
+    pub width: u32,
+    pub height: u32,
+    forward: Vec3,
+    right: Vec3,
+    true_up: Vec3,
+    tan_half_fov: f32,
+}
+
+impl Camera {
+    /// Fails with a reason if the camera is degenerate.
+    pub fn new(position: Vec3, look_at: Vec3, up: Vec3, fov_y: f32, width: u32, height: u32) -> Result<Self, String> {
+        let forward = (look_at - position).normalize_or_zero();
+        if forward == Vec3::ZERO {
+            return Err("camera position and look_at coincide".into());
+        }
+        let right = forward.cross(up).normalize_or_zero();
+        if right == Vec3::ZERO || forward.cross(up.normalize_or_zero()).length() < 1e-4 {
+            return Err("camera up is zero or parallel to the viewing direction".into());
+        }
+        if !(fov_y > 0.0 && fov_y < 180.0) {
+            return Err(format!("fov_y = {fov_y} must lie strictly between 0 and 180 degrees"));
+        }
+        if width == 0 || height == 0 {
+            return Err(format!("resolution {width}x{height} has a zero side"));
+        }
+        Ok(Camera {
+            position,
+            look_at,
+            up,
+            fov_y,
+            width,
+            height,
+            forward,
+            right,
+            true_up: right.cross(forward),
+            tan_half_fov: (fov_y.to_radians() * 0.5).tan(),
+        })
+    }
+
+    pub fn with_resolution(&self, width: u32, height: u32) -> Result<Self, String> {
+        Camera::new(self.position, self.look_at, self.up, self.fov_y, width, height)
+    }
+
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// Primary ray through continuous pixel coordinates `pixel`.
+    pub fn ray(&self, pixel: Vec2) -> Ray {
+        let x = (2.0 * pixel.x / self.width as f32 - 1.0) * self.tan_half_fov * self.aspect();
+        let y = (1.0 - 2.0 * pixel.y / self.height as f32) * self.tan_half_fov;
+        Ray::new(self.position, (self.forward + self.right * x + self.true_up * y).normalize())
+    }
+
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn centre_ray_looks_at_target_and_top_left_is_up_left() {
+        let cam = Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 64, 32).unwrap();
+        let c = cam.ray(Vec2::new(32.0, 16.0));
+        assert!((c.dir - Vec3::NEG_Z).length() < 1e-6);
+        let tl = cam.ray(Vec2::ZERO);
+        assert!(tl.dir.x < 0.0 && tl.dir.y > 0.0);
+        let top = cam.ray(Vec2::new(32.0, 0.0));
+        assert!((top.dir.y.atan2(-top.dir.z).to_degrees() - 20.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn degenerate_cameras_are_rejected() {
+        assert!(Camera::new(Vec3::ONE, Vec3::ONE, Vec3::Y, 40.0, 8, 8).is_err());
+        assert!(Camera::new(Vec3::ZERO, Vec3::Y, Vec3::Y, 40.0, 8, 8).is_err());
+        assert!(Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0, 8, 8).is_err());
+        assert!(Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 40.0, 0, 8).is_err());
+    }
+}

@@ -1,0 +1,34 @@
+//! Ray-casting geometry: primitives (triangles, analytic spheres) and the BVH
+//! that answers closest-hit and occlusion queries over them.
+
+mod accel;
+mod shapes;
+
+pub use accel::{Accel, Hit};
+pub use shapes::{Sphere, Triangle, TriangleNormals};
+
+use glam::Vec3;
+
+/// A ray `origin + t·dir`, t in (t_min, t_max).
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub t_max: f32,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Ray { origin, dir, t_max: f32::INFINITY }
+    }
+
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// Offset for spawning rays off a surface, relative to the scene's size, so
+/// that a ray does not re-hit the surface it leaves.
+pub fn ray_epsilon(scene_scale: f32) -> f32 {
+    scene_scale * 1e-5
+}

@@ -1,0 +1,105 @@
+//! Writing images: `.png` (tone-mapped 8-bit sRGB) or `.exr` (linear float
+//! RGB). Files are written under a temporary name in the same folder and
+//! renamed into place, so a failed write never leaves a half file.
+
+use crate::render::Image;
+use std::path::{Path, PathBuf};
+
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    #[error("{path}: unsupported image type (use .png or .exr)")]
+    UnsupportedExtension { path: String },
+    #[error("{path}: cannot write image: {source}")]
+    Write { path: String, source: Box<dyn std::error::Error + Send + Sync> },
+}
+
+/// sRGB transfer function (IEC 61966-2-1) of a linear value in [0,1].
+pub fn linear_to_srgb(x: f32) -> f32 {
+    if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// Exposure in stops (value × 2^exposure), clamp to [0,1], sRGB encode.
+pub fn tone_map(image: &Image, exposure: f32) -> Vec<u8> {
+    let scale = 2f32.powf(exposure);
+    image
+        .pixels
+        .iter()
+        .flat_map(|p| p.to_array())
+        .map(|c| {
+            let v = if c.is_finite() { (c * scale).clamp(0.0, 1.0) } else { 0.0 };
+            (linear_to_srgb(v) * 255.0 + 0.5) as u8
+        })
+        .collect()
+}
+
+pub fn write_image(path: &Path, image: &Image, exposure: f32) -> Result<(), OutputError> {
+    let shown = path.display().to_string();
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let format = match ext.as_deref() {
+        Some("png") => ::image::ImageFormat::Png,
+        Some("exr") => ::image::ImageFormat::OpenExr,
+        _ => return Err(OutputError::UnsupportedExtension { path: shown }),
+    };
+    let wrap = |e: Box<dyn std::error::Error + Send + Sync>| OutputError::Write { path: shown.clone(), source: e };
+    let tmp = temporary_name(path);
+    let result = match format {
+        ::image::ImageFormat::Png => {
+            ::image::RgbImage::from_raw(image.width, image.height, tone_map(image, exposure))
+                .expect("buffer size matches the image")
+                .save_with_format(&tmp, format)
+        }
+        _ => {
+            let data: Vec<f32> = image
+                .pixels
+                .iter()
+                .flat_map(|p| p.to_array())
+                .map(|c| if c.is_finite() { c } else { 0.0 })
+                .collect();
+            ::image::Rgb32FImage::from_raw(image.width, image.height, data)
+                .expect("buffer size matches the image")
+                .save_with_format(&tmp, format)
+        }
+    };
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(wrap(Box::new(e)));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        wrap(Box::new(e))
+    })
+}
+
+fn temporary_name(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    #[test]
+    fn png_and_exr_are_written_and_read_back() {
+        let dir = std::env::temp_dir().join(format!("hikari-out-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut img = Image::new(4, 2);
+        img.pixels[0] = Vec3::new(1.0, 0.5, 0.0);
+        img.pixels[1] = Vec3::new(f32::NAN, f32::INFINITY, 2.0);
+        write_image(&dir.join("a.png"), &img, 0.0).unwrap();
+        let png = ::image::open(dir.join("a.png")).unwrap().to_rgb8();
+        assert_eq!(png.get_pixel(0, 0).0, [255, 188, 0]);
+        assert_eq!(png.get_pixel(1, 0).0, [0, 0, 255]);
+        write_image(&dir.join("a.exr"), &img, 0.0).unwrap();
+        let exr = ::image::open(dir.join("a.exr")).unwrap().to_rgb32f();
+        assert_eq!(exr.get_pixel(0, 0).0, [1.0, 0.5, 0.0]);
+        assert_eq!(exr.get_pixel(1, 0).0, [0.0, 0.0, 2.0]);
+        assert!(matches!(write_image(&dir.join("a.jpg"), &img, 0.0), Err(OutputError::UnsupportedExtension { .. })));
+        // A failed write leaves nothing behind.
+        assert!(write_image(&dir.join("missing-dir/a.png"), &img, 0.0).is_err());
+        let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+        assert_eq!(leftovers.len(), 2, "{leftovers:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -1,0 +1,84 @@
+//! Bit-exact encodings of photon power and direction. The GPU decodes the
+//! same bits with the same arithmetic, so both sides see identical photons.
+
+use glam::{Vec2, Vec3};
+
+const MANTISSA_BITS: i32 = 9;
+const EXP_BIAS: i32 = 15;
+const MAX_EXP: i32 = 31;
+
+/// Shared-exponent RGB (the RGB9E5 format of GL/Vulkan): 9-bit mantissas,
+/// 5-bit exponent; error ≤ 2⁻⁹ of the largest channel.
+pub fn encode_rgb9e5(c: Vec3) -> u32 {
+    let max_value = ((1 << MANTISSA_BITS) - 1) as f32 / (1 << MANTISSA_BITS) as f32 * 2f32.powi(MAX_EXP - EXP_BIAS);
+    let c = c.clamp(Vec3::ZERO, Vec3::splat(max_value));
+    let max_c = c.max_element();
+    if max_c <= 0.0 || max_c.is_nan() {
+        return 0;
+    }
+    let mut exp = (max_c.log2().floor() as i32).max(-EXP_BIAS - 1) + 1 + EXP_BIAS;
+    let mut scale = 2f32.powi(exp - EXP_BIAS - MANTISSA_BITS);
+    if (max_c / scale).round() as u32 == 1 << MANTISSA_BITS {
+        exp += 1;
+        scale *= 2.0;
+    }
+    let exp = exp.clamp(0, MAX_EXP);
+    let q = |x: f32| ((x / scale).round() as u32).min((1 << MANTISSA_BITS) - 1);
+    q(c.x) | (q(c.y) << 9) | (q(c.z) << 18) | ((exp as u32) << 27)
+}
+
+pub fn decode_rgb9e5(bits: u32) -> Vec3 {
+    let exp = (bits >> 27) as i32;
+    let scale = 2f32.powi(exp - EXP_BIAS - MANTISSA_BITS);
+    Vec3::new((bits & 511) as f32, ((bits >> 9) & 511) as f32, ((bits >> 18) & 511) as f32) * scale
+}
+
+/// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.
+pub fn encode_octahedral_15(d: Vec3) -> u32 {
+    let d = d / (d.x.abs() + d.y.abs() + d.z.abs());
+    let mut p = Vec2::new(d.x, d.y);
+    if d.z < 0.0 {
+        p = (Vec2::ONE - Vec2::new(p.y.abs(), p.x.abs())) * Vec2::new(p.x.signum(), p.y.signum());
+    }
+    let q = |x: f32| (((x.clamp(-1.0, 1.0) * 0.5 + 0.5) * 32767.0).round() as u32) & 0x7fff;
+    q(p.x) | (q(p.y) << 15)
+}
+
+pub fn decode_octahedral_15(bits: u32) -> Vec3 {
+    let p = Vec2::new((bits & 0x7fff) as f32, ((bits >> 15) & 0x7fff) as f32) / 32767.0 * 2.0 - 1.0;
+    let z = 1.0 - p.x.abs() - p.y.abs();
+    let t = (-z).max(0.0);
+    let x = p.x + if p.x >= 0.0 { -t } else { t };
+    let y = p.y + if p.y >= 0.0 { -t } else { t };
+    Vec3::new(x, y, z).normalize()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{Rng, uniform_sphere};
+
+    #[test]
+    fn rgb9e5_round_trips_within_its_precision() {
+        let mut rng = Rng::for_item(21, 0);
+        for _ in 0..10_000 {
+            let scale = 2f32.powf(rng.next_f32() * 20.0 - 10.0);
+            let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale;
+            let back = decode_rgb9e5(encode_rgb9e5(c));
+            let err = (back - c).abs().max_element() / c.max_element();
+            assert!(err <= 1.0 / 512.0 + 1e-6, "{c} -> {back}");
+        }
+        assert_eq!(decode_rgb9e5(encode_rgb9e5(Vec3::ZERO)), Vec3::ZERO);
+        assert_eq!(decode_rgb9e5(encode_rgb9e5(Vec3::ONE)), Vec3::ONE);
+    }
+
+    #[test]
+    fn octahedral_round_trip_is_accurate() {
+        let mut rng = Rng::for_item(22, 0);
+        for _ in 0..10_000 {
+            let d = uniform_sphere(rng.next_2d());
+            let back = decode_octahedral_15(encode_octahedral_15(d));
+            assert!((d - back).length() < 3e-4, "{d} -> {back}");
+        }
+    }
+}

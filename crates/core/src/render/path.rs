@@ -1,0 +1,124 @@
+//! `path`: a unidirectional path tracer with next-event estimation and, for
+//! area lights, multiple importance sampling (power heuristic). Ground truth
+//! for the photon renderers.
+
+use super::{Image, render_pixels};
+use crate::geometry::Ray;
+use crate::material::{Event, Material, Rgb, dielectric_split, mean, reflect};
+use crate::progress::Progress;
+use crate::sampling::{Rng, cosine_hemisphere, local_to_world, power_heuristic};
+use crate::scene::Scene;
+use glam::Vec3;
+use std::f32::consts::PI;
+
+#[derive(Clone, Debug)]
+pub struct PathSettings {
+    pub spp: u32,
+    pub seed: u64,
+    /// Bounces before a path is cut (material roulette ends most much sooner).
+    pub max_depth: u32,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings { spp: 64, seed: 0, max_depth: 64 }
+    }
+}
+
+/// How the previous vertex chose the current ray, for MIS on emitter hits.
+#[derive(Clone, Copy)]
+enum Previous {
+    /// Camera or a specular bounce: emitters hit count fully.
+    Specular,
+    /// A diffuse bounce from `point`, sampled with solid-angle density `pdf`.
+    Diffuse { point: Vec3, pdf: f32 },
+}
+
+pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut Rng) -> Rgb {
+    let mut l = Rgb::ZERO;
+    let mut beta = Rgb::ONE;
+    let mut previous = Previous::Specular;
+    for _ in 0..settings.max_depth {
+        let Some(hit) = scene.accel.intersect(&ray) else { break };
+        // Emitted light, MIS-weighted against the light sampling of the last vertex.
+        if let Some(light) = scene.emitter(&hit) {
+            let le = light.emitted_radiance(ray.dir, hit.geometric_normal);
+            let weight = match previous {
+                Previous::Specular => 1.0,
+                Previous::Diffuse { point, pdf } => {
+                    power_heuristic(pdf, light.incident_pdf(point, hit.point, hit.geometric_normal))
+                }
+            };
+            l += beta * le * weight;
+            break;
+        }
+        let material = scene.material(&hit);
+        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+        let (ng, ns) = (hit.geometric_normal * facing, hit.shading_normal * facing);
+        let next_dir = match material {
+            Material::Emitter => break,
+            Material::Glass { ior } => {
+                let split = dielectric_split(ray.dir, hit.geometric_normal, *ior);
+                previous = Previous::Specular;
+                match split.refracted {
+                    Some(t) if rng.next_f32() >= split.reflectance => t,
+                    _ => split.reflected,
+                }
+            }
+            Material::Diffuse { .. } | Material::Mirror { .. } => {
+                let albedo = material.diffuse_albedo();
+                let p_diffuse = mean(albedo);
+                if p_diffuse > 0.0 {
+                    l += beta * next_event(scene, hit.point, ns, albedo, p_diffuse, rng);
+                }
+                // The material's own roulette picks the event and ends paths.
+                let (event, factor) = material.roulette(rng.next_f32());
+                beta *= factor;
+                match event {
+                    Event::Absorbed => break,
+                    Event::Diffuse => {
+                        let dir = local_to_world(cosine_hemisphere(rng.next_2d()), ns);
+                        previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
+                        dir
+                    }
+                    Event::Specular => {
+                        previous = Previous::Specular;
+                        reflect(ray.dir, ns)
+                    }
+                }
+            }
+        };
+        let transmits = matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
+        if next_dir.dot(ng) <= 0.0 && !transmits {
+            break;
+        }
+        ray = Ray::new(hit.point, next_dir);
+    }
+    l
+}
+
+/// Direct light at a diffuse vertex: one sample per light, MIS-weighted
+/// against the diffuse sampling (chosen with probability `p_diffuse`).
+fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng: &mut Rng) -> Rgb {
+    let mut sum = Rgb::ZERO;
+    for light in &scene.lights {
+        let Some(s) = light.sample_incident(x, rng.next_2d()) else { continue };
+        let cos = s.wi.dot(n);
+        if cos <= 0.0 || s.pdf <= 0.0 {
+            continue;
+        }
+        let mut shadow = Ray::new(x, s.wi);
+        shadow.t_max = s.distance * (1.0 - 1e-4);
+        if scene.accel.occluded(&shadow) {
+            continue;
+        }
+        let weight = if s.is_delta { 1.0 } else { power_heuristic(s.pdf, p_diffuse * cos / PI) };
+        sum += albedo / PI * s.radiance * (cos * weight / s.pdf);
+    }
+    sum
+}
+
+/// Renders the image; returns it and the number of non-finite samples dropped.
+pub fn render(scene: &Scene, settings: &PathSettings, progress: &dyn Progress) -> (Image, u64) {
+    render_pixels(&scene.camera, settings.spp, settings.seed, progress, |ray, rng| radiance(scene, ray, settings, rng))
+}

@@ -1,0 +1,167 @@
+//! `photon-cpu`: the seed's pipeline on the CPU and the CPU twin of the GPU
+//! renderer. Primary rays; mirror and glass followed recursively (Whitted) to
+//! the first diffuse hit; there, direct light by shadow rays, indirect light
+//! from the global map and caustics from the caustic map, both with the
+//! fixed-radius estimate of `crate::estimate`.
+
+use super::{Image, direct_diffuse, render_pixels};
+use crate::estimate::{FixedRadius, fixed_radius_radiance};
+use crate::geometry::Ray;
+use crate::material::{Material, Rgb, dielectric_split, reflect};
+use crate::photon::{PathClass, PhotonMap, TracedPhotons};
+use crate::progress::Progress;
+use crate::sampling::Rng;
+use crate::scene::Scene;
+
+/// Which parts of the light at diffuse points to include (all by default).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Components {
+    pub direct: bool,
+    pub indirect: bool,
+    pub caustic: bool,
+}
+
+impl Components {
+    pub const ALL: Components = Components { direct: true, indirect: true, caustic: true };
+}
+
+#[derive(Clone, Debug)]
+pub struct PhotonCpuSettings {
+    /// Global-map radius r; None: `default_radius`.
+    pub radius: Option<f32>,
+    /// Caustic-map radius; None: `default_caustic_radius`.
+    pub caustic_radius: Option<f32>,
+    pub spp: u32,
+    pub seed: u64,
+    /// Shadow-ray samples per area light at each shaded point.
+    pub area_light_samples: u32,
+    /// Mirror/glass bounces followed from the eye before giving up.
+    pub max_specular_depth: u32,
+    pub normal_test: bool,
+    pub components: Components,
+}
+
+impl Default for PhotonCpuSettings {
+    fn default() -> Self {
+        PhotonCpuSettings {
+            radius: None,
+            caustic_radius: None,
+            spp: 4,
+            seed: 0,
+            area_light_samples: 4,
+            max_specular_depth: 8,
+            normal_test: true,
+            components: Components::ALL,
+        }
+    }
+}
+
+/// Default global radius: 3% of the scene's bounding-box diagonal.
+pub fn default_radius(scene: &Scene) -> f32 {
+    0.03 * scene.diagonal()
+}
+
+/// Default caustic radius: 1% of the diagonal (caustic photons are dense).
+pub fn default_caustic_radius(scene: &Scene) -> f32 {
+    0.01 * scene.diagonal()
+}
+
+pub struct PhotonCpuRenderer<'a> {
+    scene: &'a Scene,
+    /// Indirect-class photons only: what the global-map estimate shows.
+    global: PhotonMap,
+    caustic: PhotonMap,
+    pub global_params: FixedRadius,
+    pub caustic_params: FixedRadius,
+    settings: PhotonCpuSettings,
+}
+
+impl<'a> PhotonCpuRenderer<'a> {
+    pub fn new(scene: &'a Scene, traced: &TracedPhotons, settings: &PhotonCpuSettings) -> Self {
+        let indirect = traced.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect();
+        PhotonCpuRenderer {
+            scene,
+            global: PhotonMap::new(indirect, traced.power_unit),
+            caustic: PhotonMap::new(traced.caustic.clone(), traced.power_unit),
+            global_params: FixedRadius {
+                radius: settings.radius.unwrap_or_else(|| default_radius(scene)),
+                normal_test: settings.normal_test,
+            },
+            caustic_params: FixedRadius {
+                radius: settings.caustic_radius.unwrap_or_else(|| default_caustic_radius(scene)),
+                normal_test: settings.normal_test,
+            },
+            settings: settings.clone(),
+        }
+    }
+
+    pub fn global_map(&self) -> &PhotonMap {
+        &self.global
+    }
+
+    pub fn caustic_map(&self) -> &PhotonMap {
+        &self.caustic
+    }
+
+    /// The photon-map part of the light leaving a diffuse point: indirect
+    /// (global map) plus caustics (caustic map), per the enabled components.
+    pub fn photon_radiance(&self, x: glam::Vec3, normal: glam::Vec3, albedo: Rgb) -> Rgb {
+        let c = self.settings.components;
+        let mut l = Rgb::ZERO;
+        if c.indirect {
+            l += fixed_radius_radiance(&self.global, None, x, normal, albedo, &self.global_params);
+        }
+        if c.caustic {
+            l += fixed_radius_radiance(&self.caustic, None, x, normal, albedo, &self.caustic_params);
+        }
+        l
+    }
+
+    /// Radiance arriving along `ray`, with `depth` specular bounces so far.
+    pub fn radiance(&self, ray: &Ray, depth: u32, rng: &mut Rng) -> Rgb {
+        let Some(hit) = self.scene.accel.intersect(ray) else { return Rgb::ZERO };
+        if let Some(light) = self.scene.emitter(&hit) {
+            return light.emitted_radiance(ray.dir, hit.geometric_normal);
+        }
+        let can_recurse = depth < self.settings.max_specular_depth;
+        let material = self.scene.material(&hit);
+        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+        let ns = hit.shading_normal * facing;
+        match material {
+            Material::Glass { ior } => {
+                if !can_recurse {
+                    return Rgb::ZERO;
+                }
+                let split = dielectric_split(ray.dir, hit.geometric_normal, *ior);
+                let mut l = split.reflectance * self.radiance(&Ray::new(hit.point, split.reflected), depth + 1, rng);
+                if let Some(t) = split.refracted {
+                    l += (1.0 - split.reflectance) * self.radiance(&Ray::new(hit.point, t), depth + 1, rng);
+                }
+                l
+            }
+            Material::Emitter => Rgb::ZERO,
+            Material::Diffuse { .. } | Material::Mirror { .. } => {
+                let mut l = Rgb::ZERO;
+                let albedo = material.diffuse_albedo();
+                if albedo.max_element() > 0.0 {
+                    if self.settings.components.direct {
+                        l += direct_diffuse(self.scene, hit.point, ns, albedo, self.settings.area_light_samples, rng);
+                    }
+                    l += self.photon_radiance(hit.point, ns, albedo);
+                }
+                let rho_s = material.mirror_reflectance();
+                if rho_s.max_element() > 0.0 && can_recurse {
+                    l += rho_s * self.radiance(&Ray::new(hit.point, reflect(ray.dir, ns)), depth + 1, rng);
+                }
+                l
+            }
+        }
+    }
+
+    /// Renders the image; returns it and the number of non-finite samples dropped.
+    pub fn render(&self, progress: &dyn Progress) -> (Image, u64) {
+        render_pixels(&self.scene.camera, self.settings.spp, self.settings.seed, progress, |ray, rng| {
+            self.radiance(&ray, 0, rng)
+        })
+    }
+}

@@ -1,0 +1,110 @@
+//! Sampling routines shared by photon tracing and the renderers.
+//!
+//! Every sampler maps uniform numbers in [0,1)² to a direction and states its
+//! density with respect to solid angle; `chi2` tests check each one against
+//! its stated density.
+
+mod rng;
+#[cfg(test)]
+pub(crate) mod chi2;
+
+pub use rng::Rng;
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// An orthonormal basis whose third axis is `n` (Duff et al. 2017, branchless).
+pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// Expresses a local direction (z = axis) in the frame around `axis`.
+pub fn local_to_world(local: Vec3, axis: Vec3) -> Vec3 {
+    let (t, b) = orthonormal_basis(axis);
+    t * local.x + b * local.y + axis * local.z
+}
+
+/// Uniform direction on the unit sphere; density 1/(4π).
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Cosine-weighted direction about +z (METHOD.md §2, eq. 2.16):
+/// θ = acos √ξ₁, φ = 2πξ₂; density cos θ / π.
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    let cos_theta = (1.0 - u.x).sqrt();
+    let sin_theta = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) / PI
+}
+
+/// Uniform direction inside the cone of half-angle acos(`cos_max`) about +z;
+/// density 1/(2π(1 − cos_max)).
+pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+}
+
+pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * (1.0 - cos_max))
+}
+
+/// Power heuristic (β = 2) weight for a sample from strategy `f` against `g`.
+pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
+    let (f2, g2) = (pdf_f * pdf_f, pdf_g * pdf_g);
+    if f2 + g2 == 0.0 { 0.0 } else { f2 / (f2 + g2) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::chi2::{assert_direction_distribution, assert_unit_density};
+    use super::*;
+
+    #[test]
+    fn basis_is_orthonormal() {
+        let mut rng = Rng::for_item(5, 0);
+        for _ in 0..1000 {
+            let n = uniform_sphere(rng.next_2d());
+            let (t, b) = orthonormal_basis(n);
+            assert!(t.dot(n).abs() < 1e-5 && b.dot(n).abs() < 1e-5 && t.dot(b).abs() < 1e-5);
+            assert!((t.length() - 1.0).abs() < 1e-5 && (b.length() - 1.0).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn uniform_sphere_matches_its_density() {
+        assert_direction_distribution(uniform_sphere, |_| UNIFORM_SPHERE_PDF);
+        assert_unit_density(|_| UNIFORM_SPHERE_PDF);
+    }
+
+    #[test]
+    fn cosine_hemisphere_matches_its_density() {
+        assert_direction_distribution(cosine_hemisphere, |w| cosine_hemisphere_pdf(w.z));
+        assert_unit_density(|w| cosine_hemisphere_pdf(w.z));
+    }
+
+    #[test]
+    fn uniform_cone_matches_its_density() {
+        let cos_max = 0.8f32;
+        let pdf = move |w: Vec3| if w.z >= cos_max { uniform_cone_pdf(cos_max) } else { 0.0 };
+        assert_direction_distribution(move |u| uniform_cone(u, cos_max), pdf);
+        assert_unit_density(pdf);
+    }
+}

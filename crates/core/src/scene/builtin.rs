@@ -1,0 +1,25 @@
+//! Built-in scenes: scene files stored in the repository's `scenes/` folder
+//! and embedded in the binary, so users can copy and edit them.
+
+pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic"];
+
+pub const DEFAULT: &str = "cornell-box";
+
+pub fn source(name: &str) -> Option<&'static str> {
+    match name {
+        "cornell-box" => Some(include_str!("../../../../scenes/cornell-box.toml")),
+        "cornell-caustic" => Some(include_str!("../../../../scenes/cornell-caustic.toml")),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_builtin_loads() {
+        for name in super::NAMES {
+            let scene = crate::scene::Scene::load(name).unwrap_or_else(|e| panic!("{e}"));
+            assert!(!scene.lights.is_empty());
+        }
+    }
+}

@@ -1,0 +1,96 @@
+//! The TOML scene file as written by users (docs/scene-format.md).
+//!
+//! These structs mirror the file one to one and reject unknown fields; which
+//! fields apply to which `type`/`shape` is checked in `load`, where errors can
+//! name the entry.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+pub type V3 = [f32; 3];
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    pub camera: Spanned<CameraDesc>,
+    #[serde(default)]
+    pub material: Vec<Spanned<MaterialDesc>>,
+    #[serde(default)]
+    pub object: Vec<Spanned<ObjectDesc>>,
+    #[serde(default)]
+    pub light: Vec<Spanned<LightDesc>>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    pub position: V3,
+    pub look_at: V3,
+    #[serde(default = "default_up")]
+    pub up: V3,
+    #[serde(default = "default_fov")]
+    pub fov_y: f32,
+    #[serde(default = "default_resolution")]
+    pub resolution: [u32; 2],
+}
+
+fn default_up() -> V3 {
+    [0.0, 1.0, 0.0]
+}
+fn default_fov() -> f32 {
+    40.0
+}
+fn default_resolution() -> [u32; 2] {
+    [512, 512]
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub albedo: Option<V3>,
+    pub specular_reflectance: Option<V3>,
+    pub reflectance: Option<V3>,
+    pub ior: Option<f32>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    /// Spanned so that an unknown name is reported where it is written.
+    pub material: Spanned<String>,
+    pub mesh: Option<String>,
+    pub shape: Option<String>,
+    pub center: Option<V3>,
+    pub radius: Option<f32>,
+    pub corner: Option<V3>,
+    pub edge_u: Option<V3>,
+    pub edge_v: Option<V3>,
+    pub size: Option<V3>,
+    /// Rotation about +y in degrees (box and mesh).
+    pub rotate_y: Option<f32>,
+    /// Uniform scale (mesh).
+    pub scale: Option<f32>,
+    /// Translation (mesh).
+    pub translate: Option<V3>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub position: Option<V3>,
+    pub intensity: Option<V3>,
+    pub direction: Option<V3>,
+    pub cutoff_angle: Option<f32>,
+    pub falloff_start_angle: Option<f32>,
+    pub center: Option<V3>,
+    pub radius: Option<f32>,
+    pub radiance: Option<V3>,
+    pub corner: Option<V3>,
+    pub edge_u: Option<V3>,
+    pub edge_v: Option<V3>,
+}

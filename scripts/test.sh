@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Runs the whole hikari test suite on a fresh Debian 12 machine: installs what
+# the machine lacks (Mesa's software Vulkan driver for the GPU tests), then
+# runs every test of the workspace.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+need=()
+for pkg in mesa-vulkan-drivers libvulkan1; do
+    dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || need+=("$pkg")
+done
+if [ ${#need[@]} -gt 0 ]; then
+    echo "installing ${need[*]}"
+    sudo_cmd=""
+    [ "$(id -u)" -eq 0 ] || sudo_cmd="sudo"
+    $sudo_cmd apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${need[@]}" >/dev/null
+fi
+
+# The Vulkan loader warns when XDG_RUNTIME_DIR is unset; give it a private one.
+if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
+    export XDG_RUNTIME_DIR
+    XDG_RUNTIME_DIR="$(mktemp -d)"
+fi
+
+cargo test --workspace --locked "$@"
