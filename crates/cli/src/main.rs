@@ -7,7 +7,11 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "hikari", version, about = "Global illumination by photon mapping: caustics, indirect light and light in fog")]
+#[command(
+    name = "hikari",
+    version,
+    about = "Global illumination by photon mapping: caustics, indirect light and light in fog"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -27,7 +31,11 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(&args),
         Command::Scenes => {
             for name in hikari_core::scene::builtin::NAMES {
-                let default = if *name == hikari_core::scene::builtin::DEFAULT { "  (default)" } else { "" };
+                let default = if *name == hikari_core::scene::builtin::DEFAULT {
+                    "  (default)"
+                } else {
+                    ""
+                };
                 println!("{name}{default}");
             }
             Ok(())

@@ -11,17 +11,26 @@ pub struct TerminalProgress {
 
 impl TerminalProgress {
     pub fn new(quiet: bool) -> Self {
-        TerminalProgress { bar: Mutex::new(None), quiet }
+        TerminalProgress {
+            bar: Mutex::new(None),
+            quiet,
+        }
     }
 }
 
 impl Progress for TerminalProgress {
     fn begin(&self, stage: &str, total: u64) {
-        let bar = if self.quiet { ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden()) } else { ProgressBar::new(total) };
+        let bar = if self.quiet {
+            ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden())
+        } else {
+            ProgressBar::new(total)
+        };
         bar.set_style(
-            ProgressStyle::with_template("{msg:>16} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}")
-                .expect("valid template")
-                .progress_chars("=> "),
+            ProgressStyle::with_template(
+                "{msg:>16} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
         );
         bar.set_message(stage.to_string());
         *self.bar.lock().unwrap() = Some(bar);

@@ -32,10 +32,10 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..))]
     pub photons: u64,
     /// Global-map radius r in scene units [default: 3% of the scene diagonal].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub radius: Option<f32>,
     /// Caustic-map radius in scene units [default: 1% of the scene diagonal].
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub caustic_radius: Option<f32>,
     /// Samples per pixel [default: 4 for photon-cpu, 64 for path].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
@@ -55,14 +55,24 @@ pub struct RenderArgs {
     /// Shadow-ray samples per area light at each shaded point (photon-cpu).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
     pub area_light_samples: u32,
+    /// Count only photons that arrived from the side the surface faces the
+    /// eye (stops light leaking through thin walls; darkens inside corners).
+    #[arg(long)]
+    pub normal_test: bool,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"));
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))
+    };
     let (w, h) = (parse(w)?, parse(h)?);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(format!("`{s}`: each side must be between 1 and 16384"));
@@ -72,7 +82,9 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 fn positive(name: &str, v: Option<f32>) -> Result<()> {
     match v {
-        Some(r) if !(r.is_finite() && r > 0.0) => bail!("--{name} {r}: must be a positive, finite length"),
+        Some(r) if !(r.is_finite() && r > 0.0) => {
+            bail!("--{name} {r}: must be a positive, finite length")
+        }
         _ => Ok(()),
     }
 }
@@ -83,24 +95,45 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !args.exposure.is_finite() {
         bail!("--exposure {}: must be finite", args.exposure);
     }
-    let ext = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let ext = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
     if !matches!(ext.as_deref(), Some("png" | "exr")) {
-        bail!("{}: unsupported image type (use .png or .exr)", args.output.display());
+        bail!(
+            "{}: unsupported image type (use .png or .exr)",
+            args.output.display()
+        );
     }
     if let Some(threads) = args.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().context("setting the thread count")?;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global()
+            .context("setting the thread count")?;
     }
 
     let mut scene = Scene::load(&args.scene)?;
     if let Some((w, h)) = args.resolution {
-        scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
+        scene.camera = scene
+            .camera
+            .with_resolution(w, h)
+            .map_err(anyhow::Error::msg)?;
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
     let (image, nonfinite) = match args.renderer {
         RendererKind::PhotonCpu => {
             let trace_start = Instant::now();
-            let traced = trace_photons(&scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, &progress);
+            let traced = trace_photons(
+                &scene,
+                &TraceSettings {
+                    photons: args.photons,
+                    seed: args.seed,
+                    ..Default::default()
+                },
+                &progress,
+            );
             let trace_time = trace_start.elapsed().as_secs_f64();
             let settings = photon_cpu::PhotonCpuSettings {
                 radius: args.radius,
@@ -108,6 +141,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 spp: args.spp.unwrap_or(4),
                 seed: args.seed,
                 area_light_samples: args.area_light_samples,
+                normal_test: args.normal_test,
                 ..Default::default()
             };
             let build_start = Instant::now();
@@ -126,12 +160,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             );
             eprintln!(
                 "radius {:.4}, caustic radius {:.4}; trace {:.2} s, kd-trees {:.2} s, render {:.2} s ({} spp)",
-                renderer.global_params.radius, renderer.caustic_params.radius, trace_time, build_time, render_time, settings.spp
+                renderer.global_params.radius,
+                renderer.caustic_params.radius,
+                trace_time,
+                build_time,
+                render_time,
+                settings.spp
             );
             result
         }
         RendererKind::Path => {
-            let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
+            let settings = path::PathSettings {
+                spp: args.spp.unwrap_or(64),
+                seed: args.seed,
+                ..Default::default()
+            };
             let result = path::render(&scene, &settings, &progress);
             eprintln!("path tracing: {} spp", settings.spp);
             result

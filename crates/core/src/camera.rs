@@ -21,7 +21,14 @@ pub struct Camera {
 
 impl Camera {
     /// Fails with a reason if the camera is degenerate.
-    pub fn new(position: Vec3, look_at: Vec3, up: Vec3, fov_y: f32, width: u32, height: u32) -> Result<Self, String> {
+    pub fn new(
+        position: Vec3,
+        look_at: Vec3,
+        up: Vec3,
+        fov_y: f32,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, String> {
         let forward = (look_at - position).normalize_or_zero();
         if forward == Vec3::ZERO {
             return Err("camera position and look_at coincide".into());
@@ -31,7 +38,9 @@ impl Camera {
             return Err("camera up is zero or parallel to the viewing direction".into());
         }
         if !(fov_y > 0.0 && fov_y < 180.0) {
-            return Err(format!("fov_y = {fov_y} must lie strictly between 0 and 180 degrees"));
+            return Err(format!(
+                "fov_y = {fov_y} must lie strictly between 0 and 180 degrees"
+            ));
         }
         if width == 0 || height == 0 {
             return Err(format!("resolution {width}x{height} has a zero side"));
@@ -51,7 +60,14 @@ impl Camera {
     }
 
     pub fn with_resolution(&self, width: u32, height: u32) -> Result<Self, String> {
-        Camera::new(self.position, self.look_at, self.up, self.fov_y, width, height)
+        Camera::new(
+            self.position,
+            self.look_at,
+            self.up,
+            self.fov_y,
+            width,
+            height,
+        )
     }
 
     pub fn aspect(&self) -> f32 {
@@ -62,7 +78,10 @@ impl Camera {
     pub fn ray(&self, pixel: Vec2) -> Ray {
         let x = (2.0 * pixel.x / self.width as f32 - 1.0) * self.tan_half_fov * self.aspect();
         let y = (1.0 - 2.0 * pixel.y / self.height as f32) * self.tan_half_fov;
-        Ray::new(self.position, (self.forward + self.right * x + self.true_up * y).normalize())
+        Ray::new(
+            self.position,
+            (self.forward + self.right * x + self.true_up * y).normalize(),
+        )
     }
 
     pub fn forward(&self) -> Vec3 {

@@ -25,7 +25,13 @@ pub struct FixedRadius {
 /// One photon's contribution L_rp (eq. 4.3) for a Lambertian surface, in
 /// units of the photon's stored power: albedo/π · ΔΦ_p / (π r²) · w(d_p).
 #[inline]
-pub fn photon_contribution(x: Vec3, normal: Vec3, albedo: Rgb, photon: &Photon, params: &FixedRadius) -> Rgb {
+pub fn photon_contribution(
+    x: Vec3,
+    normal: Vec3,
+    albedo: Rgb,
+    photon: &Photon,
+    params: &FixedRadius,
+) -> Rgb {
     let d2 = (photon.position() - x).length_squared();
     if d2 > params.radius * params.radius {
         return Rgb::ZERO;
@@ -57,7 +63,15 @@ pub fn fixed_radius_radiance(
 
 /// The classic estimate (eq. 3.9): the k nearest photons within `max_radius`,
 /// divided by the area π r_k² of the disc that holds them.
-pub fn k_nearest_radiance(map: &PhotonMap, x: Vec3, normal: Vec3, albedo: Rgb, k: usize, max_radius: f32, normal_test: bool) -> Rgb {
+pub fn k_nearest_radiance(
+    map: &PhotonMap,
+    x: Vec3,
+    normal: Vec3,
+    albedo: Rgb,
+    k: usize,
+    max_radius: f32,
+    normal_test: bool,
+) -> Rgb {
     let (photons, r) = map.nearest(x, k, max_radius);
     if photons.is_empty() || r <= 0.0 {
         return Rgb::ZERO;
@@ -87,15 +101,26 @@ mod tests {
         let photons: Vec<Photon> = (0..n)
             .map(|_| {
                 let u = rng.next_2d() * 2.0 - 1.0;
-                Photon::new(Vec3::new(u.x, 0.0, u.y), Vec3::ONE, Vec3::NEG_Y, PathClass::Indirect)
+                Photon::new(
+                    Vec3::new(u.x, 0.0, u.y),
+                    Vec3::ONE,
+                    Vec3::NEG_Y,
+                    PathClass::Indirect,
+                )
             })
             .collect();
         let map = PhotonMap::new(photons, irradiance * 4.0 / n as f32);
         let albedo = Vec3::splat(0.5);
         let want = 0.5 * irradiance / PI;
-        let params = FixedRadius { radius: 0.1, normal_test: true };
+        let params = FixedRadius {
+            radius: 0.1,
+            normal_test: true,
+        };
         let fixed = fixed_radius_radiance(&map, None, Vec3::ZERO, Vec3::Y, albedo, &params);
-        assert!((fixed.x - want).abs() / want < 0.05, "fixed {fixed} vs {want}");
+        assert!(
+            (fixed.x - want).abs() / want < 0.05,
+            "fixed {fixed} vs {want}"
+        );
         let knn = k_nearest_radiance(&map, Vec3::ZERO, Vec3::Y, albedo, 500, 1.0, true);
         assert!((knn.x - want).abs() / want < 0.08, "knn {knn} vs {want}");
         // Seen from below, every photon arrived from the other side.

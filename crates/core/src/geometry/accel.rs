@@ -6,7 +6,7 @@
 
 use super::{Ray, Sphere, Triangle};
 use glam::{Vec3, Vec3A};
-use obvhs::{BvhBuildParams, Boundable, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
 use std::time::Duration;
 
 /// What a closest-hit query found.
@@ -70,9 +70,18 @@ impl Accel {
             lo = lo.min(b.0.min.into());
             hi = hi.max(b.0.max.into());
         }
-        let scale = if bounds.is_empty() { 1.0 } else { (hi - lo).max_element().max(1e-3) };
-        let bvh = (!bounds.is_empty())
-            .then(|| build_cwbvh(&bounds, BvhBuildParams::medium_build(), &mut Duration::default()));
+        let scale = if bounds.is_empty() {
+            1.0
+        } else {
+            (hi - lo).max_element().max(1e-3)
+        };
+        let bvh = (!bounds.is_empty()).then(|| {
+            build_cwbvh(
+                &bounds,
+                BvhBuildParams::medium_build(),
+                &mut Duration::default(),
+            )
+        });
         let mut surface_of = triangle_surfaces;
         surface_of.extend(sphere_surfaces);
         Accel {
@@ -92,7 +101,11 @@ impl Accel {
 
     /// Length of the scene's bounding-box diagonal (1 for an empty scene).
     pub fn diagonal(&self) -> f32 {
-        if self.surface_of.is_empty() { 1.0 } else { (self.bounds_max - self.bounds_min).length() }
+        if self.surface_of.is_empty() {
+            1.0
+        } else {
+            (self.bounds_max - self.bounds_min).length()
+        }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -108,7 +121,13 @@ impl Accel {
     /// so such components are nudged to a tiny value; the primitive tests
     /// still use the exact ray.
     fn obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
-        let nudge = |d: f32| if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d };
+        let nudge = |d: f32| {
+            if d.abs() < 1e-20 {
+                1e-20f32.copysign(d)
+            } else {
+                d
+            }
+        };
         let dir = Vec3A::new(nudge(ray.dir.x), nudge(ray.dir.y), nudge(ray.dir.z));
         obvhs::ray::Ray::new(ray.origin.into(), dir, 0.0, ray.t_max)
     }
@@ -152,12 +171,20 @@ impl Accel {
             let n = ((point - s.center) / s.radius).normalize();
             (n, n)
         };
-        Some(Hit { t, point, geometric_normal, shading_normal, surface: self.surface_of[prim] })
+        Some(Hit {
+            t,
+            point,
+            geometric_normal,
+            shading_normal,
+            surface: self.surface_of[prim],
+        })
     }
 
     /// True if anything blocks the open segment (epsilon, ray.t_max).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else { return false };
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
         let n_tri = self.triangles.len();
         let eps = self.epsilon;
         !bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| {
@@ -186,7 +213,10 @@ mod tests {
             tris.push(Triangle { v, normals: None });
         }
         let spheres = (0..40)
-            .map(|_| Sphere { center: (rng.next_2d().extend(rng.next_f32()) - 0.5) * 10.0, radius: 0.3 })
+            .map(|_| Sphere {
+                center: (rng.next_2d().extend(rng.next_f32()) - 0.5) * 10.0,
+                radius: 0.3,
+            })
             .collect();
         (tris, spheres)
     }
@@ -198,12 +228,22 @@ mod tests {
             let tris: Vec<Triangle> = (0..n)
                 .map(|i| {
                     let z = -(i as f32);
-                    Triangle { v: [Vec3::new(0.0, 0.0, z), Vec3::new(2.0, 0.0, z), Vec3::new(0.0, 2.0, z)], normals: None }
+                    Triangle {
+                        v: [
+                            Vec3::new(0.0, 0.0, z),
+                            Vec3::new(2.0, 0.0, z),
+                            Vec3::new(0.0, 2.0, z),
+                        ],
+                        normals: None,
+                    }
                 })
                 .collect();
             let accel = Accel::build(tris, (0..n).collect(), vec![], vec![]);
             let hit = accel.intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z));
-            assert!(hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-6), "{n} triangles: {hit:?}");
+            assert!(
+                hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-6),
+                "{n} triangles: {hit:?}"
+            );
             assert!(accel.occluded(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)));
         }
     }
@@ -220,7 +260,10 @@ mod tests {
         );
         let mut rng = Rng::for_item(12, 0);
         for _ in 0..2000 {
-            let ray = Ray::new((rng.next_2d().extend(rng.next_f32()) - 0.5) * 12.0, uniform_sphere(rng.next_2d()));
+            let ray = Ray::new(
+                (rng.next_2d().extend(rng.next_f32()) - 0.5) * 12.0,
+                uniform_sphere(rng.next_2d()),
+            );
             let mut best: Option<(f32, u32)> = None;
             for (i, t) in tris.iter().enumerate() {
                 if let Some((th, _, _)) = t.intersect(&ray, accel.epsilon) {

@@ -10,7 +10,8 @@ const MAX_EXP: i32 = 31;
 /// Shared-exponent RGB (the RGB9E5 format of GL/Vulkan): 9-bit mantissas,
 /// 5-bit exponent; error ≤ 2⁻⁹ of the largest channel.
 pub fn encode_rgb9e5(c: Vec3) -> u32 {
-    let max_value = ((1 << MANTISSA_BITS) - 1) as f32 / (1 << MANTISSA_BITS) as f32 * 2f32.powi(MAX_EXP - EXP_BIAS);
+    let max_value = ((1 << MANTISSA_BITS) - 1) as f32 / (1 << MANTISSA_BITS) as f32
+        * 2f32.powi(MAX_EXP - EXP_BIAS);
     let c = c.clamp(Vec3::ZERO, Vec3::splat(max_value));
     let max_c = c.max_element();
     if max_c <= 0.0 || max_c.is_nan() {
@@ -30,7 +31,11 @@ pub fn encode_rgb9e5(c: Vec3) -> u32 {
 pub fn decode_rgb9e5(bits: u32) -> Vec3 {
     let exp = (bits >> 27) as i32;
     let scale = 2f32.powi(exp - EXP_BIAS - MANTISSA_BITS);
-    Vec3::new((bits & 511) as f32, ((bits >> 9) & 511) as f32, ((bits >> 18) & 511) as f32) * scale
+    Vec3::new(
+        (bits & 511) as f32,
+        ((bits >> 9) & 511) as f32,
+        ((bits >> 18) & 511) as f32,
+    ) * scale
 }
 
 /// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.

@@ -4,9 +4,9 @@
 //! density with respect to solid angle; `chi2` tests check each one against
 //! its stated density.
 
-mod rng;
 #[cfg(test)]
 pub(crate) mod chi2;
+mod rng;
 
 pub use rng::Rng;
 
@@ -103,7 +103,13 @@ mod tests {
     #[test]
     fn uniform_cone_matches_its_density() {
         let cos_max = 0.8f32;
-        let pdf = move |w: Vec3| if w.z >= cos_max { uniform_cone_pdf(cos_max) } else { 0.0 };
+        let pdf = move |w: Vec3| {
+            if w.z >= cos_max {
+                uniform_cone_pdf(cos_max)
+            } else {
+                0.0
+            }
+        };
         assert_direction_distribution(move |u| uniform_cone(u, cos_max), pdf);
         assert_unit_density(pdf);
     }

@@ -1,0 +1,214 @@
+//! The `hikari` binary as a user meets it: good runs, bad input, exit codes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn hikari(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the binary runs")
+}
+
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hikari-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// A failure: non-zero exit, the expected words on stderr, no panic, no image.
+fn assert_fails_with(out: &Output, dir: &Path, words: &[&str]) {
+    let err = stderr(out);
+    assert!(!out.status.success(), "succeeded: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    for w in words {
+        assert!(err.contains(w), "stderr lacks {w:?}: {err}");
+    }
+    let images: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.path().extension().is_some_and(|x| x == "png"))
+        .collect();
+    assert!(images.is_empty(), "an image was left behind");
+}
+
+const SCENE: &str = r#"
+[camera]
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+resolution = [8, 8]
+
+[[material]]
+name = "white"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[object]]
+shape = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "white"
+
+[[light]]
+type = "point"
+position = [0.0, 2.0, 2.0]
+intensity = [5.0, 5.0, 5.0]
+"#;
+
+#[test]
+fn renders_a_builtin_scene_and_reports() {
+    let dir = scratch_dir("ok");
+    let out = hikari(
+        &[
+            "render",
+            "cornell-caustic",
+            "--resolution",
+            "24x16",
+            "--photons",
+            "3000",
+            "-o",
+            "out.png",
+            "-q",
+        ],
+        &dir,
+    );
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("3000 emitted") && err.contains("paths/s") && err.contains("wrote out.png"),
+        "{err}"
+    );
+    let img = image::open(dir.join("out.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (24, 16));
+    let out = hikari(
+        &[
+            "render",
+            "--renderer",
+            "path",
+            "--spp",
+            "2",
+            "--resolution",
+            "8x8",
+            "-o",
+            "truth.exr",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(dir.join("truth.exr").is_file());
+}
+
+#[test]
+fn lists_builtin_scenes() {
+    let out = hikari(&["scenes"], &std::env::temp_dir());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && text.contains("cornell-box") && text.contains("cornell-caustic"),
+        "{text}"
+    );
+}
+
+#[test]
+fn bad_scene_files_are_reported_with_file_and_line() {
+    let dir = scratch_dir("bad");
+    let cases: &[(&str, String, &[&str])] = &[
+        (
+            "syntax.toml",
+            SCENE.replace("radius = 1.0", "radius = = 1.0"),
+            &["syntax.toml:15:10", "extra `=`"],
+        ),
+        (
+            "field.toml",
+            SCENE.replace("radius = 1.0", "radius = 1.0\ncolour = 3"),
+            &["field.toml:", "colour"],
+        ),
+        (
+            "material.toml",
+            SCENE.replace("material = \"white\"", "material = \"snow\""),
+            &[
+                "material.toml:16:",
+                "[[object]] #1",
+                "unknown material \"snow\"",
+            ],
+        ),
+        (
+            "mesh.toml",
+            SCENE.replace(
+                "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
+                "mesh = \"missing.obj\"",
+            ),
+            &["mesh.toml:", "missing.obj", "not found"],
+        ),
+        (
+            "albedo.toml",
+            SCENE.replace("albedo = [0.5, 0.5, 0.5]", "albedo = [0.5, -0.5, 0.5]"),
+            &["albedo.toml:", "[[material]] #1", "negative"],
+        ),
+        (
+            "bright.toml",
+            SCENE.replace("albedo = [0.5, 0.5, 0.5]", "albedo = [0.5, 1.5, 0.5]"),
+            &["bright.toml:", "above 1"],
+        ),
+        (
+            "nan.toml",
+            SCENE.replace("radius = 1.0", "radius = nan"),
+            &["nan.toml:", "radius"],
+        ),
+        (
+            "camera.toml",
+            SCENE.replace("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 0.0, 3.0]"),
+            &["camera.toml:", "[camera]", "coincide"],
+        ),
+    ];
+    for (name, text, words) in cases {
+        std::fs::write(dir.join(name), text).unwrap();
+        let out = hikari(&["render", name, "-o", "out.png", "-q"], &dir);
+        assert_fails_with(&out, &dir, words);
+    }
+}
+
+#[test]
+fn bad_options_are_rejected() {
+    let dir = scratch_dir("opts");
+    std::fs::write(dir.join("ok.toml"), SCENE).unwrap();
+    assert_fails_with(
+        &hikari(&["render", "ok.toml", "--photons", "0"], &dir),
+        &dir,
+        &["--photons"],
+    );
+    assert_fails_with(
+        &hikari(&["render", "ok.toml", "--radius", "-1"], &dir),
+        &dir,
+        &["--radius"],
+    );
+    assert_fails_with(
+        &hikari(&["render", "ok.toml", "-o", "out.jpg"], &dir),
+        &dir,
+        &["out.jpg", "unsupported"],
+    );
+    assert_fails_with(
+        &hikari(&["render", "ok.toml", "--resolution", "0x5"], &dir),
+        &dir,
+        &["--resolution"],
+    );
+    assert_fails_with(
+        &hikari(&["render", "no-such-scene", "-o", "out.png"], &dir),
+        &dir,
+        &["no-such-scene", "cornell-box"],
+    );
+    assert_fails_with(
+        &hikari(
+            &["render", "ok.toml", "-o", "no/such/dir/out.png", "-q"],
+            &dir,
+        ),
+        &dir,
+        &["out.png"],
+    );
+}
