@@ -22,8 +22,23 @@ pub struct FixedRadius {
     pub normal_test: bool,
 }
 
-/// One photon's contribution L_rp (eq. 4.3) for a Lambertian surface, in
-/// units of the photon's stored power: albedo/π · ΔΦ_p / (π r²) · w(d_p).
+/// The kernel w(d_p) of eq. 4.1 with the optional normal test: 1 if photon
+/// `p` counts at `x`, else 0. `d2` is |x − x_p|².
+#[inline]
+pub fn photon_accepted(d2: f32, photon_dir: Vec3, normal: Vec3, params: &FixedRadius) -> bool {
+    d2 <= params.radius * params.radius && !(params.normal_test && photon_dir.dot(normal) >= 0.0)
+}
+
+/// The factor turning accepted photon power into reflected radiance for a
+/// Lambertian surface: f_r / (π r²) = albedo / (π² r²).
+#[inline]
+pub fn radiance_per_power(albedo: Rgb, params: &FixedRadius) -> Rgb {
+    albedo * (1.0 / (PI * PI * params.radius * params.radius))
+}
+
+/// One photon's contribution L_rp (eq. 4.3), in units of the photon's stored
+/// power: albedo/π · ΔΦ_p / (π r²) · w(d_p). This is what the GPU splat adds
+/// per fragment.
 #[inline]
 pub fn photon_contribution(
     x: Vec3,
@@ -33,17 +48,16 @@ pub fn photon_contribution(
     params: &FixedRadius,
 ) -> Rgb {
     let d2 = (photon.position() - x).length_squared();
-    if d2 > params.radius * params.radius {
-        return Rgb::ZERO;
+    if photon_accepted(d2, photon.direction(), normal, params) {
+        radiance_per_power(albedo, params) * photon.power_in_units()
+    } else {
+        Rgb::ZERO
     }
-    if params.normal_test && photon.direction().dot(normal) >= 0.0 {
-        return Rgb::ZERO;
-    }
-    albedo * photon.power_in_units() * (1.0 / (PI * PI * params.radius * params.radius))
 }
 
 /// The seed's estimate (eq. 4.1): the sum of `photon_contribution` over every
-/// photon of `map` in `class` (all classes if None) within r of x.
+/// photon of `map` in `class` (all classes if None) within r of x, computed
+/// as (Σ accepted power) × `radiance_per_power` — the same sum, factored.
 pub fn fixed_radius_radiance(
     map: &PhotonMap,
     class: Option<PathClass>,
@@ -52,13 +66,21 @@ pub fn fixed_radius_radiance(
     albedo: Rgb,
     params: &FixedRadius,
 ) -> Rgb {
-    let mut sum = Rgb::ZERO;
-    map.for_each_within(x, params.radius, |p| {
-        if class.is_none_or(|c| p.class() == c) {
-            sum += photon_contribution(x, normal, albedo, p, params);
+    let photons = map.photons();
+    let mut power = Rgb::ZERO;
+    map.for_each_index_within(x, params.radius, |i, d2| {
+        let p = &photons[i];
+        let dir_needed = params.normal_test;
+        let accepted = if dir_needed {
+            photon_accepted(d2, p.direction(), normal, params)
+        } else {
+            d2 <= params.radius * params.radius
+        };
+        if accepted && class.is_none_or(|c| p.class() == c) {
+            power += map.power_in_units(i);
         }
     });
-    sum * map.power_unit
+    radiance_per_power(albedo, params) * power * map.power_unit
 }
 
 /// The classic estimate (eq. 3.9): the k nearest photons within `max_radius`,

@@ -5,32 +5,37 @@ use glam::{Vec2, Vec3};
 
 const MANTISSA_BITS: i32 = 9;
 const EXP_BIAS: i32 = 15;
-const MAX_EXP: i32 = 31;
 
 /// Shared-exponent RGB (the RGB9E5 format of GL/Vulkan): 9-bit mantissas,
 /// 5-bit exponent; error ≤ 2⁻⁹ of the largest channel.
 pub fn encode_rgb9e5(c: Vec3) -> u32 {
-    let max_value = ((1 << MANTISSA_BITS) - 1) as f32 / (1 << MANTISSA_BITS) as f32
-        * 2f32.powi(MAX_EXP - EXP_BIAS);
-    let c = c.clamp(Vec3::ZERO, Vec3::splat(max_value));
+    const MAX_VALUE: f32 = 511.0 / 512.0 * 65536.0;
+    let c = c.clamp(Vec3::ZERO, Vec3::splat(MAX_VALUE));
     let max_c = c.max_element();
-    if max_c <= 0.0 || max_c.is_nan() {
+    // Below the smallest representable step: zero (also catches NaN, which clamp keeps).
+    if !(max_c >= 2f32.powi(-EXP_BIAS - MANTISSA_BITS)) {
         return 0;
     }
-    let mut exp = (max_c.log2().floor() as i32).max(-EXP_BIAS - 1) + 1 + EXP_BIAS;
-    let mut scale = 2f32.powi(exp - EXP_BIAS - MANTISSA_BITS);
-    if (max_c / scale).round() as u32 == 1 << MANTISSA_BITS {
+    // floor(log2(max_c)) from the float's exponent bits (max_c is normal here).
+    let floor_log2 = ((max_c.to_bits() >> 23) & 0xff) as i32 - 127;
+    let mut exp = floor_log2.max(-EXP_BIAS - 1) + 1 + EXP_BIAS;
+    let mut inv_scale = pow2(MANTISSA_BITS + EXP_BIAS - exp);
+    if (max_c * inv_scale + 0.5) as u32 == 1 << MANTISSA_BITS {
         exp += 1;
-        scale *= 2.0;
+        inv_scale *= 0.5;
     }
-    let exp = exp.clamp(0, MAX_EXP);
-    let q = |x: f32| ((x / scale).round() as u32).min((1 << MANTISSA_BITS) - 1);
+    // Round half up; inputs are non-negative and scaling by 2^k is exact.
+    let q = |x: f32| ((x * inv_scale + 0.5) as u32).min((1 << MANTISSA_BITS) - 1);
     q(c.x) | (q(c.y) << 9) | (q(c.z) << 18) | ((exp as u32) << 27)
 }
 
+/// 2^k for the normal-float range, exactly, from the exponent bits.
+fn pow2(k: i32) -> f32 {
+    f32::from_bits(((k + 127) as u32) << 23)
+}
+
 pub fn decode_rgb9e5(bits: u32) -> Vec3 {
-    let exp = (bits >> 27) as i32;
-    let scale = 2f32.powi(exp - EXP_BIAS - MANTISSA_BITS);
+    let scale = pow2((bits >> 27) as i32 - EXP_BIAS - MANTISSA_BITS);
     Vec3::new(
         (bits & 511) as f32,
         ((bits >> 9) & 511) as f32,
@@ -45,7 +50,7 @@ pub fn encode_octahedral_15(d: Vec3) -> u32 {
     if d.z < 0.0 {
         p = (Vec2::ONE - Vec2::new(p.y.abs(), p.x.abs())) * Vec2::new(p.x.signum(), p.y.signum());
     }
-    let q = |x: f32| (((x.clamp(-1.0, 1.0) * 0.5 + 0.5) * 32767.0).round() as u32) & 0x7fff;
+    let q = |x: f32| ((x.clamp(-1.0, 1.0) * 0.5 + 0.5) * 32767.0 + 0.5) as u32 & 0x7fff;
     q(p.x) | (q(p.y) << 15)
 }
 

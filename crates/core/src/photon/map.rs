@@ -9,6 +9,9 @@ use std::num::NonZeroUsize;
 
 pub struct PhotonMap {
     photons: Vec<Photon>,
+    /// `photons[i].power_in_units()`, decoded once: the estimate reads it for
+    /// every photon in range, and decoding is exact, so nothing changes.
+    power: Vec<Vec3>,
     tree: Option<ImmutableKdTree<f32, 3>>,
     /// Watts per unit of `Photon::power_in_units`.
     pub power_unit: f32,
@@ -22,8 +25,10 @@ impl PhotonMap {
             ImmutableKdTree::new_from_slice(&points)
                 .expect("photon positions are finite by construction")
         });
+        let power = photons.iter().map(Photon::power_in_units).collect();
         PhotonMap {
             photons,
+            power,
             tree,
             power_unit,
         }
@@ -44,12 +49,24 @@ impl PhotonMap {
     /// Calls `visit` for every photon with |x − x_p| ≤ `radius` (eq. 4.1's w(d)).
     #[inline]
     pub fn for_each_within(&self, x: Vec3, radius: f32, mut visit: impl FnMut(&Photon)) {
+        self.for_each_index_within(x, radius, |i, _| visit(&self.photons[i]));
+    }
+
+    /// Like `for_each_within`, giving the photon's index and squared distance.
+    #[inline]
+    pub fn for_each_index_within(&self, x: Vec3, radius: f32, mut visit: impl FnMut(usize, f32)) {
         if let Some(tree) = &self.tree {
             tree.query(&x.to_array())
                 .within::<SquaredEuclidean<f32>>(radius * radius)
                 .unsorted()
-                .visit(|r| visit(&self.photons[r.item as usize]));
+                .visit(|r| visit(r.item as usize, r.distance));
         }
+    }
+
+    /// Decoded power of photon `i`, in power units.
+    #[inline]
+    pub fn power_in_units(&self, i: usize) -> Vec3 {
+        self.power[i]
     }
 
     /// The `k` photons nearest to `x` (at most `max_radius` away), and the
