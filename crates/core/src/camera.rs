@@ -2,7 +2,7 @@
 //! pixel coordinates are continuous, pixel (i,j) covering [i,i+1)×[j,j+1).
 
 use crate::geometry::Ray;
-use glam::{Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -87,6 +87,32 @@ impl Camera {
     pub fn forward(&self) -> Vec3 {
         self.forward
     }
+
+    /// World-to-view transform: view space is right-handed, looking down −z.
+    pub fn view_from_world(&self) -> Mat4 {
+        let (r, u, f) = (self.right, self.true_up, self.forward);
+        let p = self.position;
+        Mat4::from_cols(
+            Vec4::new(r.x, u.x, -f.x, 0.0),
+            Vec4::new(r.y, u.y, -f.y, 0.0),
+            Vec4::new(r.z, u.z, -f.z, 0.0),
+            Vec4::new(-r.dot(p), -u.dot(p), f.dot(p), 1.0),
+        )
+    }
+
+    /// Perspective projection to wgpu clip space (depth 0 at `near`, 1 at
+    /// `far`), matching `ray`: the ray through a pixel centre projects there.
+    pub fn clip_from_view(&self, near: f32, far: f32) -> Mat4 {
+        let fy = 1.0 / self.tan_half_fov;
+        let fx = fy / self.aspect();
+        let a = far / (near - far);
+        Mat4::from_cols(
+            Vec4::new(fx, 0.0, 0.0, 0.0),
+            Vec4::new(0.0, fy, 0.0, 0.0),
+            Vec4::new(0.0, 0.0, a, -1.0),
+            Vec4::new(0.0, 0.0, a * near, 0.0),
+        )
+    }
 }
 
 #[cfg(test)]
@@ -102,6 +128,32 @@ mod tests {
         assert!(tl.dir.x < 0.0 && tl.dir.y > 0.0);
         let top = cam.ray(Vec2::new(32.0, 0.0));
         assert!((top.dir.y.atan2(-top.dir.z).to_degrees() - 20.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn projection_matches_primary_rays() {
+        let cam = Camera::new(
+            Vec3::new(0.3, 0.2, 4.0),
+            Vec3::new(0.1, -0.1, 0.0),
+            Vec3::Y,
+            40.0,
+            64,
+            48,
+        )
+        .unwrap();
+        let clip_from_world = cam.clip_from_view(0.1, 100.0) * cam.view_from_world();
+        for pixel in [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(10.5, 40.5),
+            Vec2::new(63.5, 0.5),
+        ] {
+            let p = cam.ray(pixel).at(3.7);
+            let clip = clip_from_world * p.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            let back = Vec2::new((ndc.x + 1.0) * 0.5 * 64.0, (1.0 - ndc.y) * 0.5 * 48.0);
+            assert!((back - pixel).length() < 1e-3, "{pixel} -> {back}");
+            assert!(ndc.z > 0.0 && ndc.z < 1.0);
+        }
     }
 
     #[test]

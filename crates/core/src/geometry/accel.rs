@@ -189,6 +189,18 @@ impl Accel {
         }
     }
 
+    /// Every triangle with its surface id (for rasterization).
+    pub fn triangles(&self) -> impl Iterator<Item = (&Triangle, u32)> {
+        self.triangles.iter().zip(self.surface_of.iter().copied())
+    }
+
+    /// Every analytic sphere with its surface id.
+    pub fn spheres(&self) -> impl Iterator<Item = (&Sphere, u32)> {
+        self.spheres
+            .iter()
+            .zip(self.surface_of[self.triangles.len()..].iter().copied())
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

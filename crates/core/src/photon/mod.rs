@@ -30,7 +30,7 @@ pub enum PathClass {
 
 /// A stored photon: 20 bytes, `#[repr(C)]` so it can be uploaded as is.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Photon {
     pub position: [f32; 3],
     /// Power in units of the map's `power_unit`, RGB9E5-encoded.

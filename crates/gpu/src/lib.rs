@@ -1,0 +1,25 @@
+//! # hikari-gpu
+//!
+//! The seed's method on the GPU with wgpu (METHOD.md §4): the scene is
+//! rasterized once into a G-buffer, then every photon is drawn as one
+//! instanced quad covering the screen footprint of its radius-r sphere, and
+//! the fragment shader adds that photon's contribution at the pixel's surface
+//! point. The estimate is the one of `hikari_core::estimate`, mirrored in
+//! `estimate.wgsl`; the twin tests hold the two to the same numbers.
+//!
+//! Each pass is a small struct with its pipeline, its shader beside it.
+
+pub mod context;
+pub mod gbuffer;
+pub mod readback;
+pub mod renderer;
+pub mod scene_upload;
+pub mod splat;
+
+pub use context::{GpuContext, GpuError};
+pub use renderer::{GpuRenderer, GpuSettings};
+
+/// The WGSL mirror of `hikari_core::estimate`, prepended to the shaders that use it.
+pub const ESTIMATE_WGSL: &str = include_str!("estimate.wgsl");
+#[doc(hidden)]
+pub mod test_support;

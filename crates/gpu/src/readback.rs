@@ -1,0 +1,109 @@
+//! Copying textures back to the CPU (tests, image output).
+
+use crate::context::{GpuContext, GpuError};
+use glam::Vec4;
+
+/// Reads a 2D `Rgba32Float` or `Rgba16Float` texture as row-major RGBA,
+/// row 0 at the top.
+pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>, GpuError> {
+    let (width, height) = (texture.width(), texture.height());
+    let texel_bytes = match texture.format() {
+        wgpu::TextureFormat::Rgba32Float => 16,
+        wgpu::TextureFormat::Rgba16Float => 8,
+        other => return Err(GpuError::Readback(format!("cannot read back {other:?}"))),
+    };
+    let unpadded = width * texel_bytes;
+    let padded =
+        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: (padded * height) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+    );
+    ctx.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| GpuError::Readback(e.to_string()))?
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = slice
+        .get_mapped_range()
+        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    let mut out = Vec::with_capacity((width * height) as usize);
+    for row in 0..height {
+        let bytes = &data[(row * padded) as usize..(row * padded + unpadded) as usize];
+        if texel_bytes == 16 {
+            out.extend(
+                bytemuck::cast_slice::<u8, [f32; 4]>(bytes)
+                    .iter()
+                    .map(|&v| Vec4::from(v)),
+            );
+        } else {
+            out.extend(
+                bytemuck::cast_slice::<u8, [u16; 4]>(bytes)
+                    .iter()
+                    .map(|v| Vec4::from(v.map(f16_to_f32))),
+            );
+        }
+    }
+    drop(data);
+    buffer.unmap();
+    Ok(out)
+}
+
+/// IEEE half to single precision, exactly.
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = ((h >> 15) as u32) << 31;
+    let exp = ((h >> 10) & 0x1f) as u32;
+    let mant = (h & 0x3ff) as u32;
+    let bits = match exp {
+        0 if mant == 0 => sign,
+        0 => {
+            return f32::from_bits(sign)
+                + (mant as f32) * 2f32.powi(-24) * if sign != 0 { -1.0 } else { 1.0 };
+        }
+        31 => sign | 0x7f80_0000 | (mant << 13),
+        _ => sign | ((exp + 112) << 23) | (mant << 13),
+    };
+    f32::from_bits(bits)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn half_floats_convert_exactly() {
+        assert_eq!(super::f16_to_f32(0x3c00), 1.0);
+        assert_eq!(super::f16_to_f32(0xc000), -2.0);
+        assert_eq!(super::f16_to_f32(0x0001), 2f32.powi(-24));
+        assert_eq!(super::f16_to_f32(0x7bff), 65504.0);
+    }
+}

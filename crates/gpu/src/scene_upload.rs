@@ -1,0 +1,184 @@
+//! The scene as the rasterizer sees it: one vertex buffer of triangles
+//! (analytic spheres tessellated finely) and a storage buffer of surfaces.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use hikari_core::material::Material;
+use hikari_core::scene::Scene;
+use wgpu::util::DeviceExt;
+
+/// One rasterized vertex. Mirrors `VertexIn` in gbuffer.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuVertex {
+    pub position: [f32; 3],
+    /// Shading normal (smooth for OBJ normals and spheres).
+    pub normal: [f32; 3],
+    /// The triangle's geometric normal (winding side; outward for spheres).
+    pub geometric_normal: [f32; 3],
+    pub surface: u32,
+}
+
+/// Material kinds as the G-buffer stores them.
+pub mod kind {
+    pub const DIFFUSE: u32 = 0;
+    pub const MIRROR: u32 = 1;
+    pub const GLASS: u32 = 2;
+    pub const EMITTER: u32 = 3;
+}
+
+/// Per-surface shading data. Mirrors `Surface` in gbuffer.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuSurface {
+    pub albedo: [f32; 3],
+    pub kind: u32,
+    /// Radiance emitted toward the side the geometric normal faces.
+    pub emission: [f32; 3],
+    pub _pad: u32,
+}
+
+/// Segments around a tessellated sphere: fine enough that its silhouette is
+/// within a fraction of a pixel of the analytic one at the built-in sizes.
+const SPHERE_SEGMENTS: u32 = 96;
+
+pub struct SceneBuffers {
+    pub vertices: wgpu::Buffer,
+    pub vertex_count: u32,
+    pub surfaces: wgpu::Buffer,
+}
+
+pub fn scene_vertices(scene: &Scene) -> Vec<GpuVertex> {
+    let mut out = Vec::new();
+    for (tri, surface) in scene.accel.triangles() {
+        let ng = tri.geometric_normal().normalize();
+        let normals = match tri.normals {
+            Some(n) => n.0,
+            None => [ng; 3],
+        };
+        for k in 0..3 {
+            out.push(GpuVertex {
+                position: tri.v[k].to_array(),
+                normal: normals[k].to_array(),
+                geometric_normal: ng.to_array(),
+                surface,
+            });
+        }
+    }
+    for (sphere, surface) in scene.accel.spheres() {
+        tessellate_sphere(sphere.center, sphere.radius, surface, &mut out);
+    }
+    out
+}
+
+/// UV sphere, wound so triangle normals point outward.
+fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuVertex>) {
+    let (n_phi, n_theta) = (SPHERE_SEGMENTS, SPHERE_SEGMENTS / 2);
+    let point = |i: u32, j: u32| {
+        // Exact poles, so the collapsed triangles there are exactly degenerate.
+        if j == 0 {
+            return Vec3::Y;
+        } else if j == n_theta {
+            return Vec3::NEG_Y;
+        }
+        let theta = std::f32::consts::PI * j as f32 / n_theta as f32;
+        let phi = 2.0 * std::f32::consts::PI * i as f32 / n_phi as f32;
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
+    };
+    let mut push = |a: Vec3, b: Vec3, c: Vec3| {
+        let ng = (b - a).cross(c - a);
+        if ng.length_squared() == 0.0 {
+            return;
+        }
+        let ng = ng.normalize();
+        for n in [a, b, c] {
+            out.push(GpuVertex {
+                position: (center + n * radius).to_array(),
+                normal: n.to_array(),
+                geometric_normal: ng.to_array(),
+                surface,
+            });
+        }
+    };
+    for j in 0..n_theta {
+        for i in 0..n_phi {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            // φ grows toward +z at φ = 0 and θ toward −y, so (b−a)×(c−a) points outward.
+            push(a, b, c);
+            push(a, c, d);
+        }
+    }
+}
+
+pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
+    scene
+        .surfaces
+        .iter()
+        .map(|s| {
+            let material = &scene.materials[s.material as usize];
+            let (kind, albedo) = match material {
+                Material::Diffuse { albedo, .. } => (kind::DIFFUSE, *albedo),
+                Material::Mirror { reflectance } => (kind::MIRROR, *reflectance),
+                Material::Glass { .. } => (kind::GLASS, Vec3::ONE),
+                Material::Emitter => (kind::EMITTER, Vec3::ZERO),
+            };
+            let emission = s
+                .emitter
+                .map_or(Vec3::ZERO, |l| match &scene.lights[l as usize] {
+                    hikari_core::light::Light::Sphere { radiance, .. }
+                    | hikari_core::light::Light::Quad { radiance, .. } => *radiance,
+                    _ => Vec3::ZERO,
+                });
+            GpuSurface {
+                albedo: albedo.to_array(),
+                kind,
+                emission: emission.to_array(),
+                _pad: 0,
+            }
+        })
+        .collect()
+}
+
+impl SceneBuffers {
+    pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
+        let vertices = scene_vertices(scene);
+        let surfaces = scene_surfaces(scene);
+        SceneBuffers {
+            vertex_count: vertices.len() as u32,
+            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("scene vertices"),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+            surfaces: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("scene surfaces"),
+                contents: bytemuck::cast_slice(&surfaces),
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tessellated_sphere_winds_outward() {
+        let mut v = Vec::new();
+        tessellate_sphere(Vec3::new(1.0, 2.0, 3.0), 0.5, 0, &mut v);
+        for tri in v.chunks(3) {
+            let c = tri.iter().map(|x| Vec3::from(x.position)).sum::<Vec3>() / 3.0;
+            assert!(Vec3::from(tri[0].geometric_normal).dot(c - Vec3::new(1.0, 2.0, 3.0)) > 0.0);
+        }
+    }
+}

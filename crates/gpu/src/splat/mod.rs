@@ -1,0 +1,242 @@
+//! The photon splat pass: instanced quads, one per photon, additively
+//! blended into a float radiance target (METHOD.md §4, steps 2–3).
+
+use crate::gbuffer::GBuffer;
+use bytemuck::{Pod, Zeroable};
+use hikari_core::photon::Photon;
+use wgpu::util::DeviceExt;
+
+/// Mirrors `SplatParams` in splat.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SplatParams {
+    pub clip_from_world: [[f32; 4]; 4],
+    pub radius: f32,
+    pub power_unit: f32,
+    pub normal_test: u32,
+    pub _pad: u32,
+}
+
+/// The 20-byte `Photon` as per-instance attributes, offsets written by hand
+/// (a test checks them against the struct).
+pub const PHOTON_ATTRIBUTES: [wgpu::VertexAttribute; 3] = [
+    wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x3,
+        offset: 0,
+        shader_location: 0,
+    },
+    wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Uint32,
+        offset: 12,
+        shader_location: 1,
+    },
+    wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Uint32,
+        offset: 16,
+        shader_location: 2,
+    },
+];
+
+pub fn shader_source() -> String {
+    format!("{}\n{}", crate::ESTIMATE_WGSL, include_str!("splat.wgsl"))
+}
+
+/// Photons uploaded once per photon map, drawn every frame.
+pub struct PhotonBuffer {
+    pub buffer: wgpu::Buffer,
+    pub count: u32,
+}
+
+impl PhotonBuffer {
+    pub fn upload(device: &wgpu::Device, photons: &[Photon], label: &str) -> Self {
+        // wgpu refuses empty buffers: keep one zeroed photon, draw none.
+        let zero = [Photon::new(
+            glam::Vec3::ZERO,
+            glam::Vec3::ZERO,
+            glam::Vec3::Y,
+            hikari_core::photon::PathClass::Indirect,
+        )];
+        let data = if photons.is_empty() {
+            &zero[..]
+        } else {
+            photons
+        };
+        PhotonBuffer {
+            buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(data),
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
+            }),
+            count: photons.len() as u32,
+        }
+    }
+}
+
+pub struct SplatPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+impl SplatPass {
+    pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("splat.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("splat"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                texture_entry(1),
+                texture_entry(2),
+                texture_entry(3),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("splat"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("splat"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Photon>() as u64,
+                    step_mode: wgpu::VertexStepMode::Instance,
+                    attributes: &PHOTON_ATTRIBUTES,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleStrip,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: target_format,
+                    blend: Some(wgpu::BlendState {
+                        color: additive,
+                        alpha: additive,
+                    }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        SplatPass { pipeline, layout }
+    }
+
+    /// Adds the photons' radiance into `target` (loaded, not cleared, when
+    /// `clear` is false, so several maps can accumulate).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        gbuffer: &GBuffer,
+        photons: &PhotonBuffer,
+        instances: std::ops::Range<u32>,
+        params: &SplatParams,
+        target: &wgpu::TextureView,
+        clear: bool,
+    ) {
+        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("splat params"),
+            contents: bytemuck::bytes_of(params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (position, normal, albedo) = (
+            view(&gbuffer.position),
+            view(&gbuffer.normal),
+            view(&gbuffer.albedo),
+        );
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniforms.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&position),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&normal),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&albedo),
+                },
+            ],
+        });
+        let load = if clear {
+            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+        } else {
+            wgpu::LoadOp::Load
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("photon splat"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if instances.is_empty() || photons.count == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_vertex_buffer(0, photons.buffer.slice(..));
+        pass.draw(0..4, instances);
+    }
+}

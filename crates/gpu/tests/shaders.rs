@@ -1,0 +1,118 @@
+//! Every WGSL source parses and validates with naga, and every Rust struct
+//! shared with WGSL has the size and field offsets naga computes.
+
+use hikari_core::photon::Photon;
+use hikari_gpu::gbuffer::GBufferParams;
+use hikari_gpu::scene_upload::{GpuSurface, GpuVertex};
+use hikari_gpu::splat::SplatParams;
+use std::mem::{offset_of, size_of};
+
+fn shaders() -> Vec<(&'static str, String)> {
+    vec![
+        ("gbuffer.wgsl", hikari_gpu::gbuffer::SHADER.to_string()),
+        ("splat.wgsl", hikari_gpu::splat::shader_source()),
+        ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
+    ]
+}
+
+fn parse(name: &str, source: &str) -> naga::Module {
+    let module = naga::front::wgsl::parse_str(source)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    module
+}
+
+#[test]
+fn every_shader_validates() {
+    for (name, source) in shaders() {
+        parse(name, &source);
+    }
+}
+
+/// (size, [(field, offset)]) of the WGSL struct `name` in `source`.
+fn wgsl_layout(source: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let module = parse(name, source);
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                return (
+                    *span,
+                    members
+                        .iter()
+                        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                        .collect(),
+                );
+            }
+        }
+    }
+    panic!("struct {name} not found");
+}
+
+macro_rules! assert_layout {
+    ($source:expr, $wgsl:literal, $rust:ty, [$($field:ident),*]) => {{
+        let (size, members) = wgsl_layout(&$source, $wgsl);
+        assert_eq!(size as usize, size_of::<$rust>(), "size of {}", $wgsl);
+        let rust = [$((stringify!($field), offset_of!($rust, $field))),*];
+        assert_eq!(members.len(), rust.len(), "field count of {}", $wgsl);
+        for ((wname, woff), (rname, roff)) in members.iter().zip(rust) {
+            assert_eq!(wname, rname, "field order of {}", $wgsl);
+            assert_eq!(*woff as usize, roff, "offset of {}.{}", $wgsl, wname);
+        }
+    }};
+}
+
+#[test]
+fn shared_structs_match_wgsl_layouts() {
+    let gbuffer = hikari_gpu::gbuffer::SHADER.to_string();
+    assert_layout!(
+        gbuffer,
+        "GBufferParams",
+        GBufferParams,
+        [clip_from_world, camera_position, _pad]
+    );
+    assert_layout!(
+        gbuffer,
+        "Surface",
+        GpuSurface,
+        [albedo, kind, emission, _pad]
+    );
+    let splat = hikari_gpu::splat::shader_source();
+    assert_layout!(
+        splat,
+        "SplatParams",
+        SplatParams,
+        [clip_from_world, radius, power_unit, normal_test, _pad]
+    );
+}
+
+/// Vertex attributes are laid out by hand (vertex_attr_array! would pack
+/// them tightly): the arrays the pipelines use match the Rust structs.
+#[test]
+fn vertex_attribute_offsets_match_rust_structs() {
+    let offsets = |attrs: &[wgpu::VertexAttribute]| {
+        attrs.iter().map(|a| a.offset as usize).collect::<Vec<_>>()
+    };
+    assert_eq!(size_of::<Photon>(), 20);
+    assert_eq!(
+        offsets(&hikari_gpu::splat::PHOTON_ATTRIBUTES),
+        [
+            offset_of!(Photon, position),
+            offset_of!(Photon, power_rgb9e5),
+            offset_of!(Photon, direction_and_class)
+        ]
+    );
+    assert_eq!(
+        offsets(&hikari_gpu::gbuffer::VERTEX_ATTRIBUTES),
+        [
+            offset_of!(GpuVertex, position),
+            offset_of!(GpuVertex, normal),
+            offset_of!(GpuVertex, geometric_normal),
+            offset_of!(GpuVertex, surface)
+        ]
+    );
+}

@@ -1,0 +1,137 @@
+//! Twin tests: the GPU splat against the CPU fixed-radius estimate, on the
+//! same photons, the same radius and the G-buffer pixels read back from the
+//! GPU (METHOD.md §3: the same sum in a different order).
+
+use glam::Vec3;
+use hikari_core::estimate::{FixedRadius, fixed_radius_radiance};
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use hikari_core::scene::Scene;
+use hikari_gpu::test_support::context_or_skip;
+use hikari_gpu::{GpuRenderer, GpuSettings};
+
+struct TwinStats {
+    lit: usize,
+    within_1e4: usize,
+    worst: f32,
+}
+
+fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
+    let ctx = context_or_skip(scene_name)?;
+    let mut scene = Scene::load(scene_name).unwrap();
+    scene.camera = scene.camera.with_resolution(64, 64).unwrap();
+    let traced = trace_photons(
+        &scene,
+        &TraceSettings {
+            photons,
+            seed: 11,
+            ..Default::default()
+        },
+        &Silent,
+    );
+    let cpu_settings = PhotonCpuSettings {
+        normal_test,
+        ..Default::default()
+    };
+    let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
+    let settings = GpuSettings {
+        global: cpu.global_params,
+        caustic: cpu.caustic_params,
+    };
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
+    gpu.render();
+    let t = &gpu.targets;
+    let position = gpu.read(&t.gbuffer.position).unwrap();
+    let normal = gpu.read(&t.gbuffer.normal).unwrap();
+    let albedo = gpu.read(&t.gbuffer.albedo).unwrap();
+    let indirect = gpu.read(&t.indirect).unwrap();
+    let caustic = gpu.read(&t.caustic).unwrap();
+
+    let compare = |gpu_image: &[glam::Vec4], map, params: &FixedRadius| {
+        let mut stats = TwinStats {
+            lit: 0,
+            within_1e4: 0,
+            worst: 0.0,
+        };
+        for i in 0..position.len() {
+            if position[i].w == 0.0 || albedo[i].w != 0.0 {
+                continue; // no surface, or not diffuse
+            }
+            let want = fixed_radius_radiance(
+                map,
+                None,
+                position[i].truncate(),
+                normal[i].truncate(),
+                albedo[i].truncate(),
+                params,
+            );
+            let got: Vec3 = gpu_image[i].truncate();
+            if want.max_element() == 0.0 && got.max_element() == 0.0 {
+                continue;
+            }
+            stats.lit += 1;
+            let err = ((got - want).abs() / want.max(Vec3::splat(1e-30))).max_element();
+            let err = if want.max_element() == 0.0 {
+                f32::INFINITY
+            } else {
+                err
+            };
+            stats.within_1e4 += (err < 1e-4) as usize;
+            stats.worst = stats.worst.max(err);
+        }
+        stats
+    };
+    Some((
+        compare(&indirect, cpu.global_map(), &cpu.global_params),
+        compare(&caustic, cpu.caustic_map(), &cpu.caustic_params),
+    ))
+}
+
+fn assert_twin(name: &str, stats: &TwinStats, min_lit: usize) {
+    eprintln!(
+        "{name}: {} lit pixels, {} within 1e-4, worst relative error {:e}",
+        stats.lit, stats.within_1e4, stats.worst
+    );
+    assert!(
+        stats.lit >= min_lit,
+        "{name}: only {} lit pixels",
+        stats.lit
+    );
+    assert!(
+        stats.within_1e4 as f64 >= 0.999 * stats.lit as f64,
+        "{name}: {} of {} within 1e-4",
+        stats.within_1e4,
+        stats.lit
+    );
+    assert!(
+        stats.worst < 1e-2,
+        "{name}: worst relative error {}",
+        stats.worst
+    );
+}
+
+#[test]
+fn gpu_splat_equals_cpu_estimate_on_cornell_box() {
+    let Some((indirect, _)) = twin("cornell-box", 20_000, false) else {
+        return;
+    };
+    assert_twin("cornell-box indirect", &indirect, 2000);
+}
+
+#[test]
+fn gpu_splat_equals_cpu_estimate_on_cornell_caustic() {
+    let Some((indirect, caustic)) = twin("cornell-caustic", 20_000, false) else {
+        return;
+    };
+    assert_twin("cornell-caustic indirect", &indirect, 2000);
+    assert_twin("cornell-caustic caustic", &caustic, 20);
+}
+
+#[test]
+fn gpu_splat_equals_cpu_estimate_with_normal_test() {
+    let Some((indirect, _)) = twin("cornell-box", 20_000, true) else {
+        return;
+    };
+    assert_twin("cornell-box indirect, normal test", &indirect, 2000);
+}
