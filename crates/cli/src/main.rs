@@ -31,11 +31,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(&args),
         Command::Scenes => {
             for name in hikari_core::scene::builtin::NAMES {
-                let default = if *name == hikari_core::scene::builtin::DEFAULT {
-                    "  (default)"
-                } else {
-                    ""
-                };
+                let default = if *name == hikari_core::scene::builtin::DEFAULT { "  (default)" } else { "" };
                 println!("{name}{default}");
             }
             Ok(())

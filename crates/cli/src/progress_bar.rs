@@ -11,10 +11,7 @@ pub struct TerminalProgress {
 
 impl TerminalProgress {
     pub fn new(quiet: bool) -> Self {
-        TerminalProgress {
-            bar: Mutex::new(None),
-            quiet,
-        }
+        TerminalProgress { bar: Mutex::new(None), quiet }
     }
 }
 
@@ -26,11 +23,9 @@ impl Progress for TerminalProgress {
             ProgressBar::new(total)
         };
         bar.set_style(
-            ProgressStyle::with_template(
-                "{msg:>16} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}",
-            )
-            .expect("valid template")
-            .progress_chars("=> "),
+            ProgressStyle::with_template("{msg:>16} [{bar:40}] {percent:>3}% {elapsed_precise} eta {eta}")
+                .expect("valid template")
+                .progress_chars("=> "),
         );
         bar.set_message(stage.to_string());
         *self.bar.lock().unwrap() = Some(bar);

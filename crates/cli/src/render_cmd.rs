@@ -5,13 +5,17 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use hikari_core::output::write_image;
 use hikari_core::photon::{TraceSettings, trace_photons};
-use hikari_core::render::{path, photon_cpu};
+use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::{Scene, builtin};
+use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
 use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum RendererKind {
+    /// The seed's photon splatting on the GPU (falls back to photon-cpu
+    /// when no GPU adapter is found).
+    Gpu,
     /// The seed's fixed-radius photon mapping on the CPU.
     PhotonCpu,
     /// Path tracer (ground truth; slow to converge).
@@ -26,7 +30,7 @@ pub struct RenderArgs {
     /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB).
     #[arg(short, long, default_value = "hikari.png")]
     pub output: PathBuf,
-    #[arg(long, value_enum, default_value_t = RendererKind::PhotonCpu)]
+    #[arg(long, value_enum, default_value_t = RendererKind::Gpu)]
     pub renderer: RendererKind,
     /// Photon paths emitted from the lights.
     #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..))]
@@ -52,7 +56,11 @@ pub struct RenderArgs {
     /// Exposure in stops applied before PNG tone mapping.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
-    /// Shadow-ray samples per area light at each shaded point (photon-cpu).
+    /// Shadow-map side in texels for each shadow view (gpu).
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
+    pub shadow_map_size: u32,
+    /// Samples per area light: shadow rays per shaded point (photon-cpu),
+    /// shadow-mapped points on the light (gpu).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
     pub area_light_samples: u32,
     /// Count only photons that arrived from the side the surface faces the
@@ -65,19 +73,80 @@ pub struct RenderArgs {
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
-    let parse = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))
-    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"));
     let (w, h) = (parse(w)?, parse(h)?);
     if w == 0 || h == 0 || w > 16384 || h > 16384 {
         return Err(format!("`{s}`: each side must be between 1 and 16384"));
     }
     Ok((w, h))
+}
+
+/// Traces photons, then splats them on the GPU or estimates them on the CPU.
+fn render_photons(args: &RenderArgs, scene: &Scene, progress: &TerminalProgress) -> Result<(Image, u64)> {
+    let gpu = match args.renderer {
+        RendererKind::Gpu => match GpuContext::new() {
+            Ok(ctx) => Some(ctx),
+            Err(e) => {
+                eprintln!("{e}: falling back to the CPU renderer (photon-cpu)");
+                None
+            }
+        },
+        _ => None,
+    };
+    let trace_start = Instant::now();
+    let traced =
+        trace_photons(scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, progress);
+    let trace_time = trace_start.elapsed().as_secs_f64();
+    eprintln!(
+        "photons: {} emitted, {} stored in the global map, {} in the caustic map; {:.2} M paths/s ({:.2} s)",
+        traced.stats.emitted,
+        traced.global.len(),
+        traced.caustic.len(),
+        traced.stats.emitted as f64 / trace_time / 1e6,
+        trace_time
+    );
+    let settings = photon_cpu::PhotonCpuSettings {
+        radius: args.radius,
+        caustic_radius: args.caustic_radius,
+        spp: args.spp.unwrap_or(4),
+        seed: args.seed,
+        area_light_samples: args.area_light_samples,
+        normal_test: args.normal_test,
+        ..Default::default()
+    };
+    let build_start = Instant::now();
+    let cpu = photon_cpu::PhotonCpuRenderer::new(scene, &traced, &settings);
+    let (global, caustic) = (cpu.global_params, cpu.caustic_params);
+    eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
+    if let Some(ctx) = gpu {
+        let adapter = ctx.describe();
+        let gpu_settings = GpuSettings {
+            area_light_samples: args.area_light_samples,
+            shadow_map_size: args.shadow_map_size,
+            ..GpuSettings::new(global, caustic)
+        };
+        let setup_start = Instant::now();
+        let renderer = GpuRenderer::new(ctx, scene, &traced, gpu_settings);
+        let setup = setup_start.elapsed().as_secs_f64();
+        let frame_start = Instant::now();
+        renderer.render();
+        let result = renderer.read_image()?;
+        eprintln!(
+            "gpu: {adapter}; setup {setup:.2} s, frame and readback {:.3} s (1 sample per pixel)",
+            frame_start.elapsed().as_secs_f64()
+        );
+        return Ok(result);
+    }
+    let build_time = build_start.elapsed().as_secs_f64();
+    let render_start = Instant::now();
+    let result = cpu.render(progress);
+    eprintln!(
+        "photon-cpu: kd-trees {build_time:.2} s, render {:.2} s ({} spp)",
+        render_start.elapsed().as_secs_f64(),
+        settings.spp
+    );
+    Ok(result)
 }
 
 fn positive(name: &str, v: Option<f32>) -> Result<()> {
@@ -95,90 +164,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !args.exposure.is_finite() {
         bail!("--exposure {}: must be finite", args.exposure);
     }
-    let ext = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
+    let ext = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if !matches!(ext.as_deref(), Some("png" | "exr")) {
-        bail!(
-            "{}: unsupported image type (use .png or .exr)",
-            args.output.display()
-        );
+        bail!("{}: unsupported image type (use .png or .exr)", args.output.display());
     }
     if let Some(threads) = args.threads {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build_global()
-            .context("setting the thread count")?;
+        rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().context("setting the thread count")?;
     }
 
     let mut scene = Scene::load(&args.scene)?;
     if let Some((w, h)) = args.resolution {
-        scene.camera = scene
-            .camera
-            .with_resolution(w, h)
-            .map_err(anyhow::Error::msg)?;
+        scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
     let (image, nonfinite) = match args.renderer {
-        RendererKind::PhotonCpu => {
-            let trace_start = Instant::now();
-            let traced = trace_photons(
-                &scene,
-                &TraceSettings {
-                    photons: args.photons,
-                    seed: args.seed,
-                    ..Default::default()
-                },
-                &progress,
-            );
-            let trace_time = trace_start.elapsed().as_secs_f64();
-            let settings = photon_cpu::PhotonCpuSettings {
-                radius: args.radius,
-                caustic_radius: args.caustic_radius,
-                spp: args.spp.unwrap_or(4),
-                seed: args.seed,
-                area_light_samples: args.area_light_samples,
-                normal_test: args.normal_test,
-                ..Default::default()
-            };
-            let build_start = Instant::now();
-            let renderer = photon_cpu::PhotonCpuRenderer::new(&scene, &traced, &settings);
-            let build_time = build_start.elapsed().as_secs_f64();
-            let render_start = Instant::now();
-            let result = renderer.render(&progress);
-            let render_time = render_start.elapsed().as_secs_f64();
-            eprintln!(
-                "photons: {} emitted, {} stored in the global map ({} indirect), {} in the caustic map; {:.2} M paths/s",
-                traced.stats.emitted,
-                traced.global.len(),
-                renderer.global_map().len(),
-                traced.caustic.len(),
-                traced.stats.emitted as f64 / trace_time / 1e6
-            );
-            eprintln!(
-                "radius {:.4}, caustic radius {:.4}; trace {:.2} s, kd-trees {:.2} s, render {:.2} s ({} spp)",
-                renderer.global_params.radius,
-                renderer.caustic_params.radius,
-                trace_time,
-                build_time,
-                render_time,
-                settings.spp
-            );
-            result
-        }
         RendererKind::Path => {
-            let settings = path::PathSettings {
-                spp: args.spp.unwrap_or(64),
-                seed: args.seed,
-                ..Default::default()
-            };
+            let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
             let result = path::render(&scene, &settings, &progress);
             eprintln!("path tracing: {} spp", settings.spp);
             result
         }
+        RendererKind::Gpu | RendererKind::PhotonCpu => render_photons(args, &scene, &progress)?,
     };
     if nonfinite > 0 {
         eprintln!("warning: {nonfinite} non-finite samples were dropped");

@@ -4,11 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn hikari(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_hikari"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("the binary runs")
+    Command::new(env!("CARGO_BIN_EXE_hikari")).args(args).current_dir(dir).output().expect("the binary runs")
 }
 
 fn scratch_dir(name: &str) -> PathBuf {
@@ -65,42 +61,16 @@ intensity = [5.0, 5.0, 5.0]
 fn renders_a_builtin_scene_and_reports() {
     let dir = scratch_dir("ok");
     let out = hikari(
-        &[
-            "render",
-            "cornell-caustic",
-            "--resolution",
-            "24x16",
-            "--photons",
-            "3000",
-            "-o",
-            "out.png",
-            "-q",
-        ],
+        &["render", "cornell-caustic", "--resolution", "24x16", "--photons", "3000", "-o", "out.png", "-q"],
         &dir,
     );
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(
-        err.contains("3000 emitted") && err.contains("paths/s") && err.contains("wrote out.png"),
-        "{err}"
-    );
+    assert!(err.contains("3000 emitted") && err.contains("paths/s") && err.contains("wrote out.png"), "{err}");
     let img = image::open(dir.join("out.png")).unwrap();
     assert_eq!((img.width(), img.height()), (24, 16));
-    let out = hikari(
-        &[
-            "render",
-            "--renderer",
-            "path",
-            "--spp",
-            "2",
-            "--resolution",
-            "8x8",
-            "-o",
-            "truth.exr",
-            "-q",
-        ],
-        &dir,
-    );
+    let out =
+        hikari(&["render", "--renderer", "path", "--spp", "2", "--resolution", "8x8", "-o", "truth.exr", "-q"], &dir);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(dir.join("truth.exr").is_file());
 }
@@ -109,41 +79,23 @@ fn renders_a_builtin_scene_and_reports() {
 fn lists_builtin_scenes() {
     let out = hikari(&["scenes"], &std::env::temp_dir());
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success() && text.contains("cornell-box") && text.contains("cornell-caustic"),
-        "{text}"
-    );
+    assert!(out.status.success() && text.contains("cornell-box") && text.contains("cornell-caustic"), "{text}");
 }
 
 #[test]
 fn bad_scene_files_are_reported_with_file_and_line() {
     let dir = scratch_dir("bad");
     let cases: &[(&str, String, &[&str])] = &[
-        (
-            "syntax.toml",
-            SCENE.replace("radius = 1.0", "radius = = 1.0"),
-            &["syntax.toml:15:10", "extra `=`"],
-        ),
-        (
-            "field.toml",
-            SCENE.replace("radius = 1.0", "radius = 1.0\ncolour = 3"),
-            &["field.toml:", "colour"],
-        ),
+        ("syntax.toml", SCENE.replace("radius = 1.0", "radius = = 1.0"), &["syntax.toml:15:10", "extra `=`"]),
+        ("field.toml", SCENE.replace("radius = 1.0", "radius = 1.0\ncolour = 3"), &["field.toml:", "colour"]),
         (
             "material.toml",
             SCENE.replace("material = \"white\"", "material = \"snow\""),
-            &[
-                "material.toml:16:",
-                "[[object]] #1",
-                "unknown material \"snow\"",
-            ],
+            &["material.toml:16:", "[[object]] #1", "unknown material \"snow\""],
         ),
         (
             "mesh.toml",
-            SCENE.replace(
-                "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
-                "mesh = \"missing.obj\"",
-            ),
+            SCENE.replace("shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0", "mesh = \"missing.obj\""),
             &["mesh.toml:", "missing.obj", "not found"],
         ),
         (
@@ -156,11 +108,7 @@ fn bad_scene_files_are_reported_with_file_and_line() {
             SCENE.replace("albedo = [0.5, 0.5, 0.5]", "albedo = [0.5, 1.5, 0.5]"),
             &["bright.toml:", "above 1"],
         ),
-        (
-            "nan.toml",
-            SCENE.replace("radius = 1.0", "radius = nan"),
-            &["nan.toml:", "radius"],
-        ),
+        ("nan.toml", SCENE.replace("radius = 1.0", "radius = nan"), &["nan.toml:", "radius"]),
         (
             "camera.toml",
             SCENE.replace("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 0.0, 3.0]"),
@@ -178,37 +126,14 @@ fn bad_scene_files_are_reported_with_file_and_line() {
 fn bad_options_are_rejected() {
     let dir = scratch_dir("opts");
     std::fs::write(dir.join("ok.toml"), SCENE).unwrap();
-    assert_fails_with(
-        &hikari(&["render", "ok.toml", "--photons", "0"], &dir),
-        &dir,
-        &["--photons"],
-    );
-    assert_fails_with(
-        &hikari(&["render", "ok.toml", "--radius", "-1"], &dir),
-        &dir,
-        &["--radius"],
-    );
-    assert_fails_with(
-        &hikari(&["render", "ok.toml", "-o", "out.jpg"], &dir),
-        &dir,
-        &["out.jpg", "unsupported"],
-    );
-    assert_fails_with(
-        &hikari(&["render", "ok.toml", "--resolution", "0x5"], &dir),
-        &dir,
-        &["--resolution"],
-    );
+    assert_fails_with(&hikari(&["render", "ok.toml", "--photons", "0"], &dir), &dir, &["--photons"]);
+    assert_fails_with(&hikari(&["render", "ok.toml", "--radius", "-1"], &dir), &dir, &["--radius"]);
+    assert_fails_with(&hikari(&["render", "ok.toml", "-o", "out.jpg"], &dir), &dir, &["out.jpg", "unsupported"]);
+    assert_fails_with(&hikari(&["render", "ok.toml", "--resolution", "0x5"], &dir), &dir, &["--resolution"]);
     assert_fails_with(
         &hikari(&["render", "no-such-scene", "-o", "out.png"], &dir),
         &dir,
         &["no-such-scene", "cornell-box"],
     );
-    assert_fails_with(
-        &hikari(
-            &["render", "ok.toml", "-o", "no/such/dir/out.png", "-q"],
-            &dir,
-        ),
-        &dir,
-        &["out.png"],
-    );
+    assert_fails_with(&hikari(&["render", "ok.toml", "-o", "no/such/dir/out.png", "-q"], &dir), &dir, &["out.png"]);
 }

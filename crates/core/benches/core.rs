@@ -17,29 +17,16 @@ fn ray_casting(c: &mut Criterion) {
     // Rays from points on the walls into the box, as photon bounces cast them.
     let rays: Vec<_> = (0..4096)
         .filter_map(|_| {
-            let ray = scene
-                .camera
-                .ray(Vec2::new(rng.next_f32() * 512.0, rng.next_f32() * 512.0));
+            let ray = scene.camera.ray(Vec2::new(rng.next_f32() * 512.0, rng.next_f32() * 512.0));
             let hit = scene.accel.intersect(&ray)?;
-            let n = if ray.dir.dot(hit.geometric_normal) < 0.0 {
-                hit.geometric_normal
-            } else {
-                -hit.geometric_normal
-            };
-            Some(hikari_core::geometry::Ray::new(
-                hit.point,
-                local_to_world(cosine_hemisphere(rng.next_2d()), n),
-            ))
+            let n = if ray.dir.dot(hit.geometric_normal) < 0.0 { hit.geometric_normal } else { -hit.geometric_normal };
+            Some(hikari_core::geometry::Ray::new(hit.point, local_to_world(cosine_hemisphere(rng.next_2d()), n)))
         })
         .collect();
     let mut group = c.benchmark_group("ray_casting");
     group.throughput(Throughput::Elements(rays.len() as u64));
     group.bench_function("closest_hit_cornell_box", |b| {
-        b.iter(|| {
-            rays.iter()
-                .filter(|r| scene.accel.intersect(r).is_some())
-                .count()
-        })
+        b.iter(|| rays.iter().filter(|r| scene.accel.intersect(r).is_some()).count())
     });
     group.bench_function("occlusion_cornell_box", |b| {
         b.iter(|| rays.iter().filter(|r| scene.accel.occluded(r)).count())
@@ -52,11 +39,7 @@ fn photon_tracing(c: &mut Criterion) {
     group.sample_size(10);
     for name in ["cornell-box", "cornell-caustic"] {
         let scene = Scene::load(name).unwrap();
-        let settings = TraceSettings {
-            photons: 1_000_000,
-            seed: 1,
-            ..Default::default()
-        };
+        let settings = TraceSettings { photons: 1_000_000, seed: 1, ..Default::default() };
         group.throughput(Throughput::Elements(settings.photons));
         group.bench_function(format!("{name}_1M_paths"), |b| {
             b.iter(|| trace_photons(&scene, &settings, &Silent).global.len())
@@ -67,38 +50,17 @@ fn photon_tracing(c: &mut Criterion) {
 
 fn estimates(c: &mut Criterion) {
     let scene = Scene::load("cornell-box").unwrap();
-    let traced = trace_photons(
-        &scene,
-        &TraceSettings {
-            photons: 200_000,
-            seed: 1,
-            ..Default::default()
-        },
-        &Silent,
-    );
-    let indirect: Vec<_> = traced
-        .global
-        .iter()
-        .filter(|p| p.class() == PathClass::Indirect)
-        .copied()
-        .collect();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 1, ..Default::default() }, &Silent);
+    let indirect: Vec<_> = traced.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect();
     let map = PhotonMap::new(indirect, traced.power_unit);
     let mut rng = Rng::for_item(2, 0);
     let queries: Vec<_> = (0..1024)
         .filter_map(|_| {
-            let ray = scene
-                .camera
-                .ray(Vec2::new(rng.next_f32() * 512.0, rng.next_f32() * 512.0));
-            scene
-                .accel
-                .intersect(&ray)
-                .map(|h| (h.point, h.geometric_normal))
+            let ray = scene.camera.ray(Vec2::new(rng.next_f32() * 512.0, rng.next_f32() * 512.0));
+            scene.accel.intersect(&ray).map(|h| (h.point, h.geometric_normal))
         })
         .collect();
-    let params = FixedRadius {
-        radius: 0.1039,
-        normal_test: false,
-    };
+    let params = FixedRadius { radius: 0.1039, normal_test: false };
     let mut group = c.benchmark_group("estimates");
     group.throughput(Throughput::Elements(queries.len() as u64));
     group.bench_function("fixed_radius_r0.104_157k_photons", |b| {
@@ -127,33 +89,14 @@ fn photon_cpu_frame(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("cornell_box_512x512_200k_photons_1spp_end_to_end", |b| {
         b.iter(|| {
-            let traced = trace_photons(
-                &scene,
-                &TraceSettings {
-                    photons: 200_000,
-                    seed: 1,
-                    ..Default::default()
-                },
-                &Silent,
-            );
-            let settings = PhotonCpuSettings {
-                spp: 1,
-                ..Default::default()
-            };
-            PhotonCpuRenderer::new(&scene, &traced, &settings)
-                .render(&Silent)
-                .0
-                .mean()
+            let traced =
+                trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 1, ..Default::default() }, &Silent);
+            let settings = PhotonCpuSettings { spp: 1, ..Default::default() };
+            PhotonCpuRenderer::new(&scene, &traced, &settings).render(&Silent).0.mean()
         })
     });
     group.finish();
 }
 
-criterion_group!(
-    benches,
-    ray_casting,
-    photon_tracing,
-    estimates,
-    photon_cpu_frame
-);
+criterion_group!(benches, ray_casting, photon_tracing, estimates, photon_cpu_frame);
 criterion_main!(benches);

@@ -21,14 +21,7 @@ pub struct Camera {
 
 impl Camera {
     /// Fails with a reason if the camera is degenerate.
-    pub fn new(
-        position: Vec3,
-        look_at: Vec3,
-        up: Vec3,
-        fov_y: f32,
-        width: u32,
-        height: u32,
-    ) -> Result<Self, String> {
+    pub fn new(position: Vec3, look_at: Vec3, up: Vec3, fov_y: f32, width: u32, height: u32) -> Result<Self, String> {
         let forward = (look_at - position).normalize_or_zero();
         if forward == Vec3::ZERO {
             return Err("camera position and look_at coincide".into());
@@ -38,9 +31,7 @@ impl Camera {
             return Err("camera up is zero or parallel to the viewing direction".into());
         }
         if !(fov_y > 0.0 && fov_y < 180.0) {
-            return Err(format!(
-                "fov_y = {fov_y} must lie strictly between 0 and 180 degrees"
-            ));
+            return Err(format!("fov_y = {fov_y} must lie strictly between 0 and 180 degrees"));
         }
         if width == 0 || height == 0 {
             return Err(format!("resolution {width}x{height} has a zero side"));
@@ -60,14 +51,7 @@ impl Camera {
     }
 
     pub fn with_resolution(&self, width: u32, height: u32) -> Result<Self, String> {
-        Camera::new(
-            self.position,
-            self.look_at,
-            self.up,
-            self.fov_y,
-            width,
-            height,
-        )
+        Camera::new(self.position, self.look_at, self.up, self.fov_y, width, height)
     }
 
     pub fn aspect(&self) -> f32 {
@@ -78,10 +62,7 @@ impl Camera {
     pub fn ray(&self, pixel: Vec2) -> Ray {
         let x = (2.0 * pixel.x / self.width as f32 - 1.0) * self.tan_half_fov * self.aspect();
         let y = (1.0 - 2.0 * pixel.y / self.height as f32) * self.tan_half_fov;
-        Ray::new(
-            self.position,
-            (self.forward + self.right * x + self.true_up * y).normalize(),
-        )
+        Ray::new(self.position, (self.forward + self.right * x + self.true_up * y).normalize())
     }
 
     pub fn forward(&self) -> Vec3 {
@@ -90,29 +71,42 @@ impl Camera {
 
     /// World-to-view transform: view space is right-handed, looking down −z.
     pub fn view_from_world(&self) -> Mat4 {
-        let (r, u, f) = (self.right, self.true_up, self.forward);
-        let p = self.position;
-        Mat4::from_cols(
-            Vec4::new(r.x, u.x, -f.x, 0.0),
-            Vec4::new(r.y, u.y, -f.y, 0.0),
-            Vec4::new(r.z, u.z, -f.z, 0.0),
-            Vec4::new(-r.dot(p), -u.dot(p), f.dot(p), 1.0),
-        )
+        view_from_world(self.position, self.forward, self.true_up)
     }
 
     /// Perspective projection to wgpu clip space (depth 0 at `near`, 1 at
     /// `far`), matching `ray`: the ray through a pixel centre projects there.
     pub fn clip_from_view(&self, near: f32, far: f32) -> Mat4 {
-        let fy = 1.0 / self.tan_half_fov;
-        let fx = fy / self.aspect();
-        let a = far / (near - far);
-        Mat4::from_cols(
-            Vec4::new(fx, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, fy, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, a, -1.0),
-            Vec4::new(0.0, 0.0, a * near, 0.0),
-        )
+        clip_from_view(self.fov_y.to_radians(), self.aspect(), near, far)
     }
+}
+
+/// World-to-view transform for an eye at `position` looking along unit
+/// `forward`, with `up` (not parallel to it) giving the vertical.
+pub fn view_from_world(position: Vec3, forward: Vec3, up: Vec3) -> Mat4 {
+    let r = forward.cross(up).normalize();
+    let u = r.cross(forward);
+    let f = forward;
+    Mat4::from_cols(
+        Vec4::new(r.x, u.x, -f.x, 0.0),
+        Vec4::new(r.y, u.y, -f.y, 0.0),
+        Vec4::new(r.z, u.z, -f.z, 0.0),
+        Vec4::new(-r.dot(position), -u.dot(position), f.dot(position), 1.0),
+    )
+}
+
+/// Right-handed perspective projection to wgpu clip space: vertical field
+/// `fov_y` (radians), depth 0 at `near` and 1 at `far`.
+pub fn clip_from_view(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+    let fy = 1.0 / (fov_y * 0.5).tan();
+    let fx = fy / aspect;
+    let a = far / (near - far);
+    Mat4::from_cols(
+        Vec4::new(fx, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, fy, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, a, -1.0),
+        Vec4::new(0.0, 0.0, a * near, 0.0),
+    )
 }
 
 #[cfg(test)]
@@ -132,21 +126,9 @@ mod tests {
 
     #[test]
     fn projection_matches_primary_rays() {
-        let cam = Camera::new(
-            Vec3::new(0.3, 0.2, 4.0),
-            Vec3::new(0.1, -0.1, 0.0),
-            Vec3::Y,
-            40.0,
-            64,
-            48,
-        )
-        .unwrap();
+        let cam = Camera::new(Vec3::new(0.3, 0.2, 4.0), Vec3::new(0.1, -0.1, 0.0), Vec3::Y, 40.0, 64, 48).unwrap();
         let clip_from_world = cam.clip_from_view(0.1, 100.0) * cam.view_from_world();
-        for pixel in [
-            Vec2::new(0.5, 0.5),
-            Vec2::new(10.5, 40.5),
-            Vec2::new(63.5, 0.5),
-        ] {
+        for pixel in [Vec2::new(0.5, 0.5), Vec2::new(10.5, 40.5), Vec2::new(63.5, 0.5)] {
             let p = cam.ray(pixel).at(3.7);
             let clip = clip_from_world * p.extend(1.0);
             let ndc = clip.truncate() / clip.w;

@@ -40,13 +40,7 @@ pub fn radiance_per_power(albedo: Rgb, params: &FixedRadius) -> Rgb {
 /// power: albedo/π · ΔΦ_p / (π r²) · w(d_p). This is what the GPU splat adds
 /// per fragment.
 #[inline]
-pub fn photon_contribution(
-    x: Vec3,
-    normal: Vec3,
-    albedo: Rgb,
-    photon: &Photon,
-    params: &FixedRadius,
-) -> Rgb {
+pub fn photon_contribution(x: Vec3, normal: Vec3, albedo: Rgb, photon: &Photon, params: &FixedRadius) -> Rgb {
     let d2 = (photon.position() - x).length_squared();
     if photon_accepted(d2, photon.direction(), normal, params) {
         radiance_per_power(albedo, params) * photon.power_in_units()
@@ -123,26 +117,15 @@ mod tests {
         let photons: Vec<Photon> = (0..n)
             .map(|_| {
                 let u = rng.next_2d() * 2.0 - 1.0;
-                Photon::new(
-                    Vec3::new(u.x, 0.0, u.y),
-                    Vec3::ONE,
-                    Vec3::NEG_Y,
-                    PathClass::Indirect,
-                )
+                Photon::new(Vec3::new(u.x, 0.0, u.y), Vec3::ONE, Vec3::NEG_Y, PathClass::Indirect)
             })
             .collect();
         let map = PhotonMap::new(photons, irradiance * 4.0 / n as f32);
         let albedo = Vec3::splat(0.5);
         let want = 0.5 * irradiance / PI;
-        let params = FixedRadius {
-            radius: 0.1,
-            normal_test: true,
-        };
+        let params = FixedRadius { radius: 0.1, normal_test: true };
         let fixed = fixed_radius_radiance(&map, None, Vec3::ZERO, Vec3::Y, albedo, &params);
-        assert!(
-            (fixed.x - want).abs() / want < 0.05,
-            "fixed {fixed} vs {want}"
-        );
+        assert!((fixed.x - want).abs() / want < 0.05, "fixed {fixed} vs {want}");
         let knn = k_nearest_radiance(&map, Vec3::ZERO, Vec3::Y, albedo, 500, 1.0, true);
         assert!((knn.x - want).abs() / want < 0.08, "knn {knn} vs {want}");
         // Seen from below, every photon arrived from the other side.

@@ -15,27 +15,12 @@ pub enum Light {
     Point { position: Vec3, intensity: Rgb },
     /// Spot light with Mitsuba's falloff: full `intensity` (W/sr) within
     /// `falloff_start` of the axis, zero beyond `cutoff`, linear in the angle between.
-    Spot {
-        position: Vec3,
-        axis: Vec3,
-        intensity: Rgb,
-        cutoff: f32,
-        falloff_start: f32,
-    },
+    Spot { position: Vec3, axis: Vec3, intensity: Rgb, cutoff: f32, falloff_start: f32 },
     /// Sphere emitting `radiance` (W/(m² sr)) from its outer surface.
-    Sphere {
-        center: Vec3,
-        radius: f32,
-        radiance: Rgb,
-    },
+    Sphere { center: Vec3, radius: f32, radiance: Rgb },
     /// Parallelogram `corner + s·edge_u + t·edge_v`, emitting `radiance` on the
     /// side of `edge_u × edge_v` only.
-    Quad {
-        corner: Vec3,
-        edge_u: Vec3,
-        edge_v: Vec3,
-        radiance: Rgb,
-    },
+    Quad { corner: Vec3, edge_u: Vec3, edge_v: Vec3, radiance: Rgb },
 }
 
 /// Light arriving at a point from one sampled direction.
@@ -64,21 +49,9 @@ impl Light {
     pub fn power(&self) -> Rgb {
         match *self {
             Light::Point { intensity, .. } => 4.0 * PI * intensity,
-            Light::Spot {
-                intensity,
-                cutoff,
-                falloff_start,
-                ..
-            } => intensity * spot_solid_angle(cutoff, falloff_start),
-            Light::Sphere {
-                radius, radiance, ..
-            } => radiance * PI * (4.0 * PI * radius * radius),
-            Light::Quad {
-                edge_u,
-                edge_v,
-                radiance,
-                ..
-            } => radiance * PI * edge_u.cross(edge_v).length(),
+            Light::Spot { intensity, cutoff, falloff_start, .. } => intensity * spot_solid_angle(cutoff, falloff_start),
+            Light::Sphere { radius, radiance, .. } => radiance * PI * (4.0 * PI * radius * radius),
+            Light::Quad { edge_u, edge_v, radiance, .. } => radiance * PI * edge_u.cross(edge_v).length(),
         }
     }
 
@@ -91,44 +64,23 @@ impl Light {
     /// (METHOD.md §2), so every photon of a light carries the same power.
     pub fn emit(&self, rng: &mut Rng) -> EmittedRay {
         match *self {
-            Light::Point { position, .. } => EmittedRay {
-                origin: position,
-                dir: sampling::uniform_sphere(rng.next_2d()),
-            },
-            Light::Spot {
-                position,
-                axis,
-                cutoff,
-                falloff_start,
-                ..
-            } => {
+            Light::Point { position, .. } => {
+                EmittedRay { origin: position, dir: sampling::uniform_sphere(rng.next_2d()) }
+            }
+            Light::Spot { position, axis, cutoff, falloff_start, .. } => {
                 let local = sample_spot_direction(cutoff, falloff_start, rng);
-                EmittedRay {
-                    origin: position,
-                    dir: local_to_world(local, axis),
-                }
+                EmittedRay { origin: position, dir: local_to_world(local, axis) }
             }
             Light::Sphere { center, radius, .. } => {
                 let n = sampling::uniform_sphere(rng.next_2d());
                 let dir = local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n);
-                EmittedRay {
-                    origin: center + n * radius,
-                    dir,
-                }
+                EmittedRay { origin: center + n * radius, dir }
             }
-            Light::Quad {
-                corner,
-                edge_u,
-                edge_v,
-                ..
-            } => {
+            Light::Quad { corner, edge_u, edge_v, .. } => {
                 let u = rng.next_2d();
                 let n = edge_u.cross(edge_v).normalize();
                 let dir = local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n);
-                EmittedRay {
-                    origin: corner + edge_u * u.x + edge_v * u.y,
-                    dir,
-                }
+                EmittedRay { origin: corner + edge_u * u.x + edge_v * u.y, dir }
             }
         }
     }
@@ -136,33 +88,16 @@ impl Light {
     /// Samples light arriving at `point`. None if this sample carries nothing.
     pub fn sample_incident(&self, point: Vec3, u: Vec2) -> Option<LightSample> {
         match *self {
-            Light::Point {
-                position,
-                intensity,
-            } => delta_sample(point, position, intensity),
-            Light::Spot {
-                position,
-                axis,
-                intensity,
-                cutoff,
-                falloff_start,
-            } => {
+            Light::Point { position, intensity } => delta_sample(point, position, intensity),
+            Light::Spot { position, axis, intensity, cutoff, falloff_start } => {
                 let to_point = (point - position).normalize_or_zero();
-                let f = spot_falloff(
-                    to_point.dot(axis).clamp(-1.0, 1.0).acos(),
-                    cutoff,
-                    falloff_start,
-                );
+                let f = spot_falloff(to_point.dot(axis).clamp(-1.0, 1.0).acos(), cutoff, falloff_start);
                 if f <= 0.0 {
                     return None;
                 }
                 delta_sample(point, position, intensity * f)
             }
-            Light::Sphere {
-                center,
-                radius,
-                radiance,
-            } => {
+            Light::Sphere { center, radius, radiance } => {
                 let to_center = center - point;
                 let d2 = to_center.length_squared();
                 if d2 <= radius * radius {
@@ -173,22 +108,10 @@ impl Light {
                 let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
                 let axis = to_center / d;
                 let wi = local_to_world(sampling::uniform_cone(u, cos_max), axis);
-                let distance =
-                    sphere_entry_distance(point, wi, center, radius).unwrap_or(d - radius);
-                Some(LightSample {
-                    wi,
-                    distance,
-                    radiance,
-                    pdf: cone_pdf(sin2_max, cos_max),
-                    is_delta: false,
-                })
+                let distance = sphere_entry_distance(point, wi, center, radius).unwrap_or(d - radius);
+                Some(LightSample { wi, distance, radiance, pdf: cone_pdf(sin2_max, cos_max), is_delta: false })
             }
-            Light::Quad {
-                corner,
-                edge_u,
-                edge_v,
-                radiance,
-            } => {
+            Light::Quad { corner, edge_u, edge_v, radiance } => {
                 let p = corner + edge_u * u.x + edge_v * u.y;
                 let normal_area = edge_u.cross(edge_v);
                 let area = normal_area.length();
@@ -200,13 +123,7 @@ impl Light {
                 if cos_l <= 0.0 || !distance.is_finite() || distance == 0.0 {
                     return None;
                 }
-                Some(LightSample {
-                    wi,
-                    distance,
-                    radiance,
-                    pdf: d2 / (area * cos_l),
-                    is_delta: false,
-                })
+                Some(LightSample { wi, distance, radiance, pdf: d2 / (area * cos_l), is_delta: false })
             }
         }
     }
@@ -229,11 +146,7 @@ impl Light {
                 let d2 = to_light.length_squared();
                 let cos_l = (to_light / d2.sqrt()).dot(hit_normal).abs();
                 let area = edge_u.cross(edge_v).length();
-                if cos_l <= 0.0 {
-                    0.0
-                } else {
-                    d2 / (area * cos_l)
-                }
+                if cos_l <= 0.0 { 0.0 } else { d2 / (area * cos_l) }
             }
             _ => 0.0,
         }
@@ -244,12 +157,7 @@ impl Light {
     pub fn emitted_radiance(&self, dir: Vec3, normal: Vec3) -> Rgb {
         match *self {
             Light::Sphere { radiance, .. } if dir.dot(normal) < 0.0 => radiance,
-            Light::Quad {
-                edge_u,
-                edge_v,
-                radiance,
-                ..
-            } if dir.dot(edge_u.cross(edge_v)) < 0.0 => radiance,
+            Light::Quad { edge_u, edge_v, radiance, .. } if dir.dot(edge_u.cross(edge_v)) < 0.0 => radiance,
             _ => Rgb::ZERO,
         }
     }
@@ -262,13 +170,7 @@ fn delta_sample(point: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSamp
         return None;
     }
     let distance = d2.sqrt();
-    Some(LightSample {
-        wi: to_light / distance,
-        distance,
-        radiance: intensity / d2,
-        pdf: 1.0,
-        is_delta: true,
-    })
+    Some(LightSample { wi: to_light / distance, distance, radiance: intensity / d2, pdf: 1.0, is_delta: true })
 }
 
 /// Uniform-cone density, with 1 − cos θ_max computed without cancellation.
@@ -297,11 +199,7 @@ pub fn spot_falloff(theta: f32, cutoff: f32, falloff_start: f32) -> f32 {
 pub fn spot_solid_angle(cutoff: f32, falloff_start: f32) -> f32 {
     let (b, c) = (falloff_start as f64, cutoff as f64);
     let inner = 1.0 - b.cos();
-    let ramp = if c > b {
-        ((c - b) * b.cos() - c.sin() + b.sin()) / (c - b)
-    } else {
-        0.0
-    };
+    let ramp = if c > b { ((c - b) * b.cos() - c.sin() + b.sin()) / (c - b) } else { 0.0 };
     (2.0 * std::f64::consts::PI * (inner + ramp)) as f32
 }
 
@@ -331,10 +229,7 @@ mod tests {
         assert_unit_density(pdf);
         let rng = std::cell::RefCell::new(Rng::for_item(3, 0));
         // The sampler needs more randomness than two uniforms: draw it from its own stream.
-        assert_direction_distribution(
-            |_| sample_spot_direction(cutoff, start, &mut rng.borrow_mut()),
-            pdf,
-        );
+        assert_direction_distribution(|_| sample_spot_direction(cutoff, start, &mut rng.borrow_mut()), pdf);
     }
 
     #[test]
@@ -353,18 +248,12 @@ mod tests {
     #[test]
     fn sphere_light_sampling_matches_cone_density() {
         // Light at distance 1 with radius 0.6: cos θ_max = 0.8.
-        let light = Light::Sphere {
-            center: Vec3::Z,
-            radius: 0.6,
-            radiance: Vec3::ONE,
-        };
+        let light = Light::Sphere { center: Vec3::Z, radius: 0.6, radiance: Vec3::ONE };
         let pdf_val = 1.0 / (2.0 * PI * 0.2);
         let pdf = move |w: Vec3| if w.z >= 0.8 { pdf_val } else { 0.0 };
         assert_unit_density(pdf);
         assert_direction_distribution(|u| light.sample_incident(Vec3::ZERO, u).unwrap().wi, pdf);
-        let s = light
-            .sample_incident(Vec3::ZERO, Vec2::new(0.3, 0.7))
-            .unwrap();
+        let s = light.sample_incident(Vec3::ZERO, Vec2::new(0.3, 0.7)).unwrap();
         assert!((s.pdf - pdf_val).abs() / pdf_val < 1e-4);
         // The sampled point lies on the sphere.
         assert!(((s.wi * s.distance - Vec3::Z).length() - 0.6).abs() < 1e-4);
@@ -372,27 +261,13 @@ mod tests {
 
     #[test]
     fn quad_incident_pdf_agrees_with_sampling() {
-        let light = Light::Quad {
-            corner: Vec3::new(-0.5, 1.0, -0.5),
-            edge_u: Vec3::Z,
-            edge_v: Vec3::X,
-            radiance: Vec3::ONE,
-        };
+        let light =
+            Light::Quad { corner: Vec3::new(-0.5, 1.0, -0.5), edge_u: Vec3::Z, edge_v: Vec3::X, radiance: Vec3::ONE };
         // edge_u × edge_v = Z × X = +Y: emits upward, so a point below sees nothing.
-        assert!(
-            light
-                .sample_incident(Vec3::ZERO, Vec2::splat(0.5))
-                .is_none()
-        );
-        let flipped = Light::Quad {
-            corner: Vec3::new(-0.5, 1.0, -0.5),
-            edge_u: Vec3::X,
-            edge_v: Vec3::Z,
-            radiance: Vec3::ONE,
-        };
-        let s = flipped
-            .sample_incident(Vec3::ZERO, Vec2::new(0.2, 0.9))
-            .unwrap();
+        assert!(light.sample_incident(Vec3::ZERO, Vec2::splat(0.5)).is_none());
+        let flipped =
+            Light::Quad { corner: Vec3::new(-0.5, 1.0, -0.5), edge_u: Vec3::X, edge_v: Vec3::Z, radiance: Vec3::ONE };
+        let s = flipped.sample_incident(Vec3::ZERO, Vec2::new(0.2, 0.9)).unwrap();
         let hit = s.wi * s.distance;
         let pdf = flipped.incident_pdf(Vec3::ZERO, hit, Vec3::NEG_Y);
         assert!((pdf - s.pdf).abs() / s.pdf < 1e-4);
@@ -409,12 +284,7 @@ mod tests {
         }
         let x = 0.5f64;
         let k = (1.0 + x * x).sqrt();
-        let expected = std::f64::consts::PI * 4.0 * (2.0 * x / k * (x / k).atan())
-            / (2.0 * std::f64::consts::PI);
-        assert!(
-            (e / n as f64 - expected).abs() < 0.005,
-            "irradiance {} vs {expected}",
-            e / n as f64
-        );
+        let expected = std::f64::consts::PI * 4.0 * (2.0 * x / k * (x / k).atan()) / (2.0 * std::f64::consts::PI);
+        assert!((e / n as f64 - expected).abs() < 0.005, "irradiance {} vs {expected}", e / n as f64);
     }
 }

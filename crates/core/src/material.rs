@@ -108,21 +108,12 @@ pub struct DielectricSplit {
 /// Splits `dir` at a glass surface with outward normal `n_out` and index `ior`.
 pub fn dielectric_split(dir: Vec3, n_out: Vec3, ior: f32) -> DielectricSplit {
     let entering = dir.dot(n_out) < 0.0;
-    let (n, eta) = if entering {
-        (n_out, 1.0 / ior)
-    } else {
-        (-n_out, ior)
-    };
+    let (n, eta) = if entering { (n_out, 1.0 / ior) } else { (-n_out, ior) };
     let cos_i = -dir.dot(n);
     let (reflectance, cos_t) = fresnel_dielectric(cos_i, eta);
     let reflected = reflect(dir, n);
-    let refracted =
-        (reflectance < 1.0).then(|| (eta * dir + (eta * cos_i - cos_t) * n).normalize());
-    DielectricSplit {
-        reflectance,
-        reflected,
-        refracted,
-    }
+    let refracted = (reflectance < 1.0).then(|| (eta * dir + (eta * cos_i - cos_t) * n).normalize());
+    DielectricSplit { reflectance, reflected, refracted }
 }
 
 #[cfg(test)]
@@ -152,10 +143,7 @@ mod tests {
 
     #[test]
     fn roulette_factor_keeps_expectation() {
-        let m = Material::Diffuse {
-            albedo: Vec3::new(0.8, 0.2, 0.5),
-            specular: Vec3::new(0.1, 0.3, 0.0),
-        };
+        let m = Material::Diffuse { albedo: Vec3::new(0.8, 0.2, 0.5), specular: Vec3::new(0.1, 0.3, 0.0) };
         let n = 10_000;
         let mut total = Vec3::ZERO;
         for i in 0..n {

@@ -10,19 +10,12 @@ pub enum OutputError {
     #[error("{path}: unsupported image type (use .png or .exr)")]
     UnsupportedExtension { path: String },
     #[error("{path}: cannot write image: {source}")]
-    Write {
-        path: String,
-        source: Box<dyn std::error::Error + Send + Sync>,
-    },
+    Write { path: String, source: Box<dyn std::error::Error + Send + Sync> },
 }
 
 /// sRGB transfer function (IEC 61966-2-1) of a linear value in [0,1].
 pub fn linear_to_srgb(x: f32) -> f32 {
-    if x <= 0.003_130_8 {
-        12.92 * x
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
+    if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 }
 }
 
 /// Exposure in stops (value × 2^exposure), clamp to [0,1], sRGB encode.
@@ -33,11 +26,7 @@ pub fn tone_map(image: &Image, exposure: f32) -> Vec<u8> {
         .iter()
         .flat_map(|p| p.to_array())
         .map(|c| {
-            let v = if c.is_finite() {
-                (c * scale).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+            let v = if c.is_finite() { (c * scale).clamp(0.0, 1.0) } else { 0.0 };
             (linear_to_srgb(v) * 255.0 + 0.5) as u8
         })
         .collect()
@@ -45,33 +34,21 @@ pub fn tone_map(image: &Image, exposure: f32) -> Vec<u8> {
 
 pub fn write_image(path: &Path, image: &Image, exposure: f32) -> Result<(), OutputError> {
     let shown = path.display().to_string();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let format = match ext.as_deref() {
         Some("png") => ::image::ImageFormat::Png,
         Some("exr") => ::image::ImageFormat::OpenExr,
         _ => return Err(OutputError::UnsupportedExtension { path: shown }),
     };
-    let wrap = |e: Box<dyn std::error::Error + Send + Sync>| OutputError::Write {
-        path: shown.clone(),
-        source: e,
-    };
+    let wrap = |e: Box<dyn std::error::Error + Send + Sync>| OutputError::Write { path: shown.clone(), source: e };
     let tmp = temporary_name(path);
     let result = match format {
-        ::image::ImageFormat::Png => {
-            ::image::RgbImage::from_raw(image.width, image.height, tone_map(image, exposure))
-                .expect("buffer size matches the image")
-                .save_with_format(&tmp, format)
-        }
+        ::image::ImageFormat::Png => ::image::RgbImage::from_raw(image.width, image.height, tone_map(image, exposure))
+            .expect("buffer size matches the image")
+            .save_with_format(&tmp, format),
         _ => {
-            let data: Vec<f32> = image
-                .pixels
-                .iter()
-                .flat_map(|p| p.to_array())
-                .map(|c| if c.is_finite() { c } else { 0.0 })
-                .collect();
+            let data: Vec<f32> =
+                image.pixels.iter().flat_map(|p| p.to_array()).map(|c| if c.is_finite() { c } else { 0.0 }).collect();
             ::image::Rgb32FImage::from_raw(image.width, image.height, data)
                 .expect("buffer size matches the image")
                 .save_with_format(&tmp, format)
@@ -88,10 +65,7 @@ pub fn write_image(path: &Path, image: &Image, exposure: f32) -> Result<(), Outp
 }
 
 fn temporary_name(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
@@ -115,17 +89,11 @@ mod tests {
         let exr = ::image::open(dir.join("a.exr")).unwrap().to_rgb32f();
         assert_eq!(exr.get_pixel(0, 0).0, [1.0, 0.5, 0.0]);
         assert_eq!(exr.get_pixel(1, 0).0, [0.0, 0.0, 2.0]);
-        assert!(matches!(
-            write_image(&dir.join("a.jpg"), &img, 0.0),
-            Err(OutputError::UnsupportedExtension { .. })
-        ));
+        assert!(matches!(write_image(&dir.join("a.jpg"), &img, 0.0), Err(OutputError::UnsupportedExtension { .. })));
         // A failed write leaves nothing behind.
         assert!(write_image(&dir.join("missing-dir/a.png"), &img, 0.0).is_err());
-        let leftovers: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap()
-            .filter_map(|e| e.ok())
-            .map(|e| e.file_name())
-            .collect();
+        let leftovers: Vec<_> =
+            std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
         assert_eq!(leftovers.len(), 2, "{leftovers:?}");
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -25,8 +25,7 @@ pub struct GpuContext {
 impl GpuContext {
     /// Finds an adapter (honouring `WGPU_BACKEND` and friends) and opens a device.
     pub fn new() -> Result<Self, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             compatible_surface: None,
@@ -34,9 +33,7 @@ impl GpuContext {
             apply_limit_buckets: false,
         }))
         .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
-        let float32_blend = adapter
-            .features()
-            .contains(wgpu::Features::FLOAT32_BLENDABLE);
+        let float32_blend = adapter.features().contains(wgpu::Features::FLOAT32_BLENDABLE);
         let mut required_features = wgpu::Features::empty();
         if float32_blend {
             required_features |= wgpu::Features::FLOAT32_BLENDABLE;

@@ -10,10 +10,12 @@
 //! Each pass is a small struct with its pipeline, its shader beside it.
 
 pub mod context;
+pub mod direct;
 pub mod gbuffer;
 pub mod readback;
 pub mod renderer;
 pub mod scene_upload;
+pub mod shadow;
 pub mod splat;
 
 pub use context::{GpuContext, GpuError};

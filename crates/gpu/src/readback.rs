@@ -13,8 +13,7 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
         other => return Err(GpuError::Readback(format!("cannot read back {other:?}"))),
     };
     let unpadded = width * texel_bytes;
-    let padded =
-        unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: (padded * height) as u64,
@@ -37,11 +36,7 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
                 rows_per_image: Some(height),
             },
         },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
     );
     ctx.queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
@@ -49,30 +44,16 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    ctx.device
-        .poll(wgpu::PollType::wait_indefinitely())
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    rx.recv()
-        .map_err(|e| GpuError::Readback(e.to_string()))?
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
-    let data = slice
-        .get_mapped_range()
-        .map_err(|e| GpuError::Readback(e.to_string()))?;
+    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+    rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
     let mut out = Vec::with_capacity((width * height) as usize);
     for row in 0..height {
         let bytes = &data[(row * padded) as usize..(row * padded + unpadded) as usize];
         if texel_bytes == 16 {
-            out.extend(
-                bytemuck::cast_slice::<u8, [f32; 4]>(bytes)
-                    .iter()
-                    .map(|&v| Vec4::from(v)),
-            );
+            out.extend(bytemuck::cast_slice::<u8, [f32; 4]>(bytes).iter().map(|&v| Vec4::from(v)));
         } else {
-            out.extend(
-                bytemuck::cast_slice::<u8, [u16; 4]>(bytes)
-                    .iter()
-                    .map(|v| Vec4::from(v.map(f16_to_f32))),
-            );
+            out.extend(bytemuck::cast_slice::<u8, [u16; 4]>(bytes).iter().map(|v| Vec4::from(v.map(f16_to_f32))));
         }
     }
     drop(data);
@@ -88,8 +69,7 @@ fn f16_to_f32(h: u16) -> f32 {
     let bits = match exp {
         0 if mant == 0 => sign,
         0 => {
-            return f32::from_bits(sign)
-                + (mant as f32) * 2f32.powi(-24) * if sign != 0 { -1.0 } else { 1.0 };
+            return f32::from_bits(sign) + (mant as f32) * 2f32.powi(-24) * if sign != 0 { -1.0 } else { 1.0 };
         }
         31 => sign | 0x7f80_0000 | (mant << 13),
         _ => sign | ((exp + 112) << 23) | (mant << 13),

@@ -45,10 +45,25 @@ const SPHERE_SEGMENTS: u32 = 96;
 pub struct SceneBuffers {
     pub vertices: wgpu::Buffer,
     pub vertex_count: u32,
+    /// Vertices `0..occluder_count` are everything but area-light bodies
+    /// (which come last): what shadow maps draw, so an area light's samples
+    /// are not shadowed by the light itself.
+    pub occluder_count: u32,
     pub surfaces: wgpu::Buffer,
 }
 
-pub fn scene_vertices(scene: &Scene) -> Vec<GpuVertex> {
+/// All vertices, area-light bodies last; returns them and the occluder count.
+pub fn scene_vertices(scene: &Scene) -> (Vec<GpuVertex>, u32) {
+    let is_emitter = |surface: u32| scene.surfaces[surface as usize].emitter.is_some();
+    let mut occluders = Vec::new();
+    let mut emitters = Vec::new();
+    for_each_vertex(scene, |v| if is_emitter(v.surface) { emitters.push(v) } else { occluders.push(v) });
+    let count = occluders.len() as u32;
+    occluders.extend(emitters);
+    (occluders, count)
+}
+
+fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
     let mut out = Vec::new();
     for (tri, surface) in scene.accel.triangles() {
         let ng = tri.geometric_normal().normalize();
@@ -68,7 +83,7 @@ pub fn scene_vertices(scene: &Scene) -> Vec<GpuVertex> {
     for (sphere, surface) in scene.accel.spheres() {
         tessellate_sphere(sphere.center, sphere.radius, surface, &mut out);
     }
-    out
+    out.into_iter().for_each(&mut emit);
 }
 
 /// UV sphere, wound so triangle normals point outward.
@@ -83,11 +98,7 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
         }
         let theta = std::f32::consts::PI * j as f32 / n_theta as f32;
         let phi = 2.0 * std::f32::consts::PI * i as f32 / n_phi as f32;
-        Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            theta.sin() * phi.sin(),
-        )
+        Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())
     };
     let mut push = |a: Vec3, b: Vec3, c: Vec3| {
         let ng = (b - a).cross(c - a);
@@ -106,12 +117,7 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
     };
     for j in 0..n_theta {
         for i in 0..n_phi {
-            let (a, b, c, d) = (
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            );
+            let (a, b, c, d) = (point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
             // φ grows toward +z at φ = 0 and θ toward −y, so (b−a)×(c−a) points outward.
             push(a, b, c);
             push(a, c, d);
@@ -131,29 +137,23 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 Material::Glass { .. } => (kind::GLASS, Vec3::ONE),
                 Material::Emitter => (kind::EMITTER, Vec3::ZERO),
             };
-            let emission = s
-                .emitter
-                .map_or(Vec3::ZERO, |l| match &scene.lights[l as usize] {
-                    hikari_core::light::Light::Sphere { radiance, .. }
-                    | hikari_core::light::Light::Quad { radiance, .. } => *radiance,
-                    _ => Vec3::ZERO,
-                });
-            GpuSurface {
-                albedo: albedo.to_array(),
-                kind,
-                emission: emission.to_array(),
-                _pad: 0,
-            }
+            let emission = s.emitter.map_or(Vec3::ZERO, |l| match &scene.lights[l as usize] {
+                hikari_core::light::Light::Sphere { radiance, .. }
+                | hikari_core::light::Light::Quad { radiance, .. } => *radiance,
+                _ => Vec3::ZERO,
+            });
+            GpuSurface { albedo: albedo.to_array(), kind, emission: emission.to_array(), _pad: 0 }
         })
         .collect()
 }
 
 impl SceneBuffers {
     pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
-        let vertices = scene_vertices(scene);
+        let (vertices, occluder_count) = scene_vertices(scene);
         let surfaces = scene_surfaces(scene);
         SceneBuffers {
             vertex_count: vertices.len() as u32,
+            occluder_count,
             vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene vertices"),
                 contents: bytemuck::cast_slice(&vertices),

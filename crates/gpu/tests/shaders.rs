@@ -2,8 +2,11 @@
 //! shared with WGSL has the size and field offsets naga computes.
 
 use hikari_core::photon::Photon;
+use hikari_gpu::direct::DirectParams;
 use hikari_gpu::gbuffer::GBufferParams;
 use hikari_gpu::scene_upload::{GpuSurface, GpuVertex};
+use hikari_gpu::shadow::ShadowViewParams;
+use hikari_gpu::shadow::light_samples::{GpuLight, GpuLightSample};
 use hikari_gpu::splat::SplatParams;
 use std::mem::{offset_of, size_of};
 
@@ -12,18 +15,17 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("gbuffer.wgsl", hikari_gpu::gbuffer::SHADER.to_string()),
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
         ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
+        ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
+        ("direct.wgsl", hikari_gpu::direct::SHADER.to_string()),
     ]
 }
 
 fn parse(name: &str, source: &str) -> naga::Module {
-    let module = naga::front::wgsl::parse_str(source)
-        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
-    naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::all(),
-    )
-    .validate(&module)
-    .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    let module =
+        naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
     module
 }
 
@@ -40,13 +42,7 @@ fn wgsl_layout(source: &str, name: &str) -> (u32, Vec<(String, u32)>) {
     for (_, ty) in module.types.iter() {
         if ty.name.as_deref() == Some(name) {
             if let naga::TypeInner::Struct { members, span } = &ty.inner {
-                return (
-                    *span,
-                    members
-                        .iter()
-                        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
-                        .collect(),
-                );
+                return (*span, members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect());
             }
         }
     }
@@ -69,42 +65,46 @@ macro_rules! assert_layout {
 #[test]
 fn shared_structs_match_wgsl_layouts() {
     let gbuffer = hikari_gpu::gbuffer::SHADER.to_string();
-    assert_layout!(
-        gbuffer,
-        "GBufferParams",
-        GBufferParams,
-        [clip_from_world, camera_position, _pad]
-    );
-    assert_layout!(
-        gbuffer,
-        "Surface",
-        GpuSurface,
-        [albedo, kind, emission, _pad]
-    );
+    assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
+    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, _pad]);
     let splat = hikari_gpu::splat::shader_source();
+    assert_layout!(splat, "SplatParams", SplatParams, [clip_from_world, radius, power_unit, normal_test, _pad]);
+    let shadow = hikari_gpu::shadow::SHADER.to_string();
+    assert_layout!(shadow, "ShadowViewParams", ShadowViewParams, [clip_from_world, light_position]);
+    let direct = hikari_gpu::direct::SHADER.to_string();
+    assert_layout!(direct, "DirectParams", DirectParams, [light_count, shadow_size, bias, _pad]);
+    assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position]);
     assert_layout!(
-        splat,
-        "SplatParams",
-        SplatParams,
-        [clip_from_world, radius, power_unit, normal_test, _pad]
+        direct,
+        "Light",
+        GpuLight,
+        [
+            position,
+            kind,
+            emission,
+            first_sample,
+            axis,
+            sample_count,
+            edge_v,
+            cutoff,
+            falloff_start,
+            _pad0,
+            _pad1,
+            _pad2
+        ]
     );
+    assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, view_count, _pad0, _pad1, _pad2]);
 }
 
 /// Vertex attributes are laid out by hand (vertex_attr_array! would pack
 /// them tightly): the arrays the pipelines use match the Rust structs.
 #[test]
 fn vertex_attribute_offsets_match_rust_structs() {
-    let offsets = |attrs: &[wgpu::VertexAttribute]| {
-        attrs.iter().map(|a| a.offset as usize).collect::<Vec<_>>()
-    };
+    let offsets = |attrs: &[wgpu::VertexAttribute]| attrs.iter().map(|a| a.offset as usize).collect::<Vec<_>>();
     assert_eq!(size_of::<Photon>(), 20);
     assert_eq!(
         offsets(&hikari_gpu::splat::PHOTON_ATTRIBUTES),
-        [
-            offset_of!(Photon, position),
-            offset_of!(Photon, power_rgb9e5),
-            offset_of!(Photon, direction_and_class)
-        ]
+        [offset_of!(Photon, position), offset_of!(Photon, power_rgb9e5), offset_of!(Photon, direction_and_class)]
     );
     assert_eq!(
         offsets(&hikari_gpu::gbuffer::VERTEX_ATTRIBUTES),

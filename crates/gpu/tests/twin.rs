@@ -21,24 +21,10 @@ fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats,
     let ctx = context_or_skip(scene_name)?;
     let mut scene = Scene::load(scene_name).unwrap();
     scene.camera = scene.camera.with_resolution(64, 64).unwrap();
-    let traced = trace_photons(
-        &scene,
-        &TraceSettings {
-            photons,
-            seed: 11,
-            ..Default::default()
-        },
-        &Silent,
-    );
-    let cpu_settings = PhotonCpuSettings {
-        normal_test,
-        ..Default::default()
-    };
+    let traced = trace_photons(&scene, &TraceSettings { photons, seed: 11, ..Default::default() }, &Silent);
+    let cpu_settings = PhotonCpuSettings { normal_test, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
-    let settings = GpuSettings {
-        global: cpu.global_params,
-        caustic: cpu.caustic_params,
-    };
+    let settings = GpuSettings::new(cpu.global_params, cpu.caustic_params);
     let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
     gpu.render();
     let t = &gpu.targets;
@@ -49,11 +35,7 @@ fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats,
     let caustic = gpu.read(&t.caustic).unwrap();
 
     let compare = |gpu_image: &[glam::Vec4], map, params: &FixedRadius| {
-        let mut stats = TwinStats {
-            lit: 0,
-            within_1e4: 0,
-            worst: 0.0,
-        };
+        let mut stats = TwinStats { lit: 0, within_1e4: 0, worst: 0.0 };
         for i in 0..position.len() {
             if position[i].w == 0.0 || albedo[i].w != 0.0 {
                 continue; // no surface, or not diffuse
@@ -72,11 +54,7 @@ fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats,
             }
             stats.lit += 1;
             let err = ((got - want).abs() / want.max(Vec3::splat(1e-30))).max_element();
-            let err = if want.max_element() == 0.0 {
-                f32::INFINITY
-            } else {
-                err
-            };
+            let err = if want.max_element() == 0.0 { f32::INFINITY } else { err };
             stats.within_1e4 += (err < 1e-4) as usize;
             stats.worst = stats.worst.max(err);
         }
@@ -93,22 +71,14 @@ fn assert_twin(name: &str, stats: &TwinStats, min_lit: usize) {
         "{name}: {} lit pixels, {} within 1e-4, worst relative error {:e}",
         stats.lit, stats.within_1e4, stats.worst
     );
-    assert!(
-        stats.lit >= min_lit,
-        "{name}: only {} lit pixels",
-        stats.lit
-    );
+    assert!(stats.lit >= min_lit, "{name}: only {} lit pixels", stats.lit);
     assert!(
         stats.within_1e4 as f64 >= 0.999 * stats.lit as f64,
         "{name}: {} of {} within 1e-4",
         stats.within_1e4,
         stats.lit
     );
-    assert!(
-        stats.worst < 1e-2,
-        "{name}: worst relative error {}",
-        stats.worst
-    );
+    assert!(stats.worst < 1e-2, "{name}: worst relative error {}", stats.worst);
 }
 
 #[test]

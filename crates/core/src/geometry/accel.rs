@@ -44,15 +44,8 @@ impl PackedPrim {
     #[inline(always)]
     fn intersect(&self, ray: &Ray, t_min: f32) -> (f32, f32, f32) {
         if self.prim & SPHERE_BIT != 0 {
-            let sphere = Sphere {
-                center: self.a,
-                radius: self.b.x,
-            };
-            return (
-                sphere.intersect(ray, t_min).unwrap_or(f32::INFINITY),
-                0.0,
-                0.0,
-            );
+            let sphere = Sphere { center: self.a, radius: self.b.x };
+            return (sphere.intersect(ray, t_min).unwrap_or(f32::INFINITY), 0.0, 0.0);
         }
         // Möller–Trumbore with precomputed edges.
         let (e1, e2) = (self.b, self.c);
@@ -121,18 +114,9 @@ impl Accel {
             lo = lo.min(b.0.min.into());
             hi = hi.max(b.0.max.into());
         }
-        let scale = if bounds.is_empty() {
-            1.0
-        } else {
-            (hi - lo).max_element().max(1e-3)
-        };
-        let bvh = (!bounds.is_empty()).then(|| {
-            build_cwbvh(
-                &bounds,
-                BvhBuildParams::medium_build(),
-                &mut Duration::default(),
-            )
-        });
+        let scale = if bounds.is_empty() { 1.0 } else { (hi - lo).max_element().max(1e-3) };
+        let bvh = (!bounds.is_empty())
+            .then(|| build_cwbvh(&bounds, BvhBuildParams::medium_build(), &mut Duration::default()));
         let mut surface_of = triangle_surfaces;
         surface_of.extend(sphere_surfaces);
         let n_tri = triangles.len();
@@ -145,12 +129,7 @@ impl Accel {
                         let i = i as usize;
                         if i < n_tri {
                             let v = triangles[i].v;
-                            PackedPrim {
-                                a: v[0],
-                                b: v[1] - v[0],
-                                c: v[2] - v[0],
-                                prim: i as u32,
-                            }
+                            PackedPrim { a: v[0], b: v[1] - v[0], c: v[2] - v[0], prim: i as u32 }
                         } else {
                             let s = spheres[i - n_tri];
                             PackedPrim {
@@ -182,11 +161,7 @@ impl Accel {
 
     /// Length of the scene's bounding-box diagonal (1 for an empty scene).
     pub fn diagonal(&self) -> f32 {
-        if self.surface_of.is_empty() {
-            1.0
-        } else {
-            (self.bounds_max - self.bounds_min).length()
-        }
+        if self.surface_of.is_empty() { 1.0 } else { (self.bounds_max - self.bounds_min).length() }
     }
 
     /// Every triangle with its surface id (for rasterization).
@@ -196,9 +171,7 @@ impl Accel {
 
     /// Every analytic sphere with its surface id.
     pub fn spheres(&self) -> impl Iterator<Item = (&Sphere, u32)> {
-        self.spheres
-            .iter()
-            .zip(self.surface_of[self.triangles.len()..].iter().copied())
+        self.spheres.iter().zip(self.surface_of[self.triangles.len()..].iter().copied())
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -215,11 +188,7 @@ impl Accel {
     /// still use the exact ray.
     fn obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
         let nudge = |d: f32| {
-            if d.abs() < 1e-20 {
-                1e-20f32.copysign(d)
-            } else {
-                d
-            }
+            if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d }
         };
         let dir = Vec3A::new(nudge(ray.dir.x), nudge(ray.dir.y), nudge(ray.dir.z));
         obvhs::ray::Ray::new(ray.origin.into(), dir, 0.0, ray.t_max)
@@ -259,13 +228,7 @@ impl Accel {
             let n = ((point - s.center) / s.radius).normalize();
             (n, n)
         };
-        Some(Hit {
-            t,
-            point,
-            geometric_normal,
-            shading_normal,
-            surface: self.surface_of[prim],
-        })
+        Some(Hit { t, point, geometric_normal, shading_normal, surface: self.surface_of[prim] })
     }
 
     /// True if anything blocks the open segment (epsilon, ray.t_max).
@@ -274,9 +237,7 @@ impl Accel {
             return false;
         };
         let eps = self.epsilon;
-        !bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| {
-            self.packed[id].intersect(ray, eps).0
-        })
+        !bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| self.packed[id].intersect(ray, eps).0)
     }
 }
 
@@ -294,10 +255,7 @@ mod tests {
             tris.push(Triangle { v, normals: None });
         }
         let spheres = (0..40)
-            .map(|_| Sphere {
-                center: (rng.next_2d().extend(rng.next_f32()) - 0.5) * 10.0,
-                radius: 0.3,
-            })
+            .map(|_| Sphere { center: (rng.next_2d().extend(rng.next_f32()) - 0.5) * 10.0, radius: 0.3 })
             .collect();
         (tris, spheres)
     }
@@ -310,21 +268,14 @@ mod tests {
                 .map(|i| {
                     let z = -(i as f32);
                     Triangle {
-                        v: [
-                            Vec3::new(0.0, 0.0, z),
-                            Vec3::new(2.0, 0.0, z),
-                            Vec3::new(0.0, 2.0, z),
-                        ],
+                        v: [Vec3::new(0.0, 0.0, z), Vec3::new(2.0, 0.0, z), Vec3::new(0.0, 2.0, z)],
                         normals: None,
                     }
                 })
                 .collect();
             let accel = Accel::build(tris, (0..n).collect(), vec![], vec![]);
             let hit = accel.intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z));
-            assert!(
-                hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-6),
-                "{n} triangles: {hit:?}"
-            );
+            assert!(hit.is_some_and(|h| (h.t - 1.0).abs() < 1e-6), "{n} triangles: {hit:?}");
             assert!(accel.occluded(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)));
         }
     }
@@ -341,10 +292,7 @@ mod tests {
         );
         let mut rng = Rng::for_item(12, 0);
         for _ in 0..2000 {
-            let ray = Ray::new(
-                (rng.next_2d().extend(rng.next_f32()) - 0.5) * 12.0,
-                uniform_sphere(rng.next_2d()),
-            );
+            let ray = Ray::new((rng.next_2d().extend(rng.next_f32()) - 0.5) * 12.0, uniform_sphere(rng.next_2d()));
             let mut best: Option<(f32, u32)> = None;
             for (i, t) in tris.iter().enumerate() {
                 if let Some((th, _, _)) = t.intersect(&ray, accel.epsilon) {

@@ -19,11 +19,7 @@ pub struct Ray {
 
 impl Ray {
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Ray {
-            origin,
-            dir,
-            t_max: f32::INFINITY,
-        }
+        Ray { origin, dir, t_max: f32::INFINITY }
     }
 
     pub fn at(&self, t: f32) -> Vec3 {

@@ -54,11 +54,7 @@ impl Triangle {
             Some(TriangleNormals(n)) => {
                 let s = n[0] * (1.0 - b1 - b2) + n[1] * b1 + n[2] * b2;
                 let len = s.length();
-                if len > 0.0 && len.is_finite() {
-                    s / len
-                } else {
-                    self.geometric_normal().normalize()
-                }
+                if len > 0.0 && len.is_finite() { s / len } else { self.geometric_normal().normalize() }
             }
             None => self.geometric_normal().normalize(),
         }
@@ -87,14 +83,8 @@ impl Sphere {
         }
         let root = (a * disc).sqrt();
         let q = -half_b - root.copysign(half_b);
-        let (mut t0, mut t1) = (
-            q / a,
-            if q != 0.0 {
-                (oc.length_squared() - self.radius * self.radius) / q
-            } else {
-                q / a
-            },
-        );
+        let (mut t0, mut t1) =
+            (q / a, if q != 0.0 { (oc.length_squared() - self.radius * self.radius) / q } else { q / a });
         if t0 > t1 {
             std::mem::swap(&mut t0, &mut t1);
         }
@@ -114,10 +104,7 @@ mod tests {
 
     #[test]
     fn sphere_hits_from_outside_and_inside() {
-        let s = Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
-        };
+        let s = Sphere { center: Vec3::ZERO, radius: 1.0 };
         let r = Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z);
         assert!((s.intersect(&r, 1e-4).unwrap() - 4.0).abs() < 1e-5);
         let inside = Ray::new(Vec3::ZERO, Vec3::X);
@@ -128,10 +115,7 @@ mod tests {
 
     #[test]
     fn triangle_hit_and_barycentrics() {
-        let tri = Triangle {
-            v: [Vec3::ZERO, Vec3::X, Vec3::Y],
-            normals: None,
-        };
+        let tri = Triangle { v: [Vec3::ZERO, Vec3::X, Vec3::Y], normals: None };
         let r = Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z);
         let (t, b1, b2) = tri.intersect(&r, 1e-4).unwrap();
         assert!((t - 1.0).abs() < 1e-6 && (b1 - 0.25).abs() < 1e-6 && (b2 - 0.25).abs() < 1e-6);

@@ -36,11 +36,7 @@ fn pow2(k: i32) -> f32 {
 
 pub fn decode_rgb9e5(bits: u32) -> Vec3 {
     let scale = pow2((bits >> 27) as i32 - EXP_BIAS - MANTISSA_BITS);
-    Vec3::new(
-        (bits & 511) as f32,
-        ((bits >> 9) & 511) as f32,
-        ((bits >> 18) & 511) as f32,
-    ) * scale
+    Vec3::new((bits & 511) as f32, ((bits >> 9) & 511) as f32, ((bits >> 18) & 511) as f32) * scale
 }
 
 /// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.

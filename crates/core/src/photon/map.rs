@@ -21,17 +21,10 @@ impl PhotonMap {
     pub fn new(photons: Vec<Photon>, power_unit: f32) -> Self {
         let points: Vec<[f32; 3]> = photons.iter().map(|p| p.position).collect();
         // kiddo refuses empty input; an empty map simply answers nothing.
-        let tree = (!points.is_empty()).then(|| {
-            ImmutableKdTree::new_from_slice(&points)
-                .expect("photon positions are finite by construction")
-        });
+        let tree = (!points.is_empty())
+            .then(|| ImmutableKdTree::new_from_slice(&points).expect("photon positions are finite by construction"));
         let power = photons.iter().map(Photon::power_in_units).collect();
-        PhotonMap {
-            photons,
-            power,
-            tree,
-            power_unit,
-        }
+        PhotonMap { photons, power, tree, power_unit }
     }
 
     pub fn photons(&self) -> &[Photon] {
@@ -75,23 +68,10 @@ impl PhotonMap {
         let (Some(tree), Some(k)) = (&self.tree, NonZeroUsize::new(k)) else {
             return (Vec::new(), 0.0);
         };
-        let found = tree
-            .query(&x.to_array())
-            .nearest_n::<SquaredEuclidean<f32>>(k)
-            .within(max_radius * max_radius)
-            .execute();
-        let radius = found
-            .iter()
-            .map(|r| r.distance)
-            .fold(0.0f32, f32::max)
-            .sqrt();
-        (
-            found
-                .iter()
-                .map(|r| &self.photons[r.item as usize])
-                .collect(),
-            radius,
-        )
+        let found =
+            tree.query(&x.to_array()).nearest_n::<SquaredEuclidean<f32>>(k).within(max_radius * max_radius).execute();
+        let radius = found.iter().map(|r| r.distance).fold(0.0f32, f32::max).sqrt();
+        (found.iter().map(|r| &self.photons[r.item as usize]).collect(), radius)
     }
 }
 
@@ -140,11 +120,7 @@ mod tests {
         let x = Vec3::new(0.1, -0.2, 0.3);
         let (found, radius) = map.nearest(x, 50, 10.0);
         assert_eq!(found.len(), 50);
-        let mut d: Vec<f32> = map
-            .photons()
-            .iter()
-            .map(|p| (p.position() - x).length())
-            .collect();
+        let mut d: Vec<f32> = map.photons().iter().map(|p| (p.position() - x).length()).collect();
         d.sort_by(f32::total_cmp);
         assert!((radius - d[49]).abs() < 1e-5);
     }

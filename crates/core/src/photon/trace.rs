@@ -24,11 +24,7 @@ pub struct TraceSettings {
 
 impl Default for TraceSettings {
     fn default() -> Self {
-        TraceSettings {
-            photons: 200_000,
-            seed: 0,
-            max_bounces: 64,
-        }
+        TraceSettings { photons: 200_000, seed: 0, max_bounces: 64 }
     }
 }
 
@@ -55,11 +51,7 @@ pub struct TracedPhotons {
 /// Photons per parallel work item: large enough to amortise scheduling.
 const CHUNK: u64 = 4096;
 
-pub fn trace_photons(
-    scene: &Scene,
-    settings: &TraceSettings,
-    progress: &dyn Progress,
-) -> TracedPhotons {
+pub fn trace_photons(scene: &Scene, settings: &TraceSettings, progress: &dyn Progress) -> TracedPhotons {
     let n = settings.photons.max(1);
     let probabilities = scene.light_selection_probabilities();
     let total_power: f32 = scene.lights.iter().map(|l| mean(l.power())).sum();
@@ -72,14 +64,8 @@ pub fn trace_photons(
         .map(|c| {
             let range = c * CHUNK..((c + 1) * CHUNK).min(n);
             let mut out = ChunkResult::default();
-            let mut tracer = PathTracer {
-                scene,
-                probabilities: &probabilities,
-                n,
-                power_unit,
-                settings,
-                out: &mut out,
-            };
+            let mut tracer =
+                PathTracer { scene, probabilities: &probabilities, n, power_unit, settings, out: &mut out };
             for i in range.clone() {
                 tracer.trace_one(i);
             }
@@ -93,10 +79,7 @@ pub fn trace_photons(
         global: Vec::with_capacity(results.iter().map(|r| r.global.len()).sum()),
         caustic: Vec::with_capacity(results.iter().map(|r| r.caustic.len()).sum()),
         power_unit,
-        stats: TraceStats {
-            emitted: n,
-            ..Default::default()
-        },
+        stats: TraceStats { emitted: n, ..Default::default() },
     };
     for r in results {
         traced.global.extend(r.global);
@@ -143,10 +126,7 @@ impl PathTracer<'_> {
             }
         }
         let light = &self.scene.lights[index];
-        (
-            index,
-            light.power() / (self.probabilities[index] * self.n as f32),
-        )
+        (index, light.power() / (self.probabilities[index] * self.n as f32))
     }
 
     fn trace_one(&mut self, index: u64) {
@@ -164,11 +144,7 @@ impl PathTracer<'_> {
             };
             let material = self.scene.material(&hit);
             // Normals on the side the photon arrives from.
-            let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 {
-                1.0
-            } else {
-                -1.0
-            };
+            let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
             let (ng, ns) = (hit.geometric_normal * facing, hit.shading_normal * facing);
 
             let next_dir = match material {
@@ -202,8 +178,7 @@ impl PathTracer<'_> {
             };
             // A shading normal can send the path below the true surface: end it there.
             let leaves_front = next_dir.dot(ng) > 0.0;
-            let is_transmission =
-                matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
+            let is_transmission = matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
             if !leaves_front && !is_transmission {
                 return;
             }
@@ -212,14 +187,7 @@ impl PathTracer<'_> {
         self.out.truncated += 1;
     }
 
-    fn store(
-        &mut self,
-        point: Vec3,
-        power: Rgb,
-        dir: Vec3,
-        diffuse_bounces: u32,
-        specular_bounces: u32,
-    ) {
+    fn store(&mut self, point: Vec3, power: Rgb, dir: Vec3, diffuse_bounces: u32, specular_bounces: u32) {
         let class = match (diffuse_bounces, specular_bounces) {
             (0, 0) => PathClass::Direct,
             (0, _) => PathClass::Caustic,
@@ -247,16 +215,9 @@ mod tests {
     #[test]
     fn identical_maps_with_one_and_two_threads() {
         let scene = Scene::load("cornell-caustic").unwrap();
-        let settings = TraceSettings {
-            photons: 30_000,
-            seed: 42,
-            ..Default::default()
-        };
+        let settings = TraceSettings { photons: 30_000, seed: 42, ..Default::default() };
         let run = |threads| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| trace_photons(&scene, &settings, &Silent))
         };
         let (a, b) = (run(1), run(2));
@@ -265,14 +226,7 @@ mod tests {
         assert_eq!(a.caustic, b.caustic);
         assert_eq!(a.stats, b.stats);
         // A different seed gives different photons.
-        let c = trace_photons(
-            &scene,
-            &TraceSettings {
-                seed: 43,
-                ..settings.clone()
-            },
-            &Silent,
-        );
+        let c = trace_photons(&scene, &TraceSettings { seed: 43, ..settings.clone() }, &Silent);
         assert_ne!(a.global, c.global);
     }
 
@@ -284,15 +238,7 @@ mod tests {
         let albedo = Vec3::new(0.8, 0.5, 0.2);
         let scene = test_scenes::furnace(albedo, 1.0);
         let phi = scene.lights[0].power();
-        let traced = trace_photons(
-            &scene,
-            &TraceSettings {
-                photons: 200_000,
-                seed: 5,
-                ..Default::default()
-            },
-            &Silent,
-        );
+        let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 5, ..Default::default() }, &Silent);
         for k in 0..4 {
             let expected = phi * albedo.powf(k as f32);
             let got = traced.stats.stored_flux_per_bounce[k];
@@ -307,23 +253,10 @@ mod tests {
     #[test]
     fn path_classes_partition_hits() {
         let scene = Scene::load("cornell-caustic").unwrap();
-        let traced = trace_photons(
-            &scene,
-            &TraceSettings {
-                photons: 20_000,
-                seed: 1,
-                ..Default::default()
-            },
-            &Silent,
-        );
+        let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, seed: 1, ..Default::default() }, &Silent);
         let count = |c| traced.global.iter().filter(|p| p.class() == c).count();
         assert!(count(PathClass::Direct) > 0 && count(PathClass::Indirect) > 0);
         assert_eq!(count(PathClass::Caustic), traced.caustic.len());
-        assert!(
-            traced
-                .caustic
-                .iter()
-                .all(|p| p.class() == PathClass::Caustic)
-        );
+        assert!(traced.caustic.iter().all(|p| p.class() == PathClass::Caustic));
     }
 }

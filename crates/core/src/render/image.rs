@@ -12,11 +12,7 @@ pub struct Image {
 
 impl Image {
     pub fn new(width: u32, height: u32) -> Self {
-        Image {
-            width,
-            height,
-            pixels: vec![Rgb::ZERO; (width * height) as usize],
-        }
+        Image { width, height, pixels: vec![Rgb::ZERO; (width * height) as usize] }
     }
 
     pub fn get(&self, x: u32, y: u32) -> Rgb {

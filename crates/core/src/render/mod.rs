@@ -44,8 +44,7 @@ pub(crate) fn render_pixels(
                 let offset = if spp == 1 {
                     Vec2::splat(0.5)
                 } else if s < strata * strata {
-                    (Vec2::new((s % strata) as f32, (s / strata) as f32) + rng.next_2d())
-                        / strata as f32
+                    (Vec2::new((s % strata) as f32, (s / strata) as f32) + rng.next_2d()) / strata as f32
                 } else {
                     rng.next_2d()
                 };
@@ -64,12 +63,5 @@ pub(crate) fn render_pixels(
         progress.advance(1);
     });
     progress.end();
-    (
-        Image {
-            width: w as u32,
-            height: h as u32,
-            pixels,
-        },
-        nonfinite.into_inner(),
-    )
+    (Image { width: w as u32, height: h as u32, pixels }, nonfinite.into_inner())
 }

@@ -21,11 +21,7 @@ pub struct PathSettings {
 
 impl Default for PathSettings {
     fn default() -> Self {
-        PathSettings {
-            spp: 64,
-            seed: 0,
-            max_depth: 64,
-        }
+        PathSettings { spp: 64, seed: 0, max_depth: 64 }
     }
 }
 
@@ -51,20 +47,15 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
             let le = light.emitted_radiance(ray.dir, hit.geometric_normal);
             let weight = match previous {
                 Previous::Specular => 1.0,
-                Previous::Diffuse { point, pdf } => power_heuristic(
-                    pdf,
-                    light.incident_pdf(point, hit.point, hit.geometric_normal),
-                ),
+                Previous::Diffuse { point, pdf } => {
+                    power_heuristic(pdf, light.incident_pdf(point, hit.point, hit.geometric_normal))
+                }
             };
             l += beta * le * weight;
             break;
         }
         let material = scene.material(&hit);
-        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
+        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let (ng, ns) = (hit.geometric_normal * facing, hit.shading_normal * facing);
         let next_dir = match material {
             Material::Emitter => break,
@@ -89,10 +80,7 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
                     Event::Absorbed => break,
                     Event::Diffuse => {
                         let dir = local_to_world(cosine_hemisphere(rng.next_2d()), ns);
-                        previous = Previous::Diffuse {
-                            point: hit.point,
-                            pdf: p_diffuse * dir.dot(ns).max(0.0) / PI,
-                        };
+                        previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
                         dir
                     }
                     Event::Specular => {
@@ -128,11 +116,7 @@ fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng:
         if scene.accel.occluded(&shadow) {
             continue;
         }
-        let weight = if s.is_delta {
-            1.0
-        } else {
-            power_heuristic(s.pdf, p_diffuse * cos / PI)
-        };
+        let weight = if s.is_delta { 1.0 } else { power_heuristic(s.pdf, p_diffuse * cos / PI) };
         sum += albedo / PI * s.radiance * (cos * weight / s.pdf);
     }
     sum
@@ -140,11 +124,5 @@ fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng:
 
 /// Renders the image; returns it and the number of non-finite samples dropped.
 pub fn render(scene: &Scene, settings: &PathSettings, progress: &dyn Progress) -> (Image, u64) {
-    render_pixels(
-        &scene.camera,
-        settings.spp,
-        settings.seed,
-        progress,
-        |ray, rng| radiance(scene, ray, settings, rng),
-    )
+    render_pixels(&scene.camera, settings.spp, settings.seed, progress, |ray, rng| radiance(scene, ray, settings, rng))
 }

@@ -22,11 +22,7 @@ pub struct Components {
 }
 
 impl Components {
-    pub const ALL: Components = Components {
-        direct: true,
-        indirect: true,
-        caustic: true,
-    };
+    pub const ALL: Components = Components { direct: true, indirect: true, caustic: true };
 }
 
 #[derive(Clone, Debug)]
@@ -89,12 +85,7 @@ pub struct PhotonCpuRenderer<'a> {
 
 impl<'a> PhotonCpuRenderer<'a> {
     pub fn new(scene: &'a Scene, traced: &TracedPhotons, settings: &PhotonCpuSettings) -> Self {
-        let indirect = traced
-            .global
-            .iter()
-            .filter(|p| p.class() == PathClass::Indirect)
-            .copied()
-            .collect();
+        let indirect = traced.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect();
         PhotonCpuRenderer {
             scene,
             global: PhotonMap::new(indirect, traced.power_unit),
@@ -104,9 +95,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                 normal_test: settings.normal_test,
             },
             caustic_params: FixedRadius {
-                radius: settings
-                    .caustic_radius
-                    .unwrap_or_else(|| default_caustic_radius(scene)),
+                radius: settings.caustic_radius.unwrap_or_else(|| default_caustic_radius(scene)),
                 normal_test: settings.normal_test,
             },
             settings: settings.clone(),
@@ -130,8 +119,7 @@ impl<'a> PhotonCpuRenderer<'a> {
             l += fixed_radius_radiance(&self.global, None, x, normal, albedo, &self.global_params);
         }
         if c.caustic {
-            l +=
-                fixed_radius_radiance(&self.caustic, None, x, normal, albedo, &self.caustic_params);
+            l += fixed_radius_radiance(&self.caustic, None, x, normal, albedo, &self.caustic_params);
         }
         l
     }
@@ -146,11 +134,7 @@ impl<'a> PhotonCpuRenderer<'a> {
         }
         let can_recurse = depth < self.settings.max_specular_depth;
         let material = self.scene.material(&hit);
-        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
+        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let ns = hit.shading_normal * facing;
         match material {
             Material::Glass { ior } => {
@@ -158,11 +142,9 @@ impl<'a> PhotonCpuRenderer<'a> {
                     return Rgb::ZERO;
                 }
                 let split = dielectric_split(ray.dir, hit.geometric_normal, *ior);
-                let mut l = split.reflectance
-                    * self.radiance(&Ray::new(hit.point, split.reflected), depth + 1, rng);
+                let mut l = split.reflectance * self.radiance(&Ray::new(hit.point, split.reflected), depth + 1, rng);
                 if let Some(t) = split.refracted {
-                    l += (1.0 - split.reflectance)
-                        * self.radiance(&Ray::new(hit.point, t), depth + 1, rng);
+                    l += (1.0 - split.reflectance) * self.radiance(&Ray::new(hit.point, t), depth + 1, rng);
                 }
                 l
             }
@@ -172,21 +154,13 @@ impl<'a> PhotonCpuRenderer<'a> {
                 let albedo = material.diffuse_albedo();
                 if albedo.max_element() > 0.0 {
                     if self.settings.components.direct {
-                        l += direct_diffuse(
-                            self.scene,
-                            hit.point,
-                            ns,
-                            albedo,
-                            self.settings.area_light_samples,
-                            rng,
-                        );
+                        l += direct_diffuse(self.scene, hit.point, ns, albedo, self.settings.area_light_samples, rng);
                     }
                     l += self.photon_radiance(hit.point, ns, albedo);
                 }
                 let rho_s = material.mirror_reflectance();
                 if rho_s.max_element() > 0.0 && can_recurse {
-                    l += rho_s
-                        * self.radiance(&Ray::new(hit.point, reflect(ray.dir, ns)), depth + 1, rng);
+                    l += rho_s * self.radiance(&Ray::new(hit.point, reflect(ray.dir, ns)), depth + 1, rng);
                 }
                 l
             }
@@ -195,12 +169,8 @@ impl<'a> PhotonCpuRenderer<'a> {
 
     /// Renders the image; returns it and the number of non-finite samples dropped.
     pub fn render(&self, progress: &dyn Progress) -> (Image, u64) {
-        render_pixels(
-            &self.scene.camera,
-            self.settings.spp,
-            self.settings.seed,
-            progress,
-            |ray, rng| self.radiance(&ray, 0, rng),
-        )
+        render_pixels(&self.scene.camera, self.settings.spp, self.settings.seed, progress, |ray, rng| {
+            self.radiance(&ray, 0, rng)
+        })
     }
 }

@@ -32,11 +32,8 @@ fn expected_probabilities(pdf: &dyn Fn(Vec3) -> f32) -> Vec<f64> {
             let mut sum = 0.0f64;
             for i in 0..SUB {
                 for j in 0..SUB {
-                    let z =
-                        -1.0 + 2.0 * (c as f64 + (i as f64 + 0.5) / SUB as f64) / COS_BINS as f64;
-                    let phi =
-                        2.0 * std::f64::consts::PI * (p as f64 + (j as f64 + 0.5) / SUB as f64)
-                            / PHI_BINS as f64;
+                    let z = -1.0 + 2.0 * (c as f64 + (i as f64 + 0.5) / SUB as f64) / COS_BINS as f64;
+                    let phi = 2.0 * std::f64::consts::PI * (p as f64 + (j as f64 + 0.5) / SUB as f64) / PHI_BINS as f64;
                     let r = (1.0 - z * z).max(0.0).sqrt();
                     let w = Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32);
                     sum += pdf(w) as f64;
@@ -66,8 +63,7 @@ fn erfc(x: f64) -> f64 {
                     + t * (0.09678418
                         + t * (-0.18628806
                             + t * (0.27886807
-                                + t * (-1.13520398
-                                    + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
+                                + t * (-1.13520398 + t * (1.48851587 + t * (-0.82215223 + t * 0.17087277)))))))))
             .exp();
     if x >= 0.0 { r } else { 2.0 - r }
 }
@@ -78,19 +74,13 @@ pub fn assert_direction_distribution(sample: impl Fn(Vec2) -> Vec3, pdf: impl Fn
     let mut rng = Rng::for_item(0xC412, 0);
     for _ in 0..SAMPLES {
         let w = sample(rng.next_2d());
-        assert!(
-            (w.length() - 1.0).abs() < 1e-3,
-            "sampler returned non-unit {w}"
-        );
+        assert!((w.length() - 1.0).abs() < 1e-3, "sampler returned non-unit {w}");
         observed[bin_of(w)] += 1;
     }
     let probs = expected_probabilities(&pdf);
     let (chi2, dof) = pooled_chi2(&observed, &probs, SAMPLES as f64);
     let p = chi2_p_value(chi2, dof);
-    assert!(
-        p > 1e-4,
-        "chi-square rejects sampler: chi2 = {chi2:.1}, dof = {dof}, p = {p:e}"
-    );
+    assert!(p > 1e-4, "chi-square rejects sampler: chi2 = {chi2:.1}, dof = {dof}, p = {p:e}");
 }
 
 /// Chi-square over histogram `observed` with cell probabilities `probs`.

@@ -18,10 +18,7 @@ pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
     let sign = 1.0f32.copysign(n.z);
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
-    (
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
+    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
 /// Expresses a local direction (z = axis) in the frame around `axis`.
@@ -104,11 +101,7 @@ mod tests {
     fn uniform_cone_matches_its_density() {
         let cos_max = 0.8f32;
         let pdf = move |w: Vec3| {
-            if w.z >= cos_max {
-                uniform_cone_pdf(cos_max)
-            } else {
-                0.0
-            }
+            if w.z >= cos_max { uniform_cone_pdf(cos_max) } else { 0.0 }
         };
         assert_direction_distribution(move |u| uniform_cone(u, cos_max), pdf);
         assert_unit_density(pdf);

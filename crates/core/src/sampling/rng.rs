@@ -24,10 +24,7 @@ fn mix64(mut z: u64) -> u64 {
 impl Rng {
     /// A stream for work item `index` of a run seeded with `seed`.
     pub fn for_item(seed: u64, index: u64) -> Self {
-        let mut rng = Rng {
-            state: 0,
-            increment: (mix64(seed ^ 0x9e3779b97f4a7c15) << 1) | 1,
-        };
+        let mut rng = Rng { state: 0, increment: (mix64(seed ^ 0x9e3779b97f4a7c15) << 1) | 1 };
         rng.state = mix64(index.wrapping_add(mix64(seed)));
         rng.next_u32();
         rng

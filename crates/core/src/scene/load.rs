@@ -81,29 +81,15 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         context: String::new(),
         message: e.message().trim().to_string(),
     })?;
-    let place = |span: Range<usize>, context: String| Place {
-        file,
-        text,
-        span,
-        context,
-    };
+    let place = |span: Range<usize>, context: String| Place { file, text, span, context };
 
-    let camera = load_camera(
-        desc.camera.get_ref(),
-        &place(desc.camera.span(), "[camera]".into()),
-    )?;
+    let camera = load_camera(desc.camera.get_ref(), &place(desc.camera.span(), "[camera]".into()))?;
 
     let mut materials = Vec::new();
     let mut by_name = HashMap::new();
     for (i, m) in desc.material.iter().enumerate() {
-        let p = place(
-            m.span(),
-            format!("[[material]] #{} \"{}\"", i + 1, m.get_ref().name),
-        );
-        if by_name
-            .insert(m.get_ref().name.clone(), materials.len() as u32)
-            .is_some()
-        {
+        let p = place(m.span(), format!("[[material]] #{} \"{}\"", i + 1, m.get_ref().name));
+        if by_name.insert(m.get_ref().name.clone(), materials.len() as u32).is_some() {
             return Err(p.error("a material with this name is already defined"));
         }
         materials.push(load_material(m.get_ref(), &p)?);
@@ -114,26 +100,16 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         let p = place(o.span(), format!("[[object]] #{}", i + 1));
         let obj = o.get_ref();
         let material = *by_name.get(obj.material.get_ref()).ok_or_else(|| {
-            let known: Vec<&str> = desc
-                .material
-                .iter()
-                .map(|m| m.get_ref().name.as_str())
-                .collect();
+            let known: Vec<&str> = desc.material.iter().map(|m| m.get_ref().name.as_str()).collect();
             let at = place(obj.material.span(), p.context.clone());
             let hint = if known.is_empty() {
                 "no [[material]] is defined".to_string()
             } else {
                 format!("defined: {}", known.join(", "))
             };
-            at.error(format!(
-                "unknown material \"{}\" ({hint})",
-                obj.material.get_ref()
-            ))
+            at.error(format!("unknown material \"{}\" ({hint})", obj.material.get_ref()))
         })?;
-        let surface = geometry.add_surface(Surface {
-            material,
-            emitter: None,
-        });
+        let surface = geometry.add_surface(Surface { material, emitter: None });
         load_object(obj, &p, base_dir, surface, &mut geometry)?;
     }
 
@@ -145,20 +121,11 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         if light.is_area() {
             let emitter_material = materials.len() as u32;
             materials.push(Material::Emitter);
-            let surface = geometry.add_surface(Surface {
-                material: emitter_material,
-                emitter: Some(lights.len() as u32),
-            });
+            let surface =
+                geometry.add_surface(Surface { material: emitter_material, emitter: Some(lights.len() as u32) });
             match light {
-                Light::Sphere { center, radius, .. } => {
-                    geometry.spheres.push((Sphere { center, radius }, surface))
-                }
-                Light::Quad {
-                    corner,
-                    edge_u,
-                    edge_v,
-                    ..
-                } => geometry.add_quad(corner, edge_u, edge_v, surface),
+                Light::Sphere { center, radius, .. } => geometry.spheres.push((Sphere { center, radius }, surface)),
+                Light::Quad { corner, edge_u, edge_v, .. } => geometry.add_quad(corner, edge_u, edge_v, surface),
                 _ => unreachable!("only area lights have geometry"),
             }
         }
@@ -176,14 +143,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = geometry.triangles.into_iter().unzip();
     let (spheres, sphere_surfaces): (Vec<_>, Vec<_>) = geometry.spheres.into_iter().unzip();
     let accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
-    Ok(Scene {
-        source: file.to_string(),
-        camera,
-        materials,
-        surfaces: geometry.surfaces,
-        lights,
-        accel,
-    })
+    Ok(Scene { source: file.to_string(), camera, materials, surfaces: geometry.surfaces, lights, accel })
 }
 
 fn load_camera(c: &CameraDesc, p: &Place) -> Result<Camera, SceneError> {
@@ -208,41 +168,25 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
     ];
     match m.kind.as_str() {
         "diffuse" => {
-            p.only(
-                "a diffuse material",
-                &given,
-                &["albedo", "specular_reflectance"],
-            )?;
+            p.only("a diffuse material", &given, &["albedo", "specular_reflectance"])?;
             let albedo = p.color("albedo", p.required("albedo", m.albedo)?, Some(1.0))?;
-            let specular = p.color(
-                "specular_reflectance",
-                m.specular_reflectance.unwrap_or([0.0; 3]),
-                Some(1.0),
-            )?;
+            let specular = p.color("specular_reflectance", m.specular_reflectance.unwrap_or([0.0; 3]), Some(1.0))?;
             if (albedo + specular).max_element() > 1.0 + 1e-6 {
-                return Err(p.error("albedo + specular_reflectance exceeds 1 in some channel (energy would be created)"));
+                return Err(
+                    p.error("albedo + specular_reflectance exceeds 1 in some channel (energy would be created)")
+                );
             }
             Ok(Material::Diffuse { albedo, specular })
         }
         "mirror" => {
             p.only("a mirror material", &given, &["reflectance"])?;
-            Ok(Material::Mirror {
-                reflectance: p.color(
-                    "reflectance",
-                    m.reflectance.unwrap_or([1.0; 3]),
-                    Some(1.0),
-                )?,
-            })
+            Ok(Material::Mirror { reflectance: p.color("reflectance", m.reflectance.unwrap_or([1.0; 3]), Some(1.0))? })
         }
         "glass" => {
             p.only("a glass material", &given, &["ior"])?;
-            Ok(Material::Glass {
-                ior: p.positive("ior", m.ior.unwrap_or(1.5))?,
-            })
+            Ok(Material::Glass { ior: p.positive("ior", m.ior.unwrap_or(1.5))? })
         }
-        other => Err(p.error(format!(
-            "unknown material type \"{other}\" (expected diffuse, mirror or glass)"
-        ))),
+        other => Err(p.error(format!("unknown material type \"{other}\" (expected diffuse, mirror or glass)"))),
     }
 }
 
@@ -262,15 +206,7 @@ impl GeometryBuilder {
 
     /// Two triangles, wound so their normal is edge_u × edge_v.
     fn add_quad(&mut self, corner: Vec3, u: Vec3, v: Vec3, surface: u32) {
-        let t = |a, b, c| {
-            (
-                Triangle {
-                    v: [a, b, c],
-                    normals: None,
-                },
-                surface,
-            )
-        };
+        let t = |a, b, c| (Triangle { v: [a, b, c], normals: None }, surface);
         self.triangles.push(t(corner, corner + u, corner + u + v));
         self.triangles.push(t(corner, corner + u + v, corner + v));
     }
@@ -312,9 +248,7 @@ fn load_object(
             let path = base_dir.map_or_else(|| Path::new(mesh).to_path_buf(), |d| d.join(mesh));
             for tri in load_obj(&path, p)? {
                 let v = tri.v.map(|x| rot * (x * scale) + translate);
-                let normals = tri
-                    .normals
-                    .map(|TriangleNormals(n)| TriangleNormals(n.map(|x| (rot * x).normalize())));
+                let normals = tri.normals.map(|TriangleNormals(n)| TriangleNormals(n.map(|x| (rot * x).normalize())));
                 geo.triangles.push((Triangle { v, normals }, surface));
             }
             Ok(())
@@ -342,28 +276,19 @@ fn load_object(
             let center = p.vec3("center", p.required("center", o.center)?)?;
             let size = p.vec3("size", p.required("size", o.size)?)?;
             if size.min_element() <= 0.0 {
-                return Err(p.error(format!(
-                    "box `size` = {:?} must be positive",
-                    o.size.unwrap()
-                )));
+                return Err(p.error(format!("box `size` = {:?} must be positive", o.size.unwrap())));
             }
             let rot = rotation(o.rotate_y)?;
             add_box(geo, center, size * 0.5, rot, surface);
             Ok(())
         }
-        (None, Some(other)) => Err(p.error(format!(
-            "unknown shape \"{other}\" (expected sphere, quad or box)"
-        ))),
+        (None, Some(other)) => Err(p.error(format!("unknown shape \"{other}\" (expected sphere, quad or box)"))),
     }
 }
 
 /// Six outward-facing quads of a box with half-extent `h`, rotated by `rot`.
 fn add_box(geo: &mut GeometryBuilder, center: Vec3, h: Vec3, rot: Mat3, surface: u32) {
-    let (x, y, z) = (
-        rot * Vec3::X * h.x,
-        rot * Vec3::Y * h.y,
-        rot * Vec3::Z * h.z,
-    );
+    let (x, y, z) = (rot * Vec3::X * h.x, rot * Vec3::Y * h.y, rot * Vec3::Z * h.z);
     // For each face: the outward axis `n` and two edges whose cross product is n.
     for (n, a, b) in [(x, y, z), (y, z, x), (z, x, y)] {
         for sign in [1.0f32, -1.0] {
@@ -378,46 +303,27 @@ fn load_obj(path: &Path, p: &Place) -> Result<Vec<Triangle>, SceneError> {
     if !path.is_file() {
         return Err(p.error(format!("mesh file {} not found", path.display())));
     }
-    let (models, _) = tobj::load_obj(
-        path,
-        &tobj::LoadOptions {
-            triangulate: true,
-            single_index: true,
-            ..Default::default()
-        },
-    )
-    .map_err(|e| p.error(format!("cannot read mesh {}: {e}", path.display())))?;
+    let (models, _) =
+        tobj::load_obj(path, &tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() })
+            .map_err(|e| p.error(format!("cannot read mesh {}: {e}", path.display())))?;
     let mut tris = Vec::new();
     for model in models {
         let m = &model.mesh;
         let vertex = |i: u32| {
-            Vec3::new(
-                m.positions[3 * i as usize],
-                m.positions[3 * i as usize + 1],
-                m.positions[3 * i as usize + 2],
-            )
+            Vec3::new(m.positions[3 * i as usize], m.positions[3 * i as usize + 1], m.positions[3 * i as usize + 2])
         };
         let has_normals = m.normals.len() == m.positions.len();
-        let normal = |i: u32| {
-            Vec3::new(
-                m.normals[3 * i as usize],
-                m.normals[3 * i as usize + 1],
-                m.normals[3 * i as usize + 2],
-            )
-        };
+        let normal =
+            |i: u32| Vec3::new(m.normals[3 * i as usize], m.normals[3 * i as usize + 1], m.normals[3 * i as usize + 2]);
         for idx in m.indices.chunks_exact(3) {
             if idx.iter().any(|&i| 3 * i as usize + 2 >= m.positions.len()) {
-                return Err(p.error(format!(
-                    "mesh {} has a face with a vertex index out of range",
-                    path.display()
-                )));
+                return Err(p.error(format!("mesh {} has a face with a vertex index out of range", path.display())));
             }
             let v = [vertex(idx[0]), vertex(idx[1]), vertex(idx[2])];
             if v.iter().any(|x| !x.is_finite()) {
                 return Err(p.error(format!("mesh {} has a non-finite vertex", path.display())));
             }
-            let normals = has_normals
-                .then(|| TriangleNormals([normal(idx[0]), normal(idx[1]), normal(idx[2])]));
+            let normals = has_normals.then(|| TriangleNormals([normal(idx[0]), normal(idx[1]), normal(idx[2])]));
             let tri = Triangle { v, normals };
             if tri.area() > 0.0 {
                 tris.push(tri);
@@ -445,60 +351,38 @@ fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
         ("edge_v", l.edge_v.is_some()),
     ];
     let nonzero = |field: &str, c: Vec3| {
-        if c.max_element() > 0.0 {
-            Ok(c)
-        } else {
-            Err(p.error(format!("`{field}` is zero: the light emits nothing")))
-        }
+        if c.max_element() > 0.0 { Ok(c) } else { Err(p.error(format!("`{field}` is zero: the light emits nothing"))) }
     };
     match l.kind.as_str() {
         "point" => {
             p.only("a point light", &given, &["position", "intensity"])?;
             Ok(Light::Point {
                 position: p.vec3("position", p.required("position", l.position)?)?,
-                intensity: nonzero(
-                    "intensity",
-                    p.color("intensity", p.required("intensity", l.intensity)?, None)?,
-                )?,
+                intensity: nonzero("intensity", p.color("intensity", p.required("intensity", l.intensity)?, None)?)?,
             })
         }
         "spot" => {
             p.only(
                 "a spot light",
                 &given,
-                &[
-                    "position",
-                    "intensity",
-                    "direction",
-                    "cutoff_angle",
-                    "falloff_start_angle",
-                ],
+                &["position", "intensity", "direction", "cutoff_angle", "falloff_start_angle"],
             )?;
-            let axis = p
-                .vec3("direction", p.required("direction", l.direction)?)?
-                .normalize_or_zero();
+            let axis = p.vec3("direction", p.required("direction", l.direction)?)?.normalize_or_zero();
             if axis == Vec3::ZERO {
                 return Err(p.error("`direction` is zero"));
             }
             let cutoff = l.cutoff_angle.unwrap_or(20.0);
             if !(cutoff > 0.0 && cutoff <= 90.0) {
-                return Err(p.error(format!(
-                    "`cutoff_angle` = {cutoff} must be in (0, 90] degrees"
-                )));
+                return Err(p.error(format!("`cutoff_angle` = {cutoff} must be in (0, 90] degrees")));
             }
             let start = l.falloff_start_angle.unwrap_or(cutoff * 0.75);
             if !(start >= 0.0 && start <= cutoff) {
-                return Err(p.error(format!(
-                    "`falloff_start_angle` = {start} must be in [0, cutoff_angle = {cutoff}]"
-                )));
+                return Err(p.error(format!("`falloff_start_angle` = {start} must be in [0, cutoff_angle = {cutoff}]")));
             }
             Ok(Light::Spot {
                 position: p.vec3("position", p.required("position", l.position)?)?,
                 axis,
-                intensity: nonzero(
-                    "intensity",
-                    p.color("intensity", p.required("intensity", l.intensity)?, None)?,
-                )?,
+                intensity: nonzero("intensity", p.color("intensity", p.required("intensity", l.intensity)?, None)?)?,
                 cutoff: cutoff.to_radians(),
                 falloff_start: start.to_radians(),
             })
@@ -508,18 +392,11 @@ fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
             Ok(Light::Sphere {
                 center: p.vec3("center", p.required("center", l.center)?)?,
                 radius: p.positive("radius", p.required("radius", l.radius)?)?,
-                radiance: nonzero(
-                    "radiance",
-                    p.color("radiance", p.required("radiance", l.radiance)?, None)?,
-                )?,
+                radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, None)?)?,
             })
         }
         "quad" => {
-            p.only(
-                "a quad light",
-                &given,
-                &["corner", "edge_u", "edge_v", "radiance"],
-            )?;
+            p.only("a quad light", &given, &["corner", "edge_u", "edge_v", "radiance"])?;
             let edge_u = p.vec3("edge_u", p.required("edge_u", l.edge_u)?)?;
             let edge_v = p.vec3("edge_v", p.required("edge_v", l.edge_v)?)?;
             if edge_u.cross(edge_v).length() <= 1e-12 {
@@ -529,15 +406,10 @@ fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
                 corner: p.vec3("corner", p.required("corner", l.corner)?)?,
                 edge_u,
                 edge_v,
-                radiance: nonzero(
-                    "radiance",
-                    p.color("radiance", p.required("radiance", l.radiance)?, None)?,
-                )?,
+                radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, None)?)?,
             })
         }
-        other => Err(p.error(format!(
-            "unknown light type \"{other}\" (expected point, spot, sphere or quad)"
-        ))),
+        other => Err(p.error(format!("unknown light type \"{other}\" (expected point, spot, sphere or quad)"))),
     }
 }
 
@@ -600,33 +472,19 @@ intensity = [1.0, 1.0, 1.0]
     #[test]
     fn unknown_material_names_the_object() {
         let e = err(&BASE.replace("material = \"white\"", "material = \"whte\""));
-        assert!(
-            e.to_string().contains("[[object]] #1") && e.to_string().contains("whte"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("[[object]] #1") && e.to_string().contains("whte"), "{e}");
         assert_eq!(e.position.unwrap(), (17, 12), "{e}");
     }
 
     #[test]
     fn missing_mesh_is_reported() {
-        let e = err(&BASE.replace(
-            "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
-            "mesh = \"nope.obj\"",
-        ));
-        assert!(
-            e.message.contains("nope.obj") && e.message.contains("not found"),
-            "{e}"
-        );
+        let e = err(&BASE.replace("shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0", "mesh = \"nope.obj\""));
+        assert!(e.message.contains("nope.obj") && e.message.contains("not found"), "{e}");
     }
 
     #[test]
     fn bad_albedo_values_are_rejected() {
-        for bad in [
-            "[-0.1, 0.5, 0.5]",
-            "[1.2, 0.5, 0.5]",
-            "[nan, 0.5, 0.5]",
-            "[inf, 0.5, 0.5]",
-        ] {
+        for bad in ["[-0.1, 0.5, 0.5]", "[1.2, 0.5, 0.5]", "[nan, 0.5, 0.5]", "[inf, 0.5, 0.5]"] {
             let e = err(&BASE.replace("albedo = [0.5, 0.5, 0.5]", &format!("albedo = {bad}")));
             assert!(e.context.contains("[[material]] #1"), "{e}");
             assert!(e.message.contains("albedo"), "{e}");
@@ -636,10 +494,7 @@ intensity = [1.0, 1.0, 1.0]
     #[test]
     fn degenerate_camera_is_rejected() {
         let e = err(&BASE.replace("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 0.0, 3.0]"));
-        assert!(
-            e.context == "[camera]" && e.message.contains("coincide"),
-            "{e}"
-        );
+        assert!(e.context == "[camera]" && e.message.contains("coincide"), "{e}");
         let e = err(&BASE.replace("resolution = [16, 16]", "resolution = [0, 16]"));
         assert!(e.message.contains("zero"), "{e}");
     }
@@ -653,10 +508,7 @@ intensity = [1.0, 1.0, 1.0]
     #[test]
     fn misplaced_and_invalid_light_fields_are_rejected() {
         let e = err(&BASE.replace("type = \"point\"", "type = \"point\"\nradius = 1.0"));
-        assert!(
-            e.message.contains("radius") && e.message.contains("point light"),
-            "{e}"
-        );
+        assert!(e.message.contains("radius") && e.message.contains("point light"), "{e}");
         let e = err(&BASE.replace("intensity = [1.0, 1.0, 1.0]", "intensity = [0.0, 0.0, 0.0]"));
         assert!(e.message.contains("emits nothing"), "{e}");
     }
@@ -670,19 +522,11 @@ intensity = [1.0, 1.0, 1.0]
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0.6 0 0.8\nf 1//1 2//2 3//3\n",
         )
         .unwrap();
-        let text = BASE.replace(
-            "shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0",
-            "mesh = \"tri.obj\"\nscale = 2.0",
-        );
+        let text = BASE
+            .replace("shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0", "mesh = \"tri.obj\"\nscale = 2.0");
         let s = parse(&text, "mem.toml", Some(&dir)).unwrap();
         assert_eq!(s.accel.triangle_count(), 1);
-        let hit = s
-            .accel
-            .intersect(&crate::geometry::Ray::new(
-                Vec3::new(0.2, 0.2, 1.0),
-                -Vec3::Z,
-            ))
-            .unwrap();
+        let hit = s.accel.intersect(&crate::geometry::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)).unwrap();
         assert!((hit.point - Vec3::new(0.2, 0.2, 0.0)).length() < 1e-5);
         // Interpolated smooth normal, not the flat one.
         assert!(hit.shading_normal.x > 0.01);
@@ -692,21 +536,11 @@ intensity = [1.0, 1.0, 1.0]
     #[test]
     fn box_faces_point_outward() {
         let mut geo = GeometryBuilder::default();
-        add_box(
-            &mut geo,
-            Vec3::new(1.0, 2.0, 3.0),
-            Vec3::new(0.5, 1.0, 0.25),
-            Mat3::from_rotation_y(0.3),
-            0,
-        );
+        add_box(&mut geo, Vec3::new(1.0, 2.0, 3.0), Vec3::new(0.5, 1.0, 0.25), Mat3::from_rotation_y(0.3), 0);
         assert_eq!(geo.triangles.len(), 12);
         for (t, _) in &geo.triangles {
             let centroid = (t.v[0] + t.v[1] + t.v[2]) / 3.0;
-            assert!(
-                t.geometric_normal()
-                    .dot(centroid - Vec3::new(1.0, 2.0, 3.0))
-                    > 0.0
-            );
+            assert!(t.geometric_normal().dot(centroid - Vec3::new(1.0, 2.0, 3.0)) > 0.0);
         }
     }
 }

@@ -49,10 +49,7 @@ impl Scene {
             message: if builtin::NAMES.contains(&name.as_str()) {
                 e.to_string()
             } else {
-                format!(
-                    "cannot read scene file: {e} (built-in scenes: {})",
-                    builtin::NAMES.join(", ")
-                )
+                format!("cannot read scene file: {e} (built-in scenes: {})", builtin::NAMES.join(", "))
             },
         })?;
         load::parse(&text, &name, path.parent())
@@ -68,9 +65,7 @@ impl Scene {
     }
 
     pub fn emitter(&self, hit: &Hit) -> Option<&Light> {
-        self.surfaces[hit.surface as usize]
-            .emitter
-            .map(|l| &self.lights[l as usize])
+        self.surfaces[hit.surface as usize].emitter.map(|l| &self.lights[l as usize])
     }
 
     /// Scene size used to derive default radii and offsets.

@@ -21,26 +21,10 @@ pub const SHADER: &str = include_str!("gbuffer.wgsl");
 /// `GpuVertex` as vertex attributes, offsets written by hand (a test checks
 /// them against the struct).
 pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 4] = [
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 0,
-        shader_location: 0,
-    },
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 12,
-        shader_location: 1,
-    },
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 24,
-        shader_location: 2,
-    },
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Uint32,
-        offset: 36,
-        shader_location: 3,
-    },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 12, shader_location: 1 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 24, shader_location: 2 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 36, shader_location: 3 },
 ];
 
 /// The G-buffer's textures, all `width × height`.
@@ -59,11 +43,7 @@ impl GBuffer {
         let target = |label| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -76,11 +56,7 @@ impl GBuffer {
         };
         let depth = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("gbuffer depth"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -141,11 +117,8 @@ impl GBufferPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let target = Some(wgpu::ColorTargetState {
-            format: TARGET_FORMAT,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        });
+        let target =
+            Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("gbuffer"),
             layout: Some(&pipeline_layout),
@@ -159,10 +132,7 @@ impl GBufferPass {
                     attributes: &VERTEX_ATTRIBUTES,
                 })],
             },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: DEPTH_FORMAT,
                 depth_write_enabled: Some(true),
@@ -200,25 +170,14 @@ impl GBufferPass {
             label: Some("gbuffer"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniforms.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: scene.surfaces.as_entire_binding(),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: scene.surfaces.as_entire_binding() },
             ],
         });
-        let views: Vec<wgpu::TextureView> = [
-            &gbuffer.position,
-            &gbuffer.normal,
-            &gbuffer.albedo,
-            &gbuffer.emission,
-        ]
-        .iter()
-        .map(|t| t.create_view(&Default::default()))
-        .collect();
+        let views: Vec<wgpu::TextureView> = [&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission]
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
         let depth_view = gbuffer.depth.create_view(&Default::default());
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
             .iter()
@@ -239,10 +198,7 @@ impl GBufferPass {
             color_attachments: &attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
             timestamp_writes: None,

@@ -20,21 +20,9 @@ pub struct SplatParams {
 /// The 20-byte `Photon` as per-instance attributes, offsets written by hand
 /// (a test checks them against the struct).
 pub const PHOTON_ATTRIBUTES: [wgpu::VertexAttribute; 3] = [
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Float32x3,
-        offset: 0,
-        shader_location: 0,
-    },
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Uint32,
-        offset: 12,
-        shader_location: 1,
-    },
-    wgpu::VertexAttribute {
-        format: wgpu::VertexFormat::Uint32,
-        offset: 16,
-        shader_location: 2,
-    },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 12, shader_location: 1 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 16, shader_location: 2 },
 ];
 
 pub fn shader_source() -> String {
@@ -50,17 +38,9 @@ pub struct PhotonBuffer {
 impl PhotonBuffer {
     pub fn upload(device: &wgpu::Device, photons: &[Photon], label: &str) -> Self {
         // wgpu refuses empty buffers: keep one zeroed photon, draw none.
-        let zero = [Photon::new(
-            glam::Vec3::ZERO,
-            glam::Vec3::ZERO,
-            glam::Vec3::Y,
-            hikari_core::photon::PathClass::Indirect,
-        )];
-        let data = if photons.is_empty() {
-            &zero[..]
-        } else {
-            photons
-        };
+        let zero =
+            [Photon::new(glam::Vec3::ZERO, glam::Vec3::ZERO, glam::Vec3::Y, hikari_core::photon::PathClass::Indirect)];
+        let data = if photons.is_empty() { &zero[..] } else { photons };
         PhotonBuffer {
             buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -150,10 +130,7 @@ impl SplatPass {
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format: target_format,
-                    blend: Some(wgpu::BlendState {
-                        color: additive,
-                        alpha: additive,
-                    }),
+                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),
@@ -183,48 +160,25 @@ impl SplatPass {
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
-        let (position, normal, albedo) = (
-            view(&gbuffer.position),
-            view(&gbuffer.normal),
-            view(&gbuffer.albedo),
-        );
+        let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniforms.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&position),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&normal),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&albedo),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&albedo) },
             ],
         });
-        let load = if clear {
-            wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-        } else {
-            wgpu::LoadOp::Load
-        };
+        let load = if clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("photon splat"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations {
-                    load,
-                    store: wgpu::StoreOp::Store,
-                },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,

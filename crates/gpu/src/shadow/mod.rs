@@ -1,0 +1,194 @@
+//! The shadow pass: renders, for every light sample, the distance to the
+//! nearest surface into layers of one `R32Float` texture array (a cube of
+//! six layers for point and area samples, one layer for narrow spots).
+
+pub mod light_samples;
+
+use crate::gbuffer::DEPTH_FORMAT;
+use crate::scene_upload::{GpuVertex, SceneBuffers};
+use bytemuck::{Pod, Zeroable};
+use light_samples::ShadowView;
+use wgpu::util::DeviceExt;
+
+pub const SHADER: &str = include_str!("shadow.wgsl");
+pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// Mirrors `ShadowViewParams` in shadow.wgsl and `ShadowView` in direct.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct ShadowViewParams {
+    pub clip_from_world: [[f32; 4]; 4],
+    pub light_position: [f32; 4],
+}
+
+impl From<&ShadowView> for ShadowViewParams {
+    fn from(v: &ShadowView) -> Self {
+        ShadowViewParams {
+            clip_from_world: v.clip_from_world.to_cols_array_2d(),
+            light_position: v.light_position.extend(0.0).to_array(),
+        }
+    }
+}
+
+pub struct ShadowMaps {
+    pub size: u32,
+    pub layers: u32,
+    pub texture: wgpu::Texture,
+    depth: wgpu::Texture,
+    view_bind_groups: Vec<wgpu::BindGroup>,
+    /// All views, for the direct pass's lookups.
+    pub views_buffer: wgpu::Buffer,
+}
+
+pub struct ShadowPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl ShadowPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("shadow.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow view"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<GpuVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &crate::gbuffer::VERTEX_ATTRIBUTES[..1],
+                })],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: MAP_FORMAT,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        ShadowPass { pipeline, layout }
+    }
+
+    pub fn create_maps(&self, device: &wgpu::Device, views: &[ShadowView], size: u32) -> ShadowMaps {
+        let layers = views.len().max(1) as u32;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow maps"),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: MAP_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow depth"),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let params: Vec<ShadowViewParams> = views.iter().map(ShadowViewParams::from).collect();
+        let view_bind_groups = params
+            .iter()
+            .map(|p| {
+                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("shadow view"),
+                    contents: bytemuck::bytes_of(p),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("shadow view"),
+                    layout: &self.layout,
+                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+                })
+            })
+            .collect();
+        let zero = [ShadowViewParams::zeroed()];
+        let views_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadow views"),
+            contents: bytemuck::cast_slice(if params.is_empty() { &zero[..] } else { &params }),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        ShadowMaps { size, layers, texture, depth, view_bind_groups, views_buffer }
+    }
+
+    /// Renders every shadow view of `maps`.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, scene: &SceneBuffers, maps: &ShadowMaps) {
+        let depth_view = maps.depth.create_view(&Default::default());
+        for (layer, bind_group) in maps.view_bind_groups.iter().enumerate() {
+            let target = maps.texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow view"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    // Texels that see nothing hold "infinitely far": lit.
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 1e30, g: 0.0, b: 0.0, a: 0.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, bind_group, &[]);
+            pass.set_vertex_buffer(0, scene.vertices.slice(..));
+            pass.draw(0..scene.occluder_count, 0..1);
+        }
+    }
+}

@@ -1,0 +1,27 @@
+// Shadow views: each layer of the shadow-map array stores, per texel, the
+// distance from the light sample to the nearest surface seen through it.
+
+struct ShadowViewParams {
+    clip_from_world: mat4x4<f32>,
+    light_position: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> view: ShadowViewParams;
+
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+}
+
+@vertex
+fn vs_main(@location(0) position: vec3<f32>) -> VertexOut {
+    var out: VertexOut;
+    out.clip = view.clip_from_world * vec4<f32>(position, 1.0);
+    out.world = position;
+    return out;
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(distance(in.world, view.light_position.xyz), 0.0, 0.0, 0.0);
+}

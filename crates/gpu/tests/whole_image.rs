@@ -1,0 +1,125 @@
+//! The GPU renderer's whole image against `photon-cpu` with the same photon
+//! maps: per-pixel relative difference, away from shadow edges.
+
+use glam::{Vec2, Vec3};
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use hikari_core::sampling::Rng;
+use hikari_core::scene::Scene;
+use hikari_gpu::test_support::context_or_skip;
+use hikari_gpu::{GpuRenderer, GpuSettings};
+
+const SIZE: u32 = 64;
+
+/// Fraction of each light that a point sees, by shadow rays (64 per area light).
+fn visibility(scene: &Scene, x: Vec3) -> Vec<f32> {
+    let mut rng = Rng::for_item(99, 0);
+    scene
+        .lights
+        .iter()
+        .map(|light| {
+            let count = if light.is_area() { 64 } else { 1 };
+            let (mut seen, mut total) = (0, 0);
+            for _ in 0..count {
+                let Some(s) = light.sample_incident(x, rng.next_2d()) else { continue };
+                total += 1;
+                // As direct_diffuse casts it: from the point itself (the BVH skips t < epsilon).
+                let mut ray = hikari_core::geometry::Ray::new(x, s.wi);
+                ray.t_max = s.distance * (1.0 - 1e-4);
+                seen += (!scene.accel.occluded(&ray)) as u32;
+            }
+            if total == 0 { 1.0 } else { seen as f32 / total as f32 }
+        })
+        .collect()
+}
+
+/// Pixels to compare: a diffuse surface in both renderers, and no change of
+/// light visibility within 2 pixels (shadow-map edges and penumbrae differ
+/// by construction: texel-sized steps, N hard shadows for a soft one).
+fn comparison_mask(scene: &Scene, gpu_albedo: &[glam::Vec4]) -> Vec<bool> {
+    let n = (SIZE * SIZE) as usize;
+    let mut vis: Vec<Option<Vec<f32>>> = vec![None; n];
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            if let Some(hit) = scene.accel.intersect(&ray) {
+                if scene.material(&hit).is_diffuse() && gpu_albedo[(y * SIZE + x) as usize].w == 0.0 {
+                    vis[(y * SIZE + x) as usize] = Some(visibility(scene, hit.point));
+                }
+            }
+        }
+    }
+    let mut mask = vec![false; n];
+    for y in 0..SIZE as i32 {
+        for x in 0..SIZE as i32 {
+            let Some(v) = &vis[(y * SIZE as i32 + x) as usize] else { continue };
+            let steady = (-2..=2).all(|dy| {
+                (-2..=2).all(|dx| {
+                    let (nx, ny) = (x + dx, y + dy);
+                    if nx < 0 || ny < 0 || nx >= SIZE as i32 || ny >= SIZE as i32 {
+                        return true;
+                    }
+                    match &vis[(ny * SIZE as i32 + nx) as usize] {
+                        Some(w) => w.iter().zip(v).all(|(a, b)| (a - b).abs() < 0.02),
+                        None => true,
+                    }
+                })
+            });
+            mask[(y * SIZE as i32 + x) as usize] = steady;
+        }
+    }
+    mask
+}
+
+fn compare(scene_name: &str) -> Option<(f64, usize)> {
+    let ctx = context_or_skip(scene_name)?;
+    let mut scene = Scene::load(scene_name).unwrap();
+    scene.camera = scene.camera.with_resolution(SIZE, SIZE).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 50_000, seed: 5, ..Default::default() }, &Silent);
+    // One sample at the pixel centre, as the rasterizer sees it; many shadow
+    // rays per area light so the CPU's direct light is nearly noise-free.
+    let cpu_settings = PhotonCpuSettings { spp: 1, area_light_samples: 64, ..Default::default() };
+    let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
+    let (cpu_image, _) = cpu.render(&Silent);
+    let settings = GpuSettings {
+        area_light_samples: 16,
+        shadow_map_size: 1024,
+        ..GpuSettings::new(cpu.global_params, cpu.caustic_params)
+    };
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
+    gpu.render();
+    let (gpu_image, nonfinite) = gpu.read_image().unwrap();
+    assert_eq!(nonfinite, 0);
+    let albedo = gpu.read(&gpu.targets.gbuffer.albedo).unwrap();
+    let mask = comparison_mask(&scene, &albedo);
+    let (mut sum, mut count) = (0.0f64, 0usize);
+    for i in 0..mask.len() {
+        if !mask[i] {
+            continue;
+        }
+        let (g, c) = (gpu_image.pixels[i], cpu_image.pixels[i]);
+        let (gl, cl) = ((g.x + g.y + g.z) / 3.0, (c.x + c.y + c.z) / 3.0);
+        if cl > 1e-6 {
+            sum += ((gl - cl).abs() / cl) as f64;
+            count += 1;
+        }
+    }
+    let mean = sum / count.max(1) as f64;
+    eprintln!("{scene_name}: {count} pixels compared, mean relative difference {:.3}%", mean * 100.0);
+    Some((mean, count))
+}
+
+#[test]
+fn gpu_image_matches_photon_cpu_on_cornell_box() {
+    let Some((mean, count)) = compare("cornell-box") else { return };
+    assert!(count > 2000, "only {count} pixels compared");
+    assert!(mean < 0.02, "mean relative difference {mean}");
+}
+
+#[test]
+fn gpu_image_matches_photon_cpu_on_cornell_caustic() {
+    let Some((mean, count)) = compare("cornell-caustic") else { return };
+    assert!(count > 2000, "only {count} pixels compared");
+    assert!(mean < 0.02, "mean relative difference {mean}");
+}
