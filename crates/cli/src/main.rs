@@ -1,5 +1,6 @@
 //! `hikari`: the command-line renderer.
 
+mod bench_cmd;
 mod progress_bar;
 mod render_cmd;
 
@@ -23,12 +24,15 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// List the built-in scenes.
     Scenes,
+    /// Measure the GPU renderer: the seed's chapter-6 table for surfaces.
+    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(&args),
+        Command::Bench(args) => bench_cmd::run(&args),
         Command::Scenes => {
             for name in hikari_core::scene::builtin::NAMES {
                 let default = if *name == hikari_core::scene::builtin::DEFAULT { "  (default)" } else { "" };

@@ -3,6 +3,7 @@
 use crate::progress_bar::TerminalProgress;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use hikari_core::lod::LodSettings;
 use hikari_core::output::write_image;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::render::{Image, path, photon_cpu};
@@ -67,6 +68,16 @@ pub struct RenderArgs {
     /// eye (stops light leaking through thin walls; darkens inside corners).
     #[arg(long)]
     pub normal_test: bool,
+    /// LOD (gpu): photons nearer the eye than this are fully detailed when
+    /// lod-near < lod-far, fully culled when lod-near > lod-far (scene units).
+    #[arg(long, requires = "lod_far", allow_negative_numbers = true)]
+    pub lod_near: Option<f32>,
+    /// LOD (gpu): the other end of the detail ramp (scene units).
+    #[arg(long, requires = "lod_near", allow_negative_numbers = true)]
+    pub lod_far: Option<f32>,
+    /// LOD (gpu): number of photon groups A.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub lod_groups: u32,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
@@ -121,9 +132,14 @@ fn render_photons(args: &RenderArgs, scene: &Scene, progress: &TerminalProgress)
     eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
     if let Some(ctx) = gpu {
         let adapter = ctx.describe();
+        let lod = match (args.lod_near, args.lod_far) {
+            (Some(near), Some(far)) => Some(LodSettings { near, far, groups: args.lod_groups }),
+            _ => None,
+        };
         let gpu_settings = GpuSettings {
             area_light_samples: args.area_light_samples,
             shadow_map_size: args.shadow_map_size,
+            lod,
             ..GpuSettings::new(global, caustic)
         };
         let setup_start = Instant::now();
@@ -161,6 +177,13 @@ fn positive(name: &str, v: Option<f32>) -> Result<()> {
 pub fn run(args: &RenderArgs) -> Result<()> {
     positive("radius", args.radius)?;
     positive("caustic-radius", args.caustic_radius)?;
+    for (name, v) in [("lod-near", args.lod_near), ("lod-far", args.lod_far)] {
+        if let Some(d) = v {
+            if !(d.is_finite() && d >= 0.0) {
+                bail!("--{name} {d}: must be a finite distance ≥ 0");
+            }
+        }
+    }
     if !args.exposure.is_finite() {
         bail!("--exposure {}: must be finite", args.exposure);
     }

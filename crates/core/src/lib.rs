@@ -28,6 +28,7 @@ pub mod camera;
 pub mod estimate;
 pub mod geometry;
 pub mod light;
+pub mod lod;
 pub mod material;
 pub mod output;
 pub mod photon;

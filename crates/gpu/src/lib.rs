@@ -12,6 +12,7 @@
 pub mod context;
 pub mod direct;
 pub mod gbuffer;
+pub mod lod;
 pub mod readback;
 pub mod renderer;
 pub mod scene_upload;

@@ -61,6 +61,31 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
     Ok(out)
 }
 
+/// Reads the first `count` u32 words of `buffer` (which needs COPY_SRC).
+pub fn read_u32s(ctx: &GpuContext, buffer: &wgpu::Buffer, count: u64) -> Result<Vec<u32>, GpuError> {
+    let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback words"),
+        size: count * 4,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, count * 4);
+    ctx.queue.submit([encoder.finish()]);
+    let slice = staging.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+    rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+    let words =
+        bytemuck::cast_slice::<u8, u32>(&slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?)
+            .to_vec();
+    staging.unmap();
+    Ok(words)
+}
+
 /// IEEE half to single precision, exactly.
 fn f16_to_f32(h: u16) -> f32 {
     let sign = ((h >> 15) as u32) << 31;

@@ -4,6 +4,7 @@
 use hikari_core::photon::Photon;
 use hikari_gpu::direct::DirectParams;
 use hikari_gpu::gbuffer::GBufferParams;
+use hikari_gpu::lod::{LodParams, LodPhoton};
 use hikari_gpu::scene_upload::{GpuSurface, GpuVertex};
 use hikari_gpu::shadow::ShadowViewParams;
 use hikari_gpu::shadow::light_samples::{GpuLight, GpuLightSample};
@@ -17,6 +18,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
         ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
         ("direct.wgsl", hikari_gpu::direct::SHADER.to_string()),
+        ("lod.wgsl", hikari_gpu::lod::SHADER.to_string()),
     ]
 }
 
@@ -94,6 +96,14 @@ fn shared_structs_match_wgsl_layouts() {
         ]
     );
     assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, view_count, _pad0, _pad1, _pad2]);
+    let lod = hikari_gpu::lod::SHADER.to_string();
+    assert_layout!(lod, "LodParams", LodParams, [eye, near, far, groups, count, enabled]);
+    assert_layout!(
+        lod,
+        "LodPhoton",
+        LodPhoton,
+        [position_x, position_y, position_z, power_rgb9e5, direction_and_class, scale]
+    );
 }
 
 /// Vertex attributes are laid out by hand (vertex_attr_array! would pack
@@ -101,10 +111,20 @@ fn shared_structs_match_wgsl_layouts() {
 #[test]
 fn vertex_attribute_offsets_match_rust_structs() {
     let offsets = |attrs: &[wgpu::VertexAttribute]| attrs.iter().map(|a| a.offset as usize).collect::<Vec<_>>();
+    // The LOD pass reads stored photons as 5 words each.
     assert_eq!(size_of::<Photon>(), 20);
     assert_eq!(
+        (offset_of!(Photon, position), offset_of!(Photon, power_rgb9e5), offset_of!(Photon, direction_and_class)),
+        (0, 12, 16)
+    );
+    assert_eq!(
         offsets(&hikari_gpu::splat::PHOTON_ATTRIBUTES),
-        [offset_of!(Photon, position), offset_of!(Photon, power_rgb9e5), offset_of!(Photon, direction_and_class)]
+        [
+            offset_of!(LodPhoton, position_x),
+            offset_of!(LodPhoton, power_rgb9e5),
+            offset_of!(LodPhoton, direction_and_class),
+            offset_of!(LodPhoton, scale)
+        ]
     );
     assert_eq!(
         offsets(&hikari_gpu::gbuffer::VERTEX_ATTRIBUTES),

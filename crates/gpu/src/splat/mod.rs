@@ -17,12 +17,13 @@ pub struct SplatParams {
     pub _pad: u32,
 }
 
-/// The 20-byte `Photon` as per-instance attributes, offsets written by hand
-/// (a test checks them against the struct).
-pub const PHOTON_ATTRIBUTES: [wgpu::VertexAttribute; 3] = [
+/// `LodPhoton` (the stored photon and its LOD scale) as per-instance
+/// attributes, offsets written by hand (a test checks them against the struct).
+pub const PHOTON_ATTRIBUTES: [wgpu::VertexAttribute; 4] = [
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 12, shader_location: 1 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 16, shader_location: 2 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32, offset: 20, shader_location: 3 },
 ];
 
 pub fn shader_source() -> String {
@@ -112,7 +113,7 @@ impl SplatPass {
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
                 buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Photon>() as u64,
+                    array_stride: std::mem::size_of::<crate::lod::LodPhoton>() as u64,
                     step_mode: wgpu::VertexStepMode::Instance,
                     attributes: &PHOTON_ATTRIBUTES,
                 })],
@@ -140,7 +141,7 @@ impl SplatPass {
         SplatPass { pipeline, layout }
     }
 
-    /// Adds the photons' radiance into `target` (loaded, not cleared, when
+    /// Adds the surviving photons' radiance (counted by the LOD pass) into `target` (loaded, not cleared, when
     /// `clear` is false, so several maps can accumulate).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
@@ -148,8 +149,7 @@ impl SplatPass {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         gbuffer: &GBuffer,
-        photons: &PhotonBuffer,
-        instances: std::ops::Range<u32>,
+        photons: &crate::lod::LodOutput,
         params: &SplatParams,
         target: &wgpu::TextureView,
         clear: bool,
@@ -185,12 +185,9 @@ impl SplatPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if instances.is_empty() || photons.count == 0 {
-            return;
-        }
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
-        pass.set_vertex_buffer(0, photons.buffer.slice(..));
-        pass.draw(0..4, instances);
+        pass.set_vertex_buffer(0, photons.survivors.slice(..));
+        pass.draw_indirect(&photons.draw_args, 0);
     }
 }

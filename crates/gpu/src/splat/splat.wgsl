@@ -17,11 +17,12 @@ struct SplatParams {
 @group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_albedo: texture_2d<f32>;
 
-// The 20-byte stored photon (hikari_core::photon::Photon).
+// A surviving photon from the LOD pass: the stored photon and its power scale.
 struct PhotonIn {
     @location(0) position: vec3<f32>,
     @location(1) power_rgb9e5: u32,
     @location(2) direction_and_class: u32,
+    @location(3) scale: f32,
 }
 
 struct SplatVertex {
@@ -29,6 +30,7 @@ struct SplatVertex {
     @location(0) @interpolate(flat) photon_position: vec3<f32>,
     @location(1) @interpolate(flat) power_rgb9e5: u32,
     @location(2) @interpolate(flat) direction_and_class: u32,
+    @location(3) @interpolate(flat) scale: f32,
 }
 
 @vertex
@@ -68,6 +70,7 @@ fn vs_main(@builtin(vertex_index) corner: u32, photon: PhotonIn) -> SplatVertex 
     out.photon_position = photon.position;
     out.power_rgb9e5 = photon.power_rgb9e5;
     out.direction_and_class = photon.direction_and_class;
+    out.scale = photon.scale;
     return out;
 }
 
@@ -86,7 +89,7 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     if (!photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
         discard;
     }
-    let radiance = radiance_per_power(albedo.rgb, params.radius) * decode_rgb9e5(in.power_rgb9e5) * params.power_unit;
+    let radiance = radiance_per_power(albedo.rgb, params.radius) * decode_rgb9e5(in.power_rgb9e5) * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);
 }

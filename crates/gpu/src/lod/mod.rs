@@ -1,0 +1,171 @@
+//! The LOD pass: culls photons by distance and scales the survivors' power
+//! (hikari_core::lod, mirrored in lod.wgsl), writing them and their count
+//! for an indirect draw, so culled photons cost no rasterization.
+
+use crate::splat::PhotonBuffer;
+use bytemuck::{Pod, Zeroable};
+use hikari_core::lod::LodSettings;
+use wgpu::util::DeviceExt;
+
+pub const SHADER: &str = include_str!("lod.wgsl");
+const WORKGROUP: u32 = 64;
+
+/// Mirrors `LodParams` in lod.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LodParams {
+    pub eye: [f32; 3],
+    pub near: f32,
+    pub far: f32,
+    pub groups: u32,
+    pub count: u32,
+    pub enabled: u32,
+}
+
+/// A splat instance: the stored photon and its power scale. Mirrors
+/// `LodPhoton` in lod.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct LodPhoton {
+    pub position_x: f32,
+    pub position_y: f32,
+    pub position_z: f32,
+    pub power_rgb9e5: u32,
+    pub direction_and_class: u32,
+    pub scale: f32,
+}
+
+/// The instances and indirect arguments of one photon map's splat.
+pub struct LodOutput {
+    pub survivors: wgpu::Buffer,
+    /// `wgpu::util::DrawIndirectArgs`: 4 vertices, surviving instances.
+    pub draw_args: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    count: u32,
+}
+
+pub struct LodPass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl LodPass {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("lod.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lod"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                storage_entry(1, true),
+                storage_entry(2, false),
+                storage_entry(3, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lod"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("lod cull"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("cull"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        LodPass { pipeline, layout }
+    }
+
+    /// Buffers for culling `photons`; capacity for all of them.
+    pub fn create_output(&self, device: &wgpu::Device, photons: &PhotonBuffer) -> LodOutput {
+        let capacity = photons.count.max(1) as u64 * std::mem::size_of::<LodPhoton>() as u64;
+        let survivors = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lod survivors"),
+            size: capacity,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            mapped_at_creation: false,
+        });
+        let draw_args = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("splat draw args"),
+            contents: bytemuck::cast_slice(&[4u32, 0, 0, 0]),
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::INDIRECT
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lod params"),
+            size: std::mem::size_of::<LodParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lod"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: photons.buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: survivors.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: draw_args.as_entire_binding() },
+            ],
+        });
+        LodOutput { survivors, draw_args, bind_group, params, count: photons.count }
+    }
+
+    /// Resets the count and records the cull for the eye at `eye`.
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        output: &LodOutput,
+        eye: glam::Vec3,
+        settings: Option<&LodSettings>,
+    ) {
+        let (near, far, groups) = settings.map_or((0.0, 0.0, 1), |s| (s.near, s.far, s.groups.max(1)));
+        let params = LodParams {
+            eye: eye.to_array(),
+            near,
+            far,
+            groups,
+            count: output.count,
+            enabled: settings.is_some() as u32,
+        };
+        queue.write_buffer(&output.params, 0, bytemuck::bytes_of(&params));
+        queue.write_buffer(&output.draw_args, 0, bytemuck::cast_slice(&[4u32, 0, 0, 0]));
+        if output.count == 0 {
+            return;
+        }
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("lod cull"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &output.bind_group, &[]);
+        pass.dispatch_workgroups(output.count.div_ceil(WORKGROUP), 1, 1);
+    }
+}

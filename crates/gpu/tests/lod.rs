@@ -1,0 +1,54 @@
+//! Level of detail on the GPU: culled photons are not drawn (the count the
+//! LOD pass leaves for the indirect draw equals the CPU's prediction), and
+//! the image keeps its brightness.
+
+use hikari_core::lod::{detail_level, group_of, power_scale};
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use hikari_core::scene::Scene;
+use hikari_gpu::renderer::global_map_photons;
+use hikari_gpu::test_support::context_or_skip;
+use hikari_gpu::{GpuRenderer, GpuSettings};
+
+use hikari_gpu::renderer::SEED_CORNELL_LOD;
+
+#[test]
+fn lod_draws_the_predicted_photons_and_keeps_the_image_mean() {
+    let Some(ctx) = context_or_skip("lod") else { return };
+    let mut scene = Scene::load("cornell-box").unwrap();
+    scene.camera = scene.camera.with_resolution(64, 64).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 10_000, seed: 3, ..Default::default() }, &Silent);
+    let cpu = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
+    let mut gpu = GpuRenderer::new(ctx, &scene, &traced, GpuSettings::new(cpu.global_params, cpu.caustic_params));
+
+    // LOD off: every photon is drawn.
+    gpu.render();
+    let photons = global_map_photons(&traced);
+    assert_eq!(gpu.drawn_photons().unwrap().0 as usize, photons.len());
+    let mean = |v: &[glam::Vec4]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>() / v.len() as f64;
+    let off = mean(&gpu.read(&gpu.targets.indirect).unwrap());
+
+    // LOD on: the drawn count is the CPU's prediction.
+    let lod = SEED_CORNELL_LOD;
+    gpu.settings.lod = Some(lod);
+    gpu.render();
+    let n = photons.len() as u32;
+    let predicted = photons
+        .iter()
+        .enumerate()
+        .filter(|(i, p)| {
+            let q = detail_level((p.position() - scene.camera.position).length(), &lod);
+            power_scale(q, group_of(*i as u32, n, lod.groups), lod.groups) > 0.0
+        })
+        .count();
+    let drawn = gpu.drawn_photons().unwrap().0 as usize;
+    eprintln!("LOD: {drawn} of {} photons drawn (predicted {predicted})", photons.len());
+    // Float rounding may move a photon sitting exactly on a group boundary.
+    assert!(drawn.abs_diff(predicted) <= photons.len() / 1000 + 1, "drawn {drawn}, predicted {predicted}");
+    assert!(drawn < photons.len() * 3 / 4, "LOD culled too little: {drawn} of {}", photons.len());
+
+    let on = mean(&gpu.read(&gpu.targets.indirect).unwrap());
+    eprintln!("indirect image mean: LOD off {off:.5}, on {on:.5} ({:+.2}%)", (on - off) / off * 100.0);
+    assert!((on - off).abs() / off < 0.05);
+}
