@@ -17,7 +17,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
         ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
         ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
-        ("direct.wgsl", hikari_gpu::direct::SHADER.to_string()),
+        ("direct.wgsl", hikari_gpu::direct::shader_source()),
         ("lod.wgsl", hikari_gpu::lod::SHADER.to_string()),
     ]
 }
@@ -73,7 +73,7 @@ fn shared_structs_match_wgsl_layouts() {
     assert_layout!(splat, "SplatParams", SplatParams, [clip_from_world, radius, power_unit, normal_test, _pad]);
     let shadow = hikari_gpu::shadow::SHADER.to_string();
     assert_layout!(shadow, "ShadowViewParams", ShadowViewParams, [clip_from_world, light_position]);
-    let direct = hikari_gpu::direct::SHADER.to_string();
+    let direct = hikari_gpu::direct::shader_source();
     assert_layout!(direct, "DirectParams", DirectParams, [light_count, shadow_size, bias, _pad]);
     assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position]);
     assert_layout!(

@@ -2,9 +2,11 @@
 //! that answers closest-hit and occlusion queries over them.
 
 mod accel;
+mod flat_bvh;
 mod shapes;
 
 pub use accel::{Accel, Hit};
+pub use flat_bvh::{FlatBvh, FlatNode, FlatPrim};
 pub use shapes::{Sphere, Triangle, TriangleNormals};
 
 use glam::Vec3;

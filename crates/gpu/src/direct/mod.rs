@@ -7,7 +7,12 @@ use crate::shadow::light_samples::GpuLights;
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-pub const SHADER: &str = include_str!("direct.wgsl");
+/// Light evaluation shared with the specular pass; needs the includer's bindings.
+pub const LIGHT_EVAL_WGSL: &str = include_str!("light_eval.wgsl");
+
+pub fn shader_source() -> String {
+    format!("{}\n{}", LIGHT_EVAL_WGSL, include_str!("direct.wgsl"))
+}
 
 /// Mirrors `DirectParams` in direct.wgsl.
 #[repr(C)]
@@ -48,7 +53,7 @@ impl DirectPass {
     pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("direct.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         use wgpu::TextureViewDimension::{D2, D2Array};
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -1,0 +1,185 @@
+//! A flat binary BVH for GPU traversal: obvhs's Bvh2 over the same
+//! primitives as `Accel`, nodes and primitives in plain `#[repr(C)]` arrays.
+//! `FlatBvh::intersect` is the CPU mirror of the WGSL traversal.
+
+use super::{Accel, Ray};
+use glam::{Vec3, Vec3A};
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
+use std::time::Duration;
+
+/// A node: inner when `prim_count` is 0 (children at `first` and `first + 1`),
+/// else a leaf holding primitives `first .. first + prim_count`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FlatNode {
+    pub min: [f32; 3],
+    pub prim_count: u32,
+    pub max: [f32; 3],
+    pub first: u32,
+}
+
+/// A primitive in leaf order: a triangle as (v0, e1, e2) or a sphere as
+/// (centre, (radius, 0, 0)); `is_sphere` tells which.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FlatPrim {
+    pub a: [f32; 3],
+    pub is_sphere: u32,
+    pub b: [f32; 3],
+    pub surface: u32,
+    pub c: [f32; 3],
+    pub _pad: u32,
+}
+
+pub struct FlatBvh {
+    pub nodes: Vec<FlatNode>,
+    pub prims: Vec<FlatPrim>,
+    pub epsilon: f32,
+}
+
+struct Bounds(Aabb);
+impl Boundable for Bounds {
+    fn aabb(&self) -> Aabb {
+        self.0
+    }
+}
+
+impl FlatBvh {
+    pub fn new(accel: &Accel) -> Self {
+        let mut prims: Vec<FlatPrim> = accel
+            .triangles()
+            .map(|(t, surface)| FlatPrim {
+                a: t.v[0].to_array(),
+                is_sphere: 0,
+                b: (t.v[1] - t.v[0]).to_array(),
+                surface,
+                c: (t.v[2] - t.v[0]).to_array(),
+                _pad: 0,
+            })
+            .collect();
+        prims.extend(accel.spheres().map(|(s, surface)| FlatPrim {
+            a: s.center.to_array(),
+            is_sphere: 1,
+            b: [s.radius, 0.0, 0.0],
+            surface,
+            c: [0.0; 3],
+            _pad: 0,
+        }));
+        if prims.is_empty() {
+            return FlatBvh { nodes: Vec::new(), prims, epsilon: accel.epsilon };
+        }
+        let bounds: Vec<Bounds> = prims
+            .iter()
+            .map(|p| {
+                if p.is_sphere != 0 {
+                    let c = Vec3A::from(p.a);
+                    Bounds(Aabb::new(c - p.b[0], c + p.b[0]))
+                } else {
+                    let v0 = Vec3A::from(p.a);
+                    Bounds(Aabb::from_points(&[v0, v0 + Vec3A::from(p.b), v0 + Vec3A::from(p.c)]))
+                }
+            })
+            .collect();
+        let bvh = build_bvh2(&bounds, BvhBuildParams::medium_build(), &mut Duration::default());
+        let nodes = bvh
+            .nodes
+            .iter()
+            .map(|n| FlatNode {
+                min: n.aabb().min.to_array(),
+                prim_count: n.prim_count,
+                max: n.aabb().max.to_array(),
+                first: n.first_index,
+            })
+            .collect();
+        let ordered = bvh.primitive_indices.iter().map(|&i| prims[i as usize]).collect();
+        FlatBvh { nodes, prims: ordered, epsilon: accel.epsilon }
+    }
+
+    /// Closest hit: (t, primitive index in `prims`). The WGSL traversal
+    /// follows this loop step by step.
+    pub fn intersect(&self, ray: &Ray) -> Option<(f32, usize)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        // Zero components become ±1e-20 so the slab test never sees 0·∞.
+        let safe = |d: f32| if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d };
+        let inv = Vec3::new(safe(ray.dir.x), safe(ray.dir.y), safe(ray.dir.z)).recip();
+        let mut best: Option<(f32, usize)> = None;
+        let mut t_max = ray.t_max;
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let node = &self.nodes[stack[top] as usize];
+            if !slab_hit(ray.origin, inv, Vec3::from(node.min), Vec3::from(node.max), t_max) {
+                continue;
+            }
+            if node.prim_count == 0 {
+                stack[top] = node.first;
+                stack[top + 1] = node.first + 1;
+                top += 2;
+                continue;
+            }
+            for i in node.first..node.first + node.prim_count {
+                let t = self.intersect_prim(i as usize, ray, t_max);
+                if t < t_max {
+                    t_max = t;
+                    best = Some((t, i as usize));
+                }
+            }
+        }
+        best
+    }
+
+    fn intersect_prim(&self, i: usize, ray: &Ray, t_max: f32) -> f32 {
+        let p = &self.prims[i];
+        let mut r = *ray;
+        r.t_max = t_max;
+        if p.is_sphere != 0 {
+            let s = super::Sphere { center: Vec3::from(p.a), radius: p.b[0] };
+            return s.intersect(&r, self.epsilon).unwrap_or(f32::INFINITY);
+        }
+        let (v0, e1, e2) = (Vec3::from(p.a), Vec3::from(p.b), Vec3::from(p.c));
+        let tri = super::Triangle { v: [v0, v0 + e1, v0 + e2], normals: None };
+        tri.intersect(&r, self.epsilon).map_or(f32::INFINITY, |h| h.0)
+    }
+}
+
+/// Ray–box slab test over [0, t_max], tolerant of infinite inverse directions.
+fn slab_hit(origin: Vec3, inv: Vec3, min: Vec3, max: Vec3, t_max: f32) -> bool {
+    let t0 = (min - origin) * inv;
+    let t1 = (max - origin) * inv;
+    let near = t0.min(t1).max_element().max(0.0);
+    let far = t0.max(t1).min_element().min(t_max);
+    near <= far
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{Rng, uniform_sphere};
+
+    /// The flat BVH's traversal finds the same closest hits as `Accel`.
+    #[test]
+    fn flat_bvh_matches_accel() {
+        for name in ["cornell-box", "cornell-caustic"] {
+            let scene = crate::scene::Scene::load(name).unwrap();
+            let flat = FlatBvh::new(&scene.accel);
+            let mut rng = Rng::for_item(77, 0);
+            for _ in 0..3000 {
+                let origin = (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) - 0.5) * 1.9;
+                let ray = Ray::new(origin, uniform_sphere(rng.next_2d()));
+                let a = scene.accel.intersect(&ray);
+                let f = flat.intersect(&ray);
+                match (a, f) {
+                    (None, None) => {}
+                    (Some(h), Some((t, i))) => {
+                        assert!((h.t - t).abs() < 1e-5 * h.t.max(1.0), "{name}: t {} vs {t}", h.t);
+                        assert_eq!(h.surface, flat.prims[i].surface);
+                    }
+                    (a, f) => panic!("{name}: accel {a:?} vs flat {f:?}"),
+                }
+            }
+        }
+    }
+}
