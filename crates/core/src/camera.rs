@@ -69,6 +69,12 @@ impl Camera {
         self.forward
     }
 
+    /// (forward, right, up, tan(fov_y/2)): what `ray` builds directions from,
+    /// for shaders that cast the same primary rays.
+    pub fn basis(&self) -> (Vec3, Vec3, Vec3, f32) {
+        (self.forward, self.right, self.true_up, self.tan_half_fov)
+    }
+
     /// World-to-view transform: view space is right-handed, looking down −z.
     pub fn view_from_world(&self) -> Mat4 {
         view_from_world(self.position, self.forward, self.true_up)

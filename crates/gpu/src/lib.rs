@@ -17,6 +17,7 @@ pub mod readback;
 pub mod renderer;
 pub mod scene_upload;
 pub mod shadow;
+pub mod specular;
 pub mod splat;
 
 pub use context::{GpuContext, GpuError};
@@ -24,5 +25,6 @@ pub use renderer::{GpuRenderer, GpuSettings};
 
 /// The WGSL mirror of `hikari_core::estimate`, prepended to the shaders that use it.
 pub const ESTIMATE_WGSL: &str = include_str!("estimate.wgsl");
+pub mod photon_grid;
 #[doc(hidden)]
 pub mod test_support;

@@ -9,6 +9,7 @@ use crate::readback::read_rgba;
 use crate::scene_upload::SceneBuffers;
 use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
+use crate::specular::{SpecularInputs, SpecularPass};
 use crate::splat::{PhotonBuffer, SplatParams, SplatPass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
@@ -31,11 +32,21 @@ pub struct GpuSettings {
     pub shadow_bias: f32,
     /// Level of detail for the photon splats; None draws every photon.
     pub lod: Option<LodSettings>,
+    /// Mirror/glass bounces followed from the eye (as photon-cpu's).
+    pub max_specular_depth: u32,
 }
 
 impl GpuSettings {
     pub fn new(global: FixedRadius, caustic: FixedRadius) -> Self {
-        GpuSettings { global, caustic, area_light_samples: 4, shadow_map_size: 1024, shadow_bias: 0.01, lod: None }
+        GpuSettings {
+            global,
+            caustic,
+            area_light_samples: 4,
+            shadow_map_size: 1024,
+            shadow_bias: 0.01,
+            lod: None,
+            max_specular_depth: 8,
+        }
     }
 }
 
@@ -64,11 +75,13 @@ pub enum Stage {
     GlobalSplat,
     /// LOD cull and splat of the caustic map.
     CausticSplat,
+    /// Mirrors and glass seen by the camera, ray-traced to diffuse hits.
+    Specular,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 5] =
-        [Stage::GBuffer, Stage::Shadows, Stage::Direct, Stage::GlobalSplat, Stage::CausticSplat];
+    pub const ALL: [Stage; 6] =
+        [Stage::GBuffer, Stage::Shadows, Stage::Direct, Stage::GlobalSplat, Stage::CausticSplat, Stage::Specular];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -77,6 +90,7 @@ impl Stage {
             Stage::Direct => "direct light",
             Stage::GlobalSplat => "global splat",
             Stage::CausticSplat => "caustic splat",
+            Stage::Specular => "specular",
         }
     }
 }
@@ -87,6 +101,7 @@ pub struct GpuRenderer {
     splat_pass: SplatPass,
     shadow_pass: ShadowPass,
     direct_pass: DirectPass,
+    specular_pass: SpecularPass,
     lights: GpuLights,
     scene: SceneBuffers,
     lod_pass: LodPass,
@@ -152,13 +167,33 @@ impl GpuRenderer {
             shadow_maps: shadow_pass.create_maps(device, &lights.views, settings.shadow_map_size),
         };
         let (near, far) = depth_range(scene);
+        let scene_buffers = SceneBuffers::upload(device, scene);
+        let global_photons = global_map_photons(traced);
+        let specular_pass = SpecularPass::new(
+            device,
+            scene,
+            &scene_buffers.surfaces,
+            &lights,
+            &targets.shadow_maps,
+            &targets.gbuffer,
+            &SpecularInputs {
+                global_photons: &global_photons,
+                caustic_photons: &traced.caustic,
+                global: settings.global,
+                caustic: settings.caustic,
+                power_unit: traced.power_unit,
+                max_depth: settings.max_specular_depth,
+                shadow_bias: settings.shadow_bias,
+            },
+        );
         GpuRenderer {
+            specular_pass,
             gbuffer_pass: GBufferPass::new(device),
             splat_pass: SplatPass::new(device, ctx.radiance_format),
             direct_pass: DirectPass::new(device, ctx.radiance_format),
             shadow_pass,
             lights,
-            scene: SceneBuffers::upload(device, scene),
+            scene: scene_buffers,
             global_lod: lod_pass
                 .create_output(device, &PhotonBuffer::upload(device, &global_map_photons(traced), "global photons")),
             caustic_lod: lod_pass
@@ -244,7 +279,13 @@ impl GpuRenderer {
             }
             Stage::GlobalSplat => splat(encoder, &self.global_lod, &self.settings.global, &self.targets.indirect),
             Stage::CausticSplat => splat(encoder, &self.caustic_lod, &self.settings.caustic, &self.targets.caustic),
+            Stage::Specular => self.specular_pass.record(encoder),
         }
+    }
+
+    /// The specular pass's radiance target.
+    pub fn specular_output(&self) -> &wgpu::Texture {
+        &self.specular_pass.output
     }
 
     /// Photons drawn in the last frame by the global and caustic splats.
@@ -258,11 +299,16 @@ impl GpuRenderer {
     }
 
     /// Reads the frame back as one image: emission + direct + indirect +
-    /// caustics. Non-finite values are dropped (counted in the second value).
+    /// caustics + specular. Non-finite values are dropped (counted in the second value).
     pub fn read_image(&self) -> Result<(Image, u64), GpuError> {
         let t = &self.targets;
-        let parts =
-            [self.read(&t.gbuffer.emission)?, self.read(&t.direct)?, self.read(&t.indirect)?, self.read(&t.caustic)?];
+        let parts = [
+            self.read(&t.gbuffer.emission)?,
+            self.read(&t.direct)?,
+            self.read(&t.indirect)?,
+            self.read(&t.caustic)?,
+            self.read(&self.specular_pass.output)?,
+        ];
         let mut image = Image::new(t.gbuffer.width, t.gbuffer.height);
         let mut nonfinite = 0;
         for (i, pixel) in image.pixels.iter_mut().enumerate() {

@@ -35,7 +35,8 @@ pub struct GpuSurface {
     pub kind: u32,
     /// Radiance emitted toward the side the geometric normal faces.
     pub emission: [f32; 3],
-    pub _pad: u32,
+    /// Index of refraction (glass).
+    pub ior: f32,
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -131,18 +132,18 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
         .iter()
         .map(|s| {
             let material = &scene.materials[s.material as usize];
-            let (kind, albedo) = match material {
-                Material::Diffuse { albedo, .. } => (kind::DIFFUSE, *albedo),
-                Material::Mirror { reflectance } => (kind::MIRROR, *reflectance),
-                Material::Glass { .. } => (kind::GLASS, Vec3::ONE),
-                Material::Emitter => (kind::EMITTER, Vec3::ZERO),
+            let (kind, albedo, ior) = match material {
+                Material::Diffuse { albedo, .. } => (kind::DIFFUSE, *albedo, 1.0),
+                Material::Mirror { reflectance } => (kind::MIRROR, *reflectance, 1.0),
+                Material::Glass { ior } => (kind::GLASS, Vec3::ONE, *ior),
+                Material::Emitter => (kind::EMITTER, Vec3::ZERO, 1.0),
             };
             let emission = s.emitter.map_or(Vec3::ZERO, |l| match &scene.lights[l as usize] {
                 hikari_core::light::Light::Sphere { radiance, .. }
                 | hikari_core::light::Light::Quad { radiance, .. } => *radiance,
                 _ => Vec3::ZERO,
             });
-            GpuSurface { albedo: albedo.to_array(), kind, emission: emission.to_array(), _pad: 0 }
+            GpuSurface { albedo: albedo.to_array(), kind, emission: emission.to_array(), ior }
         })
         .collect()
 }

@@ -19,6 +19,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
         ("direct.wgsl", hikari_gpu::direct::shader_source()),
         ("lod.wgsl", hikari_gpu::lod::SHADER.to_string()),
+        ("specular.wgsl", hikari_gpu::specular::shader_source()),
     ]
 }
 
@@ -68,7 +69,7 @@ macro_rules! assert_layout {
 fn shared_structs_match_wgsl_layouts() {
     let gbuffer = hikari_gpu::gbuffer::SHADER.to_string();
     assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
-    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, _pad]);
+    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior]);
     let splat = hikari_gpu::splat::shader_source();
     assert_layout!(splat, "SplatParams", SplatParams, [clip_from_world, radius, power_unit, normal_test, _pad]);
     let shadow = hikari_gpu::shadow::SHADER.to_string();
@@ -96,6 +97,37 @@ fn shared_structs_match_wgsl_layouts() {
         ]
     );
     assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, view_count, _pad0, _pad1, _pad2]);
+    let specular = hikari_gpu::specular::shader_source();
+    assert_layout!(
+        specular,
+        "SpecularParams",
+        hikari_gpu::specular::SpecularParams,
+        [
+            camera_position,
+            tan_half_fov,
+            camera_right,
+            aspect,
+            camera_up,
+            epsilon,
+            camera_forward,
+            max_depth,
+            width,
+            height,
+            normal_test,
+            power_unit,
+            global_radius,
+            global_buckets,
+            global_start_offset,
+            global_photon_offset,
+            caustic_radius,
+            caustic_buckets,
+            caustic_start_offset,
+            caustic_photon_offset
+        ]
+    );
+    assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
+    assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
+    assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior]);
     let lod = hikari_gpu::lod::SHADER.to_string();
     assert_layout!(lod, "LodParams", LodParams, [eye, near, far, groups, count, enabled]);
     assert_layout!(

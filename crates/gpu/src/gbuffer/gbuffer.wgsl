@@ -11,7 +11,7 @@ struct Surface {
     albedo: vec3<f32>,
     kind: u32,
     emission: vec3<f32>,
-    _pad: u32,
+    ior: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: GBufferParams;

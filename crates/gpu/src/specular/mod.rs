@@ -1,0 +1,249 @@
+//! The specular pass: mirrors and glass seen by the camera, ray-traced on
+//! the GPU through the scene BVH to their diffuse hits, which are shaded
+//! with direct light and photon gathers (see specular.wgsl).
+
+use crate::direct::DirectParams;
+use crate::gbuffer::GBuffer;
+use crate::photon_grid::PhotonGrid;
+use crate::shadow::ShadowMaps;
+use crate::shadow::light_samples::GpuLights;
+use bytemuck::{Pod, Zeroable};
+use hikari_core::estimate::FixedRadius;
+use hikari_core::geometry::FlatBvh;
+use hikari_core::photon::Photon;
+use hikari_core::scene::Scene;
+use wgpu::util::DeviceExt;
+
+const WORKGROUP: u32 = 8;
+
+pub fn shader_source() -> String {
+    format!("{}\n{}\n{}", crate::ESTIMATE_WGSL, crate::direct::LIGHT_EVAL_WGSL, include_str!("specular.wgsl"))
+}
+
+/// Mirrors `SpecularParams` in specular.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SpecularParams {
+    pub camera_position: [f32; 3],
+    pub tan_half_fov: f32,
+    pub camera_right: [f32; 3],
+    pub aspect: f32,
+    pub camera_up: [f32; 3],
+    pub epsilon: f32,
+    pub camera_forward: [f32; 3],
+    pub max_depth: u32,
+    pub width: u32,
+    pub height: u32,
+    pub normal_test: u32,
+    pub power_unit: f32,
+    pub global_radius: f32,
+    pub global_buckets: u32,
+    pub global_start_offset: u32,
+    pub global_photon_offset: u32,
+    pub caustic_radius: f32,
+    pub caustic_buckets: u32,
+    pub caustic_start_offset: u32,
+    pub caustic_photon_offset: u32,
+}
+
+/// Everything the estimate needs to know about the two photon maps.
+pub struct SpecularInputs<'a> {
+    pub global_photons: &'a [Photon],
+    pub caustic_photons: &'a [Photon],
+    pub global: FixedRadius,
+    pub caustic: FixedRadius,
+    pub power_unit: f32,
+    pub max_depth: u32,
+    pub shadow_bias: f32,
+}
+
+pub struct SpecularPass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    width: u32,
+    height: u32,
+    pub output: wgpu::Texture,
+}
+
+fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
+}
+
+fn storage() -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Storage { read_only: true },
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
+fn uniform() -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    }
+}
+
+fn texture(view_dimension: wgpu::TextureViewDimension) -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+        view_dimension,
+        multisampled: false,
+    }
+}
+
+impl SpecularPass {
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        device: &wgpu::Device,
+        scene: &Scene,
+        surfaces: &wgpu::Buffer,
+        lights: &GpuLights,
+        maps: &ShadowMaps,
+        gbuffer: &GBuffer,
+        inputs: &SpecularInputs,
+    ) -> Self {
+        let (width, height) = (gbuffer.width, gbuffer.height);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("specular.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+        });
+        use wgpu::TextureViewDimension::{D2, D2Array};
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("specular"),
+            entries: &[
+                entry(0, uniform()),
+                entry(1, storage()),
+                entry(2, storage()),
+                entry(3, storage()),
+                entry(4, storage()),
+                entry(5, storage()),
+                entry(6, uniform()),
+                entry(7, storage()),
+                entry(8, storage()),
+                entry(9, storage()),
+                entry(10, texture(D2Array)),
+                entry(11, texture(D2)),
+                entry(
+                    12,
+                    wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        view_dimension: D2,
+                    },
+                ),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("specular"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("specular"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+
+        // Static scene data: the flat BVH and both photon grids, concatenated.
+        let bvh = FlatBvh::new(&scene.accel);
+        let global = PhotonGrid::new(inputs.global_photons, inputs.global.radius);
+        let caustic = PhotonGrid::new(inputs.caustic_photons, inputs.caustic.radius);
+        let mut starts = global.starts.clone();
+        starts.extend(&caustic.starts);
+        let mut photons = global.photons.clone();
+        photons.extend(&caustic.photons);
+        let (forward, right, up, tan_half_fov) = scene.camera.basis();
+        let params = SpecularParams {
+            camera_position: scene.camera.position.to_array(),
+            tan_half_fov,
+            camera_right: right.to_array(),
+            aspect: scene.camera.aspect(),
+            camera_up: up.to_array(),
+            epsilon: scene.accel.epsilon,
+            camera_forward: forward.to_array(),
+            max_depth: inputs.max_depth,
+            width,
+            height,
+            normal_test: inputs.global.normal_test as u32,
+            power_unit: inputs.power_unit,
+            global_radius: inputs.global.radius,
+            global_buckets: global.buckets,
+            global_start_offset: 0,
+            global_photon_offset: 0,
+            caustic_radius: inputs.caustic.radius,
+            caustic_buckets: caustic.buckets,
+            caustic_start_offset: global.starts.len() as u32,
+            caustic_photon_offset: global.photons.len() as u32,
+        };
+        let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: pad to one zero word.
+            let padded: &[u8] = if bytes.is_empty() { &[0; 48] } else { bytes };
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: padded, usage })
+        };
+        let storage_usage = wgpu::BufferUsages::STORAGE;
+        let params_buffer = buffer("specular params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let nodes = buffer("bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage_usage);
+        let prims = buffer("bvh prims", bytemuck::cast_slice(&bvh.prims), storage_usage);
+        let starts = buffer("grid starts", bytemuck::cast_slice(&starts), storage_usage);
+        let photons = buffer("grid photons", bytemuck::cast_slice(&photons), storage_usage);
+        let direct_params = DirectParams {
+            light_count: lights.lights.len() as u32,
+            shadow_size: maps.size,
+            bias: inputs.shadow_bias,
+            _pad: 0,
+        };
+        let direct_buffer =
+            buffer("specular direct params", bytemuck::bytes_of(&direct_params), wgpu::BufferUsages::UNIFORM);
+        let lights_buffer = buffer("specular lights", bytemuck::cast_slice(&lights.lights), storage_usage);
+        let samples_buffer = buffer("specular light samples", bytemuck::cast_slice(&lights.samples), storage_usage);
+        let output = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("specular radiance"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let maps_view =
+            maps.texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(D2Array), ..Default::default() });
+        let albedo_view = gbuffer.albedo.create_view(&Default::default());
+        let output_view = output.create_view(&Default::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("specular"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: nodes.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: prims.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: surfaces.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: starts.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: photons.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: direct_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: lights_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 8, resource: samples_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 9, resource: maps.views_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&maps_view) },
+                wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&albedo_view) },
+                wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
+            ],
+        });
+        SpecularPass { pipeline, bind_group, width, height, output }
+    }
+
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("specular"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+    }
+}

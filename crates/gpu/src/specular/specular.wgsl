@@ -1,0 +1,312 @@
+// Specular surfaces seen by the camera (METHOD.md §4: the seed ray-traces
+// them). For every pixel whose first surface is a mirror or glass, cast the
+// same primary ray as photon-cpu, follow reflection and refraction (Fresnel,
+// total internal reflection) through the scene BVH up to `max_depth`
+// bounces, and shade each diffuse hit, weighted by its throughput, with
+// direct light (light_eval.wgsl) and fixed-radius gathers over both photon
+// maps (estimate.wgsl). Prepended with estimate.wgsl and light_eval.wgsl.
+
+struct SpecularParams {
+    camera_position: vec3<f32>,
+    tan_half_fov: f32,
+    camera_right: vec3<f32>,
+    aspect: f32,
+    camera_up: vec3<f32>,
+    epsilon: f32,
+    camera_forward: vec3<f32>,
+    max_depth: u32,
+    width: u32,
+    height: u32,
+    normal_test: u32,
+    power_unit: f32,
+    global_radius: f32,
+    global_buckets: u32,
+    global_start_offset: u32,
+    global_photon_offset: u32,
+    caustic_radius: f32,
+    caustic_buckets: u32,
+    caustic_start_offset: u32,
+    caustic_photon_offset: u32,
+}
+
+struct FlatNode {
+    min: vec3<f32>,
+    prim_count: u32,
+    max: vec3<f32>,
+    first: u32,
+}
+
+struct FlatPrim {
+    a: vec3<f32>,
+    is_sphere: u32,
+    b: vec3<f32>,
+    surface: u32,
+    c: vec3<f32>,
+    _pad: u32,
+}
+
+struct Surface {
+    albedo: vec3<f32>,
+    kind: u32,
+    emission: vec3<f32>,
+    ior: f32,
+}
+
+@group(0) @binding(0) var<uniform> params: SpecularParams;
+@group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
+@group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;
+@group(0) @binding(3) var<storage, read> surfaces: array<Surface>;
+// Both photon grids' bucket starts, then both grids' photons (5 words each).
+@group(0) @binding(4) var<storage, read> grid_starts: array<u32>;
+@group(0) @binding(5) var<storage, read> grid_photons: array<u32>;
+@group(0) @binding(6) var<uniform> direct_params: DirectParams;
+@group(0) @binding(7) var<storage, read> lights: array<Light>;
+@group(0) @binding(8) var<storage, read> samples: array<LightSample>;
+@group(0) @binding(9) var<storage, read> views: array<ShadowView>;
+@group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
+@group(0) @binding(11) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
+
+const NO_HIT: f32 = 3.0e38;
+
+// Zero components become ±1e-20 so the slab test never sees 0·∞
+// (as hikari_core::geometry::FlatBvh::intersect).
+fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
+    let s = select(d, sign(d + vec3<f32>(1.0e-30)) * 1.0e-20, abs(d) < vec3<f32>(1.0e-20));
+    return 1.0 / s;
+}
+
+fn slab_hit(o: vec3<f32>, inv: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, t_max: f32) -> bool {
+    let t0 = (lo - o) * inv;
+    let t1 = (hi - o) * inv;
+    let near = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);
+    let far = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), t_max);
+    return near <= far;
+}
+
+// Nearest hit in (epsilon, t_max), as hikari_core's Triangle/Sphere::intersect.
+fn intersect_prim(p: FlatPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> f32 {
+    let eps = params.epsilon;
+    if (p.is_sphere != 0u) {
+        let radius = p.b.x;
+        let oc = o - p.a;
+        let a = dot(d, d);
+        let half_b = dot(oc, d);
+        let closest = oc - d * (half_b / a);
+        let disc = radius * radius - dot(closest, closest);
+        if (disc < 0.0) {
+            return NO_HIT;
+        }
+        let root = sqrt(a * disc);
+        let q = -half_b - select(-root, root, half_b >= 0.0);
+        var t0 = q / a;
+        var t1 = select(q / a, (dot(oc, oc) - radius * radius) / q, q != 0.0);
+        if (t0 > t1) {
+            let tmp = t0;
+            t0 = t1;
+            t1 = tmp;
+        }
+        if (t0 > eps && t0 < t_max) {
+            return t0;
+        }
+        if (t1 > eps && t1 < t_max) {
+            return t1;
+        }
+        return NO_HIT;
+    }
+    let e1 = p.b;
+    let e2 = p.c;
+    let pv = cross(d, e2);
+    let det = dot(e1, pv);
+    if (abs(det) < 1.0e-12) {
+        return NO_HIT;
+    }
+    let inv = 1.0 / det;
+    let s = o - p.a;
+    let b1 = dot(s, pv) * inv;
+    if (b1 < 0.0 || b1 > 1.0) {
+        return NO_HIT;
+    }
+    let qv = cross(s, e1);
+    let b2 = dot(d, qv) * inv;
+    if (b2 < 0.0 || b1 + b2 > 1.0) {
+        return NO_HIT;
+    }
+    let t = dot(e2, qv) * inv;
+    if (t > eps && t < t_max) {
+        return t;
+    }
+    return NO_HIT;
+}
+
+struct Hit {
+    t: f32,
+    prim: u32,
+}
+
+// Closest hit by stack traversal of the flat BVH (FlatBvh::intersect).
+fn trace(o: vec3<f32>, d: vec3<f32>) -> Hit {
+    var hit = Hit(NO_HIT, 0u);
+    if (arrayLength(&nodes) == 0u) {
+        return hit;
+    }
+    let inv = safe_inverse(d);
+    var stack: array<u32, 64>;
+    var top = 1u;
+    stack[0] = 0u;
+    while (top > 0u) {
+        top -= 1u;
+        let node = nodes[stack[top]];
+        if (!slab_hit(o, inv, node.min, node.max, hit.t)) {
+            continue;
+        }
+        if (node.prim_count == 0u) {
+            if (top + 2u <= 64u) {
+                stack[top] = node.first;
+                stack[top + 1u] = node.first + 1u;
+                top += 2u;
+            }
+            continue;
+        }
+        for (var i = node.first; i < node.first + node.prim_count; i++) {
+            let t = intersect_prim(prims[i], o, d, hit.t);
+            if (t < hit.t) {
+                hit = Hit(t, i);
+            }
+        }
+    }
+    return hit;
+}
+
+// The spatial hash of photon_grid.rs.
+fn bucket_of(cell: vec3<i32>, buckets: u32) -> u32 {
+    let h = (u32(cell.x) * 73856093u) ^ (u32(cell.y) * 19349663u) ^ (u32(cell.z) * 83492791u);
+    return h & (buckets - 1u);
+}
+
+// Fixed-radius estimate at x from one photon grid (PhotonGrid::for_each_within).
+fn gather(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
+    let centre = vec3<i32>(floor(x / radius));
+    var seen: array<u32, 27>;
+    var seen_count = 0u;
+    var power = vec3<f32>(0.0);
+    for (var k = 0u; k < 27u; k++) {
+        let offset = vec3<i32>(i32(k % 3u) - 1, i32((k / 3u) % 3u) - 1, i32(k / 9u) - 1);
+        let b = bucket_of(centre + offset, buckets);
+        var duplicate = false;
+        for (var j = 0u; j < seen_count; j++) {
+            duplicate = duplicate || seen[j] == b;
+        }
+        if (duplicate) {
+            continue;
+        }
+        seen[seen_count] = b;
+        seen_count += 1u;
+        let start = grid_starts[start_offset + b];
+        let end = grid_starts[start_offset + b + 1u];
+        for (var i = start; i < end; i++) {
+            let base = 5u * (photon_offset + i);
+            let p = vec3<f32>(bitcast<f32>(grid_photons[base]), bitcast<f32>(grid_photons[base + 1u]), bitcast<f32>(grid_photons[base + 2u]));
+            let d = p - x;
+            let dir = decode_octahedral_15(grid_photons[base + 4u] & 0x3fffffffu);
+            if (photon_accepted(dot(d, d), dir, n, radius, params.normal_test != 0u)) {
+                power += decode_rgb9e5(grid_photons[base + 3u]);
+            }
+        }
+    }
+    return radiance_per_power(albedo, radius) * power * params.power_unit;
+}
+
+struct Branch {
+    origin: vec3<f32>,
+    depth: u32,
+    dir: vec3<f32>,
+    weight: vec3<f32>,
+}
+
+const STACK: u32 = 16u;
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= params.width || id.y >= params.height) {
+        return;
+    }
+    let pixel = vec2<i32>(id.xy);
+    let kind = textureLoad(gbuffer_albedo, pixel, 0).a;
+    if (kind != 1.0 && kind != 2.0) {
+        textureStore(output, pixel, vec4<f32>(0.0));
+        return;
+    }
+    // The primary ray through the pixel centre, as Camera::ray builds it.
+    let px = vec2<f32>(f32(id.x) + 0.5, f32(id.y) + 0.5);
+    let sx = (2.0 * px.x / f32(params.width) - 1.0) * params.tan_half_fov * params.aspect;
+    let sy = (1.0 - 2.0 * px.y / f32(params.height)) * params.tan_half_fov;
+    let primary = normalize(params.camera_forward + params.camera_right * sx + params.camera_up * sy);
+
+    var stack: array<Branch, STACK>;
+    stack[0] = Branch(params.camera_position, 0u, primary, vec3<f32>(1.0));
+    var top = 1u;
+    var radiance = vec3<f32>(0.0);
+    while (top > 0u) {
+        top -= 1u;
+        let b = stack[top];
+        let hit = trace(b.origin, b.dir);
+        if (hit.t >= NO_HIT) {
+            continue;
+        }
+        let p = prims[hit.prim];
+        let x = b.origin + b.dir * hit.t;
+        var ng = normalize(cross(p.b, p.c));
+        if (p.is_sphere != 0u) {
+            ng = normalize(x - p.a);
+        }
+        let s = surfaces[p.surface];
+        let front = dot(b.dir, ng) < 0.0;
+        let n = select(-ng, ng, front);
+        let can_bounce = b.depth < params.max_depth;
+        switch s.kind {
+            case 0u: {
+                let g = gather(x, n, s.albedo, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
+                let c = gather(x, n, s.albedo, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                radiance += b.weight * (direct_radiance(x, n, s.albedo) + g + c);
+            }
+            case 1u: {
+                if (can_bounce && top < STACK) {
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), b.weight * s.albedo);
+                    top += 1u;
+                }
+            }
+            case 2u: {
+                if (can_bounce) {
+                    // hikari_core::material::dielectric_split
+                    let eta = select(s.ior, 1.0 / s.ior, front);
+                    let cos_i = -dot(b.dir, n);
+                    let sin2_t = eta * eta * max(1.0 - cos_i * cos_i, 0.0);
+                    var reflectance = 1.0;
+                    var cos_t = 0.0;
+                    if (sin2_t < 1.0) {
+                        cos_t = sqrt(1.0 - sin2_t);
+                        let r_par = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+                        let r_perp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+                        reflectance = 0.5 * (r_par * r_par + r_perp * r_perp);
+                    }
+                    if (reflectance < 1.0 && top < STACK) {
+                        let refracted = normalize(eta * b.dir + (eta * cos_i - cos_t) * n);
+                        stack[top] = Branch(x, b.depth + 1u, refracted, b.weight * (1.0 - reflectance));
+                        top += 1u;
+                    }
+                    if (reflectance > 0.0 && top < STACK) {
+                        stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), b.weight * reflectance);
+                        top += 1u;
+                    }
+                }
+            }
+            default: {
+                if (front) {
+                    radiance += b.weight * s.emission;
+                }
+            }
+        }
+    }
+    textureStore(output, pixel, vec4<f32>(radiance, 1.0));
+}
