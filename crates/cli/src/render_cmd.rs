@@ -132,6 +132,9 @@ fn render_photons(args: &RenderArgs, scene: &Scene, progress: &TerminalProgress)
     eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
     if let Some(ctx) = gpu {
         let adapter = ctx.describe();
+        if !ctx.float32_blend {
+            eprintln!("note: this adapter cannot blend 32-bit float targets; photon splats accumulate in Rgba16Float");
+        }
         let lod = match (args.lod_near, args.lod_far) {
             (Some(near), Some(far)) => Some(LodSettings { near, far, groups: args.lod_groups }),
             _ => None,

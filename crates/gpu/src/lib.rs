@@ -15,6 +15,7 @@ pub mod gbuffer;
 pub mod lod;
 pub mod readback;
 pub mod renderer;
+pub mod resolve;
 pub mod scene_upload;
 pub mod shadow;
 pub mod specular;

@@ -6,6 +6,7 @@ use crate::direct::DirectPass;
 use crate::gbuffer::{GBuffer, GBufferParams, GBufferPass};
 use crate::lod::{LodOutput, LodPass};
 use crate::readback::read_rgba;
+use crate::resolve::ResolvePass;
 use crate::scene_upload::SceneBuffers;
 use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
@@ -77,11 +78,20 @@ pub enum Stage {
     CausticSplat,
     /// Mirrors and glass seen by the camera, ray-traced to diffuse hits.
     Specular,
+    /// The sum of all radiance targets.
+    Resolve,
 }
 
 impl Stage {
-    pub const ALL: [Stage; 6] =
-        [Stage::GBuffer, Stage::Shadows, Stage::Direct, Stage::GlobalSplat, Stage::CausticSplat, Stage::Specular];
+    pub const ALL: [Stage; 7] = [
+        Stage::GBuffer,
+        Stage::Shadows,
+        Stage::Direct,
+        Stage::GlobalSplat,
+        Stage::CausticSplat,
+        Stage::Specular,
+        Stage::Resolve,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -91,6 +101,7 @@ impl Stage {
             Stage::GlobalSplat => "global splat",
             Stage::CausticSplat => "caustic splat",
             Stage::Specular => "specular",
+            Stage::Resolve => "resolve",
         }
     }
 }
@@ -102,6 +113,7 @@ pub struct GpuRenderer {
     shadow_pass: ShadowPass,
     direct_pass: DirectPass,
     specular_pass: SpecularPass,
+    resolve_pass: ResolvePass,
     lights: GpuLights,
     scene: SceneBuffers,
     lod_pass: LodPass,
@@ -186,7 +198,11 @@ impl GpuRenderer {
                 shadow_bias: settings.shadow_bias,
             },
         );
+        let t = &targets;
+        let resolve_pass =
+            ResolvePass::new(device, [&t.gbuffer.emission, &t.direct, &t.indirect, &t.caustic, &specular_pass.output]);
         GpuRenderer {
+            resolve_pass,
             specular_pass,
             gbuffer_pass: GBufferPass::new(device),
             splat_pass: SplatPass::new(device, ctx.radiance_format),
@@ -280,6 +296,7 @@ impl GpuRenderer {
             Stage::GlobalSplat => splat(encoder, &self.global_lod, &self.settings.global, &self.targets.indirect),
             Stage::CausticSplat => splat(encoder, &self.caustic_lod, &self.settings.caustic, &self.targets.caustic),
             Stage::Specular => self.specular_pass.record(encoder),
+            Stage::Resolve => self.resolve_pass.record(encoder),
         }
     }
 
@@ -298,23 +315,17 @@ impl GpuRenderer {
         read_rgba(&self.ctx, texture)
     }
 
-    /// Reads the frame back as one image: emission + direct + indirect +
-    /// caustics + specular. Non-finite values are dropped (counted in the second value).
+    /// Reads the resolved frame back as one image. Non-finite values are
+    /// dropped (counted in the second value), so they never reach a file.
     pub fn read_image(&self) -> Result<(Image, u64), GpuError> {
+        let resolved = self.read(&self.resolve_pass.output)?;
         let t = &self.targets;
-        let parts = [
-            self.read(&t.gbuffer.emission)?,
-            self.read(&t.direct)?,
-            self.read(&t.indirect)?,
-            self.read(&t.caustic)?,
-            self.read(&self.specular_pass.output)?,
-        ];
         let mut image = Image::new(t.gbuffer.width, t.gbuffer.height);
         let mut nonfinite = 0;
-        for (i, pixel) in image.pixels.iter_mut().enumerate() {
-            let sum: Vec3 = parts.iter().map(|p| p[i].truncate()).sum();
-            if sum.is_finite() {
-                *pixel = sum;
+        for (pixel, value) in image.pixels.iter_mut().zip(&resolved) {
+            let v = value.truncate();
+            if v.is_finite() {
+                *pixel = v;
             } else {
                 nonfinite += 1;
             }

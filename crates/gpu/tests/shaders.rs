@@ -20,6 +20,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("direct.wgsl", hikari_gpu::direct::shader_source()),
         ("lod.wgsl", hikari_gpu::lod::SHADER.to_string()),
         ("specular.wgsl", hikari_gpu::specular::shader_source()),
+        ("resolve.wgsl", hikari_gpu::resolve::SHADER.to_string()),
     ]
 }
 

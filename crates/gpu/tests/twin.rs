@@ -18,9 +18,13 @@ struct TwinStats {
 }
 
 fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
-    let ctx = context_or_skip(scene_name)?;
     let mut scene = Scene::load(scene_name).unwrap();
     scene.camera = scene.camera.with_resolution(64, 64).unwrap();
+    twin_scene(scene, photons, normal_test)
+}
+
+fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
+    let ctx = context_or_skip("twin")?;
     let traced = trace_photons(&scene, &TraceSettings { photons, seed: 11, ..Default::default() }, &Silent);
     let cpu_settings = PhotonCpuSettings { normal_test, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
@@ -104,4 +108,23 @@ fn gpu_splat_equals_cpu_estimate_with_normal_test() {
         return;
     };
     assert_twin("cornell-box indirect, normal test", &indirect, 2000);
+}
+
+/// The eye close to the floor inside the box: photon spheres cross the near
+/// plane and lie behind the eye, so the splat's conservative quads must still
+/// cover every pixel each photon reaches.
+#[test]
+fn gpu_splat_equals_cpu_estimate_with_photons_around_the_eye() {
+    let mut scene = Scene::load("cornell-box").unwrap();
+    scene.camera = hikari_core::camera::Camera::new(
+        Vec3::new(0.2, -0.93, 0.6),
+        Vec3::new(-0.5, -1.0, -0.6),
+        Vec3::Y,
+        100.0,
+        64,
+        64,
+    )
+    .unwrap();
+    let Some((indirect, _)) = twin_scene(scene, 20_000, false) else { return };
+    assert_twin("eye among photons", &indirect, 2000);
 }
