@@ -95,7 +95,7 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
     renderer.wait()?;
     let frame = start.elapsed().as_secs_f64() / frames as f64;
     let (drawn, _) = renderer.drawn_photons()?;
-    let breakdown = renderer.render_timed()?;
+    let (breakdown, timestamps) = renderer.render_timed()?;
     println!(
         "{} at {}x{}: {:.2} fps ({:.2} ms/frame), {} global photons drawn",
         row.label,
@@ -107,6 +107,7 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
     );
     let parts: Vec<String> =
         breakdown.iter().map(|(stage, t): &(Stage, f64)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
-    println!("    per pass (separate submits): {}", parts.join(", "));
+    let how = if timestamps { "GPU timestamps" } else { "wall-clock, separate submits" };
+    println!("    per pass ({how}): {}", parts.join(", "));
     Ok((renderer, drawn))
 }

@@ -20,6 +20,8 @@ pub struct GpuContext {
     /// can blend it, else Rgba16Float (and `float32_blend` is false).
     pub radiance_format: wgpu::TextureFormat,
     pub float32_blend: bool,
+    /// GPU timestamps can be written between passes (per-pass timings).
+    pub timestamps: bool,
 }
 
 impl GpuContext {
@@ -37,6 +39,11 @@ impl GpuContext {
         let mut required_features = wgpu::Features::empty();
         if float32_blend {
             required_features |= wgpu::Features::FLOAT32_BLENDABLE;
+        }
+        let timestamp_features = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let timestamps = adapter.features().contains(timestamp_features);
+        if timestamps {
+            required_features |= timestamp_features;
         }
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("hikari"),
@@ -57,6 +64,7 @@ impl GpuContext {
                 wgpu::TextureFormat::Rgba16Float
             },
             float32_blend,
+            timestamps,
         })
     }
 

@@ -243,9 +243,13 @@ impl GpuRenderer {
         self.ctx.queue.submit([encoder.finish()]);
     }
 
-    /// Renders one frame submitting each stage on its own and waiting for it:
-    /// wall-clock seconds per stage (slower than `render`, for breakdowns).
-    pub fn render_timed(&self) -> Result<Vec<(Stage, f64)>, GpuError> {
+    /// Renders one frame and times each stage: with GPU timestamps written
+    /// between the stages when the adapter has them (true = timestamps),
+    /// else wall-clock around a separate submit per stage, waited for.
+    pub fn render_timed(&self) -> Result<(Vec<(Stage, f64)>, bool), GpuError> {
+        if self.ctx.timestamps {
+            return Ok((self.render_timestamped()?, true));
+        }
         let mut times = Vec::new();
         for stage in Stage::ALL {
             let start = std::time::Instant::now();
@@ -255,7 +259,39 @@ impl GpuRenderer {
             self.wait()?;
             times.push((stage, start.elapsed().as_secs_f64()));
         }
-        Ok(times)
+        Ok((times, false))
+    }
+
+    fn render_timestamped(&self) -> Result<Vec<(Stage, f64)>, GpuError> {
+        let device = &self.ctx.device;
+        let count = Stage::ALL.len() as u32 + 1;
+        let queries = device.create_query_set(&wgpu::QuerySetDescriptor {
+            label: Some("stage timestamps"),
+            ty: wgpu::QueryType::Timestamp,
+            count,
+        });
+        let resolved = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("stage timestamps"),
+            size: count as u64 * 8,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.write_timestamp(&queries, 0);
+        for (i, stage) in Stage::ALL.into_iter().enumerate() {
+            self.record_stage(stage, &mut encoder);
+            encoder.write_timestamp(&queries, i as u32 + 1);
+        }
+        encoder.resolve_query_set(&queries, 0..count, &resolved, 0);
+        self.ctx.queue.submit([encoder.finish()]);
+        let words = crate::readback::read_u32s(&self.ctx, &resolved, count as u64 * 2)?;
+        let ticks: Vec<u64> = words.chunks(2).map(|w| w[0] as u64 | ((w[1] as u64) << 32)).collect();
+        let period_ns = self.ctx.queue.get_timestamp_period() as f64;
+        Ok(Stage::ALL
+            .into_iter()
+            .enumerate()
+            .map(|(i, stage)| (stage, ticks[i + 1].saturating_sub(ticks[i]) as f64 * period_ns * 1e-9))
+            .collect())
     }
 
     /// Blocks until the GPU has finished all submitted work.

@@ -10,6 +10,7 @@ use crate::shadow::light_samples::GpuLights;
 use bytemuck::{Pod, Zeroable};
 use hikari_core::estimate::FixedRadius;
 use hikari_core::geometry::FlatBvh;
+use hikari_core::material::Material;
 use hikari_core::photon::Photon;
 use hikari_core::scene::Scene;
 use wgpu::util::DeviceExt;
@@ -62,6 +63,9 @@ pub struct SpecularPass {
     bind_group: wgpu::BindGroup,
     width: u32,
     height: u32,
+    /// False when no surface is a mirror or glass: the pass is skipped and
+    /// its (zero-initialised) output stays black.
+    enabled: bool,
     pub output: wgpu::Texture,
 }
 
@@ -236,10 +240,17 @@ impl SpecularPass {
                 wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
             ],
         });
-        SpecularPass { pipeline, bind_group, width, height, output }
+        let enabled = scene
+            .surfaces
+            .iter()
+            .any(|s| matches!(scene.materials[s.material as usize], Material::Mirror { .. } | Material::Glass { .. }));
+        SpecularPass { pipeline, bind_group, width, height, enabled, output }
     }
 
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        if !self.enabled {
+            return;
+        }
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("specular"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
