@@ -9,6 +9,7 @@
 //!
 //! Each pass is a small struct with its pipeline, its shader beside it.
 
+pub mod binding;
 pub mod context;
 pub mod direct;
 pub mod gbuffer;

@@ -39,14 +39,7 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
         wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
     );
     ctx.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-    rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-    let data = slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?;
+    let data = map_read(ctx, &buffer)?;
     let mut out = Vec::with_capacity((width * height) as usize);
     for row in 0..height {
         let bytes = &data[(row * padded) as usize..(row * padded + unpadded) as usize];
@@ -56,9 +49,22 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
             out.extend(bytemuck::cast_slice::<u8, [u16; 4]>(bytes).iter().map(|v| Vec4::from(v.map(f16_to_f32))));
         }
     }
-    drop(data);
-    buffer.unmap();
     Ok(out)
+}
+
+/// Maps a MAP_READ buffer after the submitted work and copies its bytes out.
+fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    let error = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
+    let slice = buffer.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| error(&e))?;
+    rx.recv().map_err(|e| error(&e))?.map_err(|e| error(&e))?;
+    let bytes = slice.get_mapped_range().map_err(|e| error(&e))?.to_vec();
+    buffer.unmap();
+    Ok(bytes)
 }
 
 /// Reads the first `count` u32 words of `buffer` (which needs COPY_SRC).
@@ -72,18 +78,7 @@ pub fn read_u32s(ctx: &GpuContext, buffer: &wgpu::Buffer, count: u64) -> Result<
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, count * 4);
     ctx.queue.submit([encoder.finish()]);
-    let slice = staging.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
-    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-    rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-    let words =
-        bytemuck::cast_slice::<u8, u32>(&slice.get_mapped_range().map_err(|e| GpuError::Readback(e.to_string()))?)
-            .to_vec();
-    staging.unmap();
-    Ok(words)
+    Ok(bytemuck::pod_collect_to_vec(&map_read(ctx, &staging)?))
 }
 
 /// IEEE half to single precision, exactly.

@@ -29,47 +29,22 @@ pub struct DirectPass {
     layout: wgpu::BindGroupLayout,
 }
 
-fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::FRAGMENT, ty, count: None }
-}
-
-fn texture(dimension: wgpu::TextureViewDimension) -> wgpu::BindingType {
-    wgpu::BindingType::Texture {
-        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-        view_dimension: dimension,
-        multisampled: false,
-    }
-}
-
-fn storage() -> wgpu::BindingType {
-    wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Storage { read_only: true },
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    }
-}
-
 impl DirectPass {
     pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("direct.wgsl"),
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
+        use crate::binding::{storage, texture, uniform};
         use wgpu::TextureViewDimension::{D2, D2Array};
+        let entry = |b, ty| crate::binding::entry(b, wgpu::ShaderStages::FRAGMENT, ty);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("direct"),
             entries: &[
-                entry(
-                    0,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-                entry(1, storage()),
-                entry(2, storage()),
-                entry(3, storage()),
+                entry(0, uniform()),
+                entry(1, storage(true)),
+                entry(2, storage(true)),
+                entry(3, storage(true)),
                 entry(4, texture(D2Array)),
                 entry(5, texture(D2)),
                 entry(6, texture(D2)),

@@ -14,32 +14,15 @@ impl ResolvePass {
     /// `inputs`: emission, direct, indirect, caustic, specular (same size).
     pub fn new(device: &wgpu::Device, inputs: [&wgpu::Texture; 5]) -> Self {
         let (width, height) = (inputs[0].width(), inputs[0].height());
+        use crate::binding::{entry, storage_texture_rgba32f, texture};
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("resolve.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
         });
-        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..5)
-            .map(|binding| wgpu::BindGroupLayoutEntry {
-                binding,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            })
-            .collect();
-        entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 5,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: wgpu::TextureFormat::Rgba32Float,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        });
+        let stage = wgpu::ShaderStages::COMPUTE;
+        let mut entries: Vec<wgpu::BindGroupLayoutEntry> =
+            (0..5).map(|b| entry(b, stage, texture(wgpu::TextureViewDimension::D2))).collect();
+        entries.push(entry(5, stage, storage_texture_rgba32f()));
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -69,34 +69,6 @@ pub struct SpecularPass {
     pub output: wgpu::Texture,
 }
 
-fn entry(binding: u32, ty: wgpu::BindingType) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry { binding, visibility: wgpu::ShaderStages::COMPUTE, ty, count: None }
-}
-
-fn storage() -> wgpu::BindingType {
-    wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Storage { read_only: true },
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    }
-}
-
-fn uniform() -> wgpu::BindingType {
-    wgpu::BindingType::Buffer {
-        ty: wgpu::BufferBindingType::Uniform,
-        has_dynamic_offset: false,
-        min_binding_size: None,
-    }
-}
-
-fn texture(view_dimension: wgpu::TextureViewDimension) -> wgpu::BindingType {
-    wgpu::BindingType::Texture {
-        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-        view_dimension,
-        multisampled: false,
-    }
-}
-
 impl SpecularPass {
     #[allow(clippy::too_many_arguments)]
     pub fn new(
@@ -113,30 +85,25 @@ impl SpecularPass {
             label: Some("specular.wgsl"),
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
+        use crate::binding::{storage, storage_texture_rgba32f, texture, uniform};
         use wgpu::TextureViewDimension::{D2, D2Array};
+        let entry = |b, ty| crate::binding::entry(b, wgpu::ShaderStages::COMPUTE, ty);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("specular"),
             entries: &[
                 entry(0, uniform()),
-                entry(1, storage()),
-                entry(2, storage()),
-                entry(3, storage()),
-                entry(4, storage()),
-                entry(5, storage()),
+                entry(1, storage(true)),
+                entry(2, storage(true)),
+                entry(3, storage(true)),
+                entry(4, storage(true)),
+                entry(5, storage(true)),
                 entry(6, uniform()),
-                entry(7, storage()),
-                entry(8, storage()),
-                entry(9, storage()),
+                entry(7, storage(true)),
+                entry(8, storage(true)),
+                entry(9, storage(true)),
                 entry(10, texture(D2Array)),
                 entry(11, texture(D2)),
-                entry(
-                    12,
-                    wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba32Float,
-                        view_dimension: D2,
-                    },
-                ),
+                entry(12, storage_texture_rgba32f()),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

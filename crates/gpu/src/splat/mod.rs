@@ -58,41 +58,21 @@ pub struct SplatPass {
     layout: wgpu::BindGroupLayout,
 }
 
-fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
-
 impl SplatPass {
     pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("splat.wgsl"),
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
+        use crate::binding::{entry, texture, uniform};
+        use wgpu::TextureViewDimension::D2;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("splat"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                texture_entry(1),
-                texture_entry(2),
-                texture_entry(3),
+                entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, uniform()),
+                entry(1, wgpu::ShaderStages::FRAGMENT, texture(D2)),
+                entry(2, wgpu::ShaderStages::FRAGMENT, texture(D2)),
+                entry(3, wgpu::ShaderStages::FRAGMENT, texture(D2)),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
