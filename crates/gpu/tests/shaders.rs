@@ -130,7 +130,12 @@ fn shared_structs_match_wgsl_layouts() {
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
     assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior]);
     let lod = hikari_gpu::lod::SHADER.to_string();
-    assert_layout!(lod, "LodParams", LodParams, [eye, near, far, groups, count, enabled]);
+    assert_layout!(
+        lod,
+        "LodParams",
+        LodParams,
+        [eye, near, far, groups, count, enabled, workgroups, _pad0, _pad1, _pad2]
+    );
     assert_layout!(
         lod,
         "LodPhoton",

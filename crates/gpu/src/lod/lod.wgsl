@@ -1,7 +1,8 @@
-// Level of detail (METHOD.md §6): a compute pass that computes each photon's
-// detail level and power scale, mirrored from hikari_core::lod, and appends
-// the photons that survive to the splat's instance buffer, counting them
-// into the indirect draw: culled photons are never rasterized.
+// Level of detail (METHOD.md §6): compute each photon's detail level and
+// power scale, mirrored from hikari_core::lod, and compact the photons that
+// survive into the splat's instance buffer and indirect draw, so culled
+// photons are never rasterized. The compaction keeps storage order (count →
+// scan → scatter), so the splat blends in the same order on every run.
 
 struct LodParams {
     eye: vec3<f32>,
@@ -11,6 +12,11 @@ struct LodParams {
     count: u32,
     // 0: LOD off (every photon drawn with scale 1).
     enabled: u32,
+    // Workgroups of the count and scatter dispatches.
+    workgroups: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // The splat's instance: a stored photon and its LOD power scale.
@@ -25,7 +31,7 @@ struct LodPhoton {
 
 struct DrawIndirect {
     vertex_count: u32,
-    instance_count: atomic<u32>,
+    instance_count: u32,
     first_vertex: u32,
     first_instance: u32,
 }
@@ -35,6 +41,11 @@ struct DrawIndirect {
 @group(0) @binding(1) var<storage, read> photons: array<u32>;
 @group(0) @binding(2) var<storage, read_write> survivors: array<LodPhoton>;
 @group(0) @binding(3) var<storage, read_write> draw: DrawIndirect;
+// Survivors per workgroup, then (after `scan`) each workgroup's first slot.
+@group(0) @binding(4) var<storage, read_write> group_sums: array<u32>;
+
+const WORKGROUP: u32 = 256u;
+var<workgroup> shared_sums: array<u32, 256>;
 
 fn smoothstep_lod(e0: f32, e1: f32, x: f32) -> f32 {
     if (e0 == e1) {
@@ -69,21 +80,78 @@ fn power_scale(q: f32, group: u32) -> f32 {
     return (1.0 - (1.0 - g - dq) / (1.0 - q)) / dq;
 }
 
-@compute @workgroup_size(64)
-fn cull(@builtin(global_invocation_id) id: vec3<u32>) {
-    let i = id.x;
-    if (i >= params.count) {
-        return;
-    }
+fn photon_position(i: u32) -> vec3<f32> {
     let base = 5u * i;
-    let position = vec3<f32>(bitcast<f32>(photons[base]), bitcast<f32>(photons[base + 1u]), bitcast<f32>(photons[base + 2u]));
-    var scale = 1.0;
-    if (params.enabled != 0u) {
-        scale = power_scale(detail_level(distance(position, params.eye)), group_of(i));
-        if (scale <= 0.0) {
-            return;
-        }
+    return vec3<f32>(bitcast<f32>(photons[base]), bitcast<f32>(photons[base + 1u]), bitcast<f32>(photons[base + 2u]));
+}
+
+// The scale of photon i; 0 when culled or past the end.
+fn scale_of(i: u32) -> f32 {
+    if (i >= params.count) {
+        return 0.0;
     }
-    let slot = atomicAdd(&draw.instance_count, 1u);
-    survivors[slot] = LodPhoton(position.x, position.y, position.z, photons[base + 3u], photons[base + 4u], scale);
+    if (params.enabled == 0u) {
+        return 1.0;
+    }
+    return power_scale(detail_level(distance(photon_position(i), params.eye)), group_of(i));
+}
+
+// Exclusive prefix sum of `value` over the workgroup (Hillis–Steele), and the
+// workgroup's total in shared_sums[WORKGROUP - 1]. Called in uniform control flow.
+fn workgroup_exclusive_prefix(lid: u32, value: u32) -> u32 {
+    shared_sums[lid] = value;
+    workgroupBarrier();
+    for (var offset = 1u; offset < WORKGROUP; offset *= 2u) {
+        var add = 0u;
+        if (lid >= offset) {
+            add = shared_sums[lid - offset];
+        }
+        workgroupBarrier();
+        shared_sums[lid] += add;
+        workgroupBarrier();
+    }
+    return shared_sums[lid] - value;
+}
+
+@compute @workgroup_size(256)
+fn count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let keep = u32(scale_of(wid.x * WORKGROUP + lid) > 0.0);
+    workgroup_exclusive_prefix(lid, keep);
+    if (lid == 0u) {
+        group_sums[wid.x] = shared_sums[WORKGROUP - 1u];
+    }
+}
+
+// One workgroup turns the per-workgroup counts into first slots.
+@compute @workgroup_size(256)
+fn scan(@builtin(local_invocation_index) lid: u32) {
+    let n = params.workgroups;
+    let chunk = (n + WORKGROUP - 1u) / WORKGROUP;
+    let start = min(lid * chunk, n);
+    let end = min(start + chunk, n);
+    var partial = 0u;
+    for (var i = start; i < end; i++) {
+        partial += group_sums[i];
+    }
+    var running = workgroup_exclusive_prefix(lid, partial);
+    for (var i = start; i < end; i++) {
+        let c = group_sums[i];
+        group_sums[i] = running;
+        running += c;
+    }
+    if (lid == WORKGROUP - 1u) {
+        draw.instance_count = shared_sums[WORKGROUP - 1u];
+    }
+}
+
+@compute @workgroup_size(256)
+fn scatter(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let i = wid.x * WORKGROUP + lid;
+    let scale = scale_of(i);
+    let keep = u32(scale > 0.0);
+    let slot = group_sums[wid.x] + workgroup_exclusive_prefix(lid, keep);
+    if (keep == 1u) {
+        let p = photon_position(i);
+        survivors[slot] = LodPhoton(p.x, p.y, p.z, photons[5u * i + 3u], photons[5u * i + 4u], scale);
+    }
 }

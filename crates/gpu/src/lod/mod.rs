@@ -1,6 +1,8 @@
 //! The LOD pass: culls photons by distance and scales the survivors' power
-//! (hikari_core::lod, mirrored in lod.wgsl), writing them and their count
-//! for an indirect draw, so culled photons cost no rasterization.
+//! (hikari_core::lod, mirrored in lod.wgsl), compacting them in storage
+//! order (count, scan, scatter) into the instances and count of an indirect
+//! draw, so culled photons cost no rasterization and every run draws the
+//! same instances in the same order.
 
 use crate::splat::PhotonBuffer;
 use bytemuck::{Pod, Zeroable};
@@ -8,7 +10,8 @@ use hikari_core::lod::LodSettings;
 use wgpu::util::DeviceExt;
 
 pub const SHADER: &str = include_str!("lod.wgsl");
-const WORKGROUP: u32 = 64;
+/// Matches `WORKGROUP` in lod.wgsl.
+const WORKGROUP: u32 = 256;
 
 /// Mirrors `LodParams` in lod.wgsl.
 #[repr(C)]
@@ -20,6 +23,10 @@ pub struct LodParams {
     pub groups: u32,
     pub count: u32,
     pub enabled: u32,
+    pub workgroups: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// A splat instance: the stored photon and its power scale. Mirrors
@@ -46,7 +53,9 @@ pub struct LodOutput {
 }
 
 pub struct LodPass {
-    pipeline: wgpu::ComputePipeline,
+    count: wgpu::ComputePipeline,
+    scan: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
@@ -65,6 +74,7 @@ impl LodPass {
                 entry(1, storage(true)),
                 entry(2, storage(false)),
                 entry(3, storage(false)),
+                entry(4, storage(false)),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -72,15 +82,17 @@ impl LodPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("lod cull"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("cull"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        LodPass { pipeline, layout }
+        let pipeline = |entry_point: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        LodPass { count: pipeline("count"), scan: pipeline("scan"), scatter: pipeline("scatter"), layout }
     }
 
     /// Buffers for culling `photons`; capacity for all of them.
@@ -106,6 +118,12 @@ impl LodPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let group_sums = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lod group sums"),
+            size: photons.count.div_ceil(WORKGROUP).max(1) as u64 * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lod"),
             layout: &self.layout,
@@ -114,6 +132,7 @@ impl LodPass {
                 wgpu::BindGroupEntry { binding: 1, resource: photons.buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: survivors.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: draw_args.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: group_sums.as_entire_binding() },
             ],
         });
         LodOutput { survivors, draw_args, bind_group, params, count: photons.count }
@@ -128,7 +147,10 @@ impl LodPass {
         eye: glam::Vec3,
         settings: Option<&LodSettings>,
     ) {
-        let (near, far, groups) = settings.map_or((0.0, 0.0, 1), |s| (s.near, s.far, s.groups.max(1)));
+        // group_of's u32 arithmetic needs count · groups < 2^32.
+        let max_groups = (u32::MAX / output.count.max(1)).max(1);
+        let (near, far, groups) = settings.map_or((0.0, 0.0, 1), |s| (s.near, s.far, s.groups.clamp(1, max_groups)));
+        let workgroups = output.count.div_ceil(WORKGROUP);
         let params = LodParams {
             eye: eye.to_array(),
             near,
@@ -136,6 +158,10 @@ impl LodPass {
             groups,
             count: output.count,
             enabled: settings.is_some() as u32,
+            workgroups,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         };
         queue.write_buffer(&output.params, 0, bytemuck::bytes_of(&params));
         queue.write_buffer(&output.draw_args, 0, bytemuck::cast_slice(&[4u32, 0, 0, 0]));
@@ -144,8 +170,12 @@ impl LodPass {
         }
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("lod cull"), timestamp_writes: None });
-        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &output.bind_group, &[]);
-        pass.dispatch_workgroups(output.count.div_ceil(WORKGROUP), 1, 1);
+        pass.set_pipeline(&self.count);
+        pass.dispatch_workgroups(workgroups, 1, 1);
+        pass.set_pipeline(&self.scan);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(&self.scatter);
+        pass.dispatch_workgroups(workgroups, 1, 1);
     }
 }
