@@ -37,6 +37,9 @@ pub struct GpuSurface {
     pub emission: [f32; 3],
     /// Index of refraction (glass).
     pub ior: f32,
+    /// Mirror reflectance ρ_s of diffuse + mirror materials.
+    pub specular: [f32; 3],
+    pub _pad: u32,
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -143,7 +146,14 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 | hikari_core::light::Light::Quad { radiance, .. } => *radiance,
                 _ => Vec3::ZERO,
             });
-            GpuSurface { albedo: albedo.to_array(), kind, emission: emission.to_array(), ior }
+            GpuSurface {
+                albedo: albedo.to_array(),
+                kind,
+                emission: emission.to_array(),
+                ior,
+                specular: if kind == kind::DIFFUSE { material.mirror_reflectance().to_array() } else { [0.0; 3] },
+                _pad: 0,
+            }
         })
         .collect()
 }

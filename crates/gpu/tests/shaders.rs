@@ -70,7 +70,7 @@ macro_rules! assert_layout {
 fn shared_structs_match_wgsl_layouts() {
     let gbuffer = hikari_gpu::gbuffer::SHADER.to_string();
     assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
-    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior]);
+    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
     let splat = hikari_gpu::splat::shader_source();
     assert_layout!(splat, "SplatParams", SplatParams, [clip_from_world, radius, power_unit, normal_test, _pad]);
     let shadow = hikari_gpu::shadow::SHADER.to_string();
@@ -128,7 +128,7 @@ fn shared_structs_match_wgsl_layouts() {
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
-    assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior]);
+    assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
     let lod = hikari_gpu::lod::SHADER.to_string();
     assert_layout!(
         lod,

@@ -73,8 +73,11 @@ fn comparison_mask(scene: &Scene, gpu_albedo: &[glam::Vec4]) -> Vec<bool> {
 }
 
 fn compare(scene_name: &str) -> Option<(f64, usize, Option<(f64, usize)>)> {
+    compare_scene(scene_name, Scene::load(scene_name).unwrap())
+}
+
+fn compare_scene(scene_name: &str, mut scene: Scene) -> Option<(f64, usize, Option<(f64, usize)>)> {
     let ctx = context_or_skip(scene_name)?;
-    let mut scene = Scene::load(scene_name).unwrap();
     scene.camera = scene.camera.with_resolution(SIZE, SIZE).unwrap();
     let traced = trace_photons(&scene, &TraceSettings { photons: 50_000, seed: 5, ..Default::default() }, &Silent);
     // One sample at the pixel centre, as the rasterizer sees it; many shadow
@@ -149,4 +152,27 @@ fn gpu_image_matches_photon_cpu_on_cornell_caustic() {
     eprintln!("cornell-caustic glass: {specular_count} pixels, mean relative difference {:.3}%", specular_mean * 100.0);
     assert!(specular_count > 100);
     assert!(specular_mean < 0.05, "glass pixels: mean relative difference {specular_mean}");
+}
+
+/// A floor that is part diffuse, part mirror: the raster passes shade the
+/// diffuse part, the specular pass follows the mirror part (photon-cpu does
+/// both by recursion).
+#[test]
+fn gpu_image_matches_photon_cpu_with_a_diffuse_mirror_floor() {
+    let text = hikari_core::scene::builtin::source("cornell-box").unwrap().replacen(
+        "[[material]]",
+        "[[material]]\nname = \"glossy\"\ntype = \"diffuse\"\nalbedo = [0.2, 0.2, 0.2]\nspecular_reflectance = [0.75, 0.75, 0.75]\n\n[[material]]",
+        1,
+    );
+    // The floor is the first object; make it glossy.
+    let text = text.replacen(
+        "edge_v = [2.0, 0.0, 0.0]\nmaterial = \"white\"",
+        "edge_v = [2.0, 0.0, 0.0]\nmaterial = \"glossy\"",
+        1,
+    );
+    let scene = Scene::from_toml(&text, "glossy-floor", None).unwrap();
+    assert!(scene.materials.iter().any(|m| m.mirror_reflectance().max_element() > 0.0));
+    let Some((mean, count, _)) = compare_scene("glossy floor", scene) else { return };
+    assert!(count > 2000, "only {count} pixels compared");
+    assert!(mean < 0.02, "mean relative difference {mean}");
 }

@@ -12,6 +12,8 @@ struct Surface {
     kind: u32,
     emission: vec3<f32>,
     ior: f32,
+    specular: vec3<f32>,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: GBufferParams;

@@ -1,4 +1,5 @@
-//! The specular pass: mirrors and glass seen by the camera, ray-traced on
+//! The specular pass: mirrors, glass and the mirror part of diffuse + mirror
+//! materials seen by the camera, ray-traced on
 //! the GPU through the scene BVH to their diffuse hits, which are shaded
 //! with direct light and photon gathers (see specular.wgsl).
 
@@ -186,7 +187,7 @@ impl SpecularPass {
         });
         let maps_view =
             maps.texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(D2Array), ..Default::default() });
-        let albedo_view = gbuffer.albedo.create_view(&Default::default());
+        let normal_view = gbuffer.normal.create_view(&Default::default());
         let output_view = output.create_view(&Default::default());
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("specular"),
@@ -203,14 +204,14 @@ impl SpecularPass {
                 wgpu::BindGroupEntry { binding: 8, resource: samples_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 9, resource: maps.views_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&maps_view) },
-                wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&albedo_view) },
+                wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&normal_view) },
                 wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
             ],
         });
-        let enabled = scene
-            .surfaces
-            .iter()
-            .any(|s| matches!(scene.materials[s.material as usize], Material::Mirror { .. } | Material::Glass { .. }));
+        let enabled = scene.surfaces.iter().any(|s| {
+            let m = &scene.materials[s.material as usize];
+            matches!(m, Material::Mirror { .. } | Material::Glass { .. }) || m.mirror_reflectance().max_element() > 0.0
+        });
         SpecularPass { pipeline, bind_group, width, height, enabled, output }
     }
 

@@ -50,6 +50,8 @@ struct Surface {
     kind: u32,
     emission: vec3<f32>,
     ior: f32,
+    specular: vec3<f32>,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: SpecularParams;
@@ -64,7 +66,7 @@ struct Surface {
 @group(0) @binding(8) var<storage, read> samples: array<LightSample>;
 @group(0) @binding(9) var<storage, read> views: array<ShadowView>;
 @group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
-@group(0) @binding(11) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
 
 const NO_HIT: f32 = 3.0e38;
@@ -232,8 +234,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pixel = vec2<i32>(id.xy);
-    let kind = textureLoad(gbuffer_albedo, pixel, 0).a;
-    if (kind != 1.0 && kind != 2.0) {
+    // The G-buffer's normal.w is the surface id (the background's is 0 with
+    // w = 0 everywhere, so check coverage through the normal's length).
+    let g = textureLoad(gbuffer_normal, pixel, 0);
+    let first = surfaces[u32(g.w)];
+    let mirror_part = first.kind == 0u && any(first.specular > vec3<f32>(0.0));
+    if (dot(g.xyz, g.xyz) == 0.0 || (first.kind != 1u && first.kind != 2u && !mirror_part)) {
         textureStore(output, pixel, vec4<f32>(0.0));
         return;
     }
@@ -266,9 +272,17 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let can_bounce = b.depth < params.max_depth;
         switch s.kind {
             case 0u: {
-                let g = gather(x, n, s.albedo, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
-                let c = gather(x, n, s.albedo, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
-                radiance += b.weight * (direct_radiance(x, n, s.albedo) + g + c);
+                // A diffuse primary hit is shaded by the raster passes; here
+                // only its mirror part is followed.
+                if (b.depth > 0u) {
+                    let g = gather(x, n, s.albedo, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
+                    let c = gather(x, n, s.albedo, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    radiance += b.weight * (direct_radiance(x, n, s.albedo) + g + c);
+                }
+                if (any(s.specular > vec3<f32>(0.0)) && can_bounce && top < STACK) {
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), b.weight * s.specular);
+                    top += 1u;
+                }
             }
             case 1u: {
                 if (can_bounce && top < STACK) {
