@@ -30,6 +30,7 @@ pub mod geometry;
 pub mod light;
 pub mod lod;
 pub mod material;
+pub mod medium;
 pub mod output;
 pub mod photon;
 pub mod progress;
