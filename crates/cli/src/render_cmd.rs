@@ -199,6 +199,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let mut scene = Scene::load(&args.scene)?;
+    if scene.medium.is_some() {
+        bail!(
+            "{}: the scene has a [[medium]], and no renderer draws participating media yet (issue #4); remove it to render",
+            scene.source
+        );
+    }
     if let Some((w, h)) = args.resolution {
         scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
     }

@@ -19,6 +19,8 @@ pub struct SceneDesc {
     pub object: Vec<Spanned<ObjectDesc>>,
     #[serde(default)]
     pub light: Vec<Spanned<LightDesc>>,
+    #[serde(default)]
+    pub medium: Vec<Spanned<MediumDesc>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -93,4 +95,19 @@ pub struct LightDesc {
     pub corner: Option<V3>,
     pub edge_u: Option<V3>,
     pub edge_v: Option<V3>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct MediumDesc {
+    #[serde(default)]
+    pub sigma_a: V3,
+    #[serde(default)]
+    pub sigma_s: V3,
+    /// "schlick" (with `k`) or "hg" (with `g`).
+    pub phase: Option<String>,
+    pub k: Option<f32>,
+    pub g: Option<f32>,
+    /// A closed mesh bounding the medium; none: the whole scene.
+    pub region: Option<String>,
 }

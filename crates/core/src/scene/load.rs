@@ -1,12 +1,13 @@
 //! Turns a parsed scene description into a `Scene`, checking every value.
 
-use super::desc::{CameraDesc, LightDesc, MaterialDesc, ObjectDesc, SceneDesc, V3};
+use super::desc::{CameraDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3};
 use super::error::{SceneError, line_col};
 use super::{Scene, Surface};
 use crate::camera::Camera;
 use crate::geometry::{Accel, Sphere, Triangle, TriangleNormals};
 use crate::light::Light;
 use crate::material::Material;
+use crate::medium::{Medium, Phase};
 use glam::{Mat3, Vec3};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -140,10 +141,52 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         });
     }
 
+    let mut medium = None;
+    for (i, m) in desc.medium.iter().enumerate() {
+        let p = place(m.span(), format!("[[medium]] #{}", i + 1));
+        let loaded = load_medium(m.get_ref(), &p)?;
+        if medium.replace(loaded).is_some() {
+            return Err(p.error("only one medium filling the whole scene is supported so far (regions: issue #4)"));
+        }
+    }
+
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = geometry.triangles.into_iter().unzip();
     let (spheres, sphere_surfaces): (Vec<_>, Vec<_>) = geometry.spheres.into_iter().unzip();
     let accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
-    Ok(Scene { source: file.to_string(), camera, materials, surfaces: geometry.surfaces, lights, accel })
+    Ok(Scene { source: file.to_string(), camera, materials, surfaces: geometry.surfaces, lights, accel, medium })
+}
+
+fn load_medium(m: &MediumDesc, p: &Place) -> Result<Medium, SceneError> {
+    if m.region.is_some() {
+        return Err(p.error(
+            "media bounded by a `region` mesh are not supported yet (issue #4); omit `region` to fill the scene",
+        ));
+    }
+    let sigma_a = p.color("sigma_a", m.sigma_a, None)?;
+    let sigma_s = p.color("sigma_s", m.sigma_s, None)?;
+    if (sigma_a + sigma_s).max_element() <= 0.0 {
+        return Err(p.error("sigma_a + sigma_s is zero in every channel: the medium does nothing"));
+    }
+    let parameter = |name: &str, v: Option<f32>| -> Result<f32, SceneError> {
+        let v = v.unwrap_or(0.0);
+        if v.is_finite() && v > -1.0 && v < 1.0 {
+            Ok(v)
+        } else {
+            Err(p.error(format!("`{name}` = {v} must lie strictly between -1 and 1")))
+        }
+    };
+    let phase = match m.phase.as_deref().unwrap_or("schlick") {
+        "schlick" => {
+            p.only("a Schlick phase function", &[("g", m.g.is_some())], &[])?;
+            Phase::Schlick { k: parameter("k", m.k)? }
+        }
+        "hg" => {
+            p.only("a Henyey-Greenstein phase function", &[("k", m.k.is_some())], &[])?;
+            Phase::HenyeyGreenstein { g: parameter("g", m.g)? }
+        }
+        other => return Err(p.error(format!("unknown phase function \"{other}\" (expected schlick or hg)"))),
+    };
+    Ok(Medium { sigma_a, sigma_s, phase })
 }
 
 fn load_camera(c: &CameraDesc, p: &Place) -> Result<Camera, SceneError> {
@@ -531,6 +574,27 @@ intensity = [1.0, 1.0, 1.0]
         // Interpolated smooth normal, not the flat one.
         assert!(hit.shading_normal.x > 0.01);
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn media_load_and_bad_media_are_rejected() {
+        let fog = "\n[[medium]]\nsigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.2, 0.3, 0.4]\nphase = \"hg\"\ng = 0.5\n";
+        let s = parse(&format!("{BASE}{fog}"), "test.toml", None).unwrap();
+        let m = s.medium.unwrap();
+        assert_eq!(m.phase, Phase::HenyeyGreenstein { g: 0.5 });
+        assert_eq!(m.sigma_s, Vec3::new(0.2, 0.3, 0.4));
+        for (bad, words) in [
+            (fog.replace("g = 0.5", "g = 1.0"), "strictly between"),
+            (fog.replace("g = 0.5", "k = 0.5"), "does not apply"),
+            (fog.replace("sigma_a = [0.1, 0.1, 0.1]", "sigma_a = [-0.1, 0.1, 0.1]"), "negative"),
+            (fog.replace("phase = \"hg\"", "phase = \"rayleigh\""), "unknown phase"),
+            (format!("{fog}region = \"fog.obj\"\n"), "not supported yet"),
+            (format!("{fog}{fog}"), "only one medium"),
+            ("\n[[medium]]\n".to_string(), "does nothing"),
+        ] {
+            let e = err(&format!("{BASE}{bad}"));
+            assert!(e.context.starts_with("[[medium]]") && e.message.contains(words), "{e}");
+        }
     }
 
     #[test]

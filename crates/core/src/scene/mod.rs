@@ -29,6 +29,8 @@ pub struct Scene {
     pub surfaces: Vec<Surface>,
     pub lights: Vec<Light>,
     pub accel: Accel,
+    /// A participating medium filling the whole scene, if any.
+    pub medium: Option<crate::medium::Medium>,
 }
 
 impl Scene {
