@@ -114,7 +114,11 @@ fn bad_scene_files_are_reported_with_file_and_line() {
             SCENE.replace("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 0.0, 3.0]"),
             &["camera.toml:", "[camera]", "coincide"],
         ),
-        ("fog.toml", format!("{SCENE}\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n"), &["fog.toml", "[[medium]]", "issue #4"]),
+        (
+            "fog.toml",
+            format!("{SCENE}\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n"),
+            &["fog.toml", "[[medium]]", "issue #4"],
+        ),
     ];
     for (name, text, words) in cases {
         std::fs::write(dir.join(name), text).unwrap();

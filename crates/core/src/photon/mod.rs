@@ -24,8 +24,11 @@ pub enum PathClass {
     Direct = 0,
     /// L S+ D: through one or more specular bounces only (the caustic map).
     Caustic = 1,
-    /// At least one diffuse bounce before this hit (the global-map estimate).
+    /// At least one diffuse bounce (or volume scattering) before this hit
+    /// (the global-map estimate).
     Indirect = 2,
+    /// A scattering event in a participating medium (the volume map).
+    Volume = 3,
 }
 
 /// A stored photon: 20 bytes, `#[repr(C)]` so it can be uploaded as is.
@@ -66,7 +69,8 @@ impl Photon {
         match self.direction_and_class >> 30 {
             0 => PathClass::Direct,
             1 => PathClass::Caustic,
-            _ => PathClass::Indirect,
+            2 => PathClass::Indirect,
+            _ => PathClass::Volume,
         }
     }
 }

@@ -6,6 +6,7 @@
 use super::{PathClass, Photon};
 use crate::geometry::Ray;
 use crate::material::{Event, Material, Rgb, dielectric_split, mean, reflect};
+use crate::medium::Flight;
 use crate::progress::Progress;
 use crate::sampling::{Rng, cosine_hemisphere, local_to_world};
 use crate::scene::Scene;
@@ -43,6 +44,9 @@ pub struct TracedPhotons {
     pub global: Vec<Photon>,
     /// L S+ D photons only.
     pub caustic: Vec<Photon>,
+    /// Scattering events in the scene's medium (METHOD.md §5.2), with the
+    /// power they scatter.
+    pub volume: Vec<Photon>,
     /// Watts per unit of stored photon power (`Photon::power_in_units`).
     pub power_unit: f32,
     pub stats: TraceStats,
@@ -78,12 +82,14 @@ pub fn trace_photons(scene: &Scene, settings: &TraceSettings, progress: &dyn Pro
     let mut traced = TracedPhotons {
         global: Vec::with_capacity(results.iter().map(|r| r.global.len()).sum()),
         caustic: Vec::with_capacity(results.iter().map(|r| r.caustic.len()).sum()),
+        volume: Vec::with_capacity(results.iter().map(|r| r.volume.len()).sum()),
         power_unit,
         stats: TraceStats { emitted: n, ..Default::default() },
     };
     for r in results {
         traced.global.extend(r.global);
         traced.caustic.extend(r.caustic);
+        traced.volume.extend(r.volume);
         let per_bounce = &mut traced.stats.stored_flux_per_bounce;
         if per_bounce.len() < r.flux_per_bounce.len() {
             per_bounce.resize(r.flux_per_bounce.len(), Rgb::ZERO);
@@ -100,6 +106,7 @@ pub fn trace_photons(scene: &Scene, settings: &TraceSettings, progress: &dyn Pro
 struct ChunkResult {
     global: Vec<Photon>,
     caustic: Vec<Photon>,
+    volume: Vec<Photon>,
     flux_per_bounce: Vec<Rgb>,
     truncated: u64,
 }
@@ -139,9 +146,29 @@ impl PathTracer<'_> {
         let (mut diffuse_bounces, mut specular_bounces) = (0u32, 0u32);
 
         for _ in 0..self.settings.max_bounces {
-            let Some(hit) = self.scene.accel.intersect(&ray) else {
-                return;
-            };
+            let hit = self.scene.accel.intersect(&ray);
+            // Free flight through the medium, if any (eq. 5.10–5.12).
+            if let Some(medium) = &self.scene.medium {
+                match medium.sample_flight(rng.next_f32(), hit.map_or(f32::INFINITY, |h| h.t)) {
+                    Flight::Passed { weight } => power *= weight,
+                    Flight::Interaction { distance, weight } => {
+                        let lambda = medium.scattering_probability();
+                        if rng.next_f32() >= lambda {
+                            return; // absorbed
+                        }
+                        // Scattered: power × (σ_s/σ_t)/Λ per channel, stored as it leaves.
+                        let sigma_t = medium.sigma_t();
+                        let albedo = Rgb::select(sigma_t.cmpgt(Rgb::ZERO), medium.sigma_s / sigma_t, Rgb::ZERO);
+                        power *= weight * albedo / lambda;
+                        let x = ray.at(distance);
+                        self.out.volume.push(Photon::new(x, power, ray.dir, PathClass::Volume));
+                        diffuse_bounces += 1;
+                        ray = Ray::new(x, medium.phase.sample(ray.dir, rng.next_2d()));
+                        continue;
+                    }
+                }
+            }
+            let Some(hit) = hit else { return };
             let material = self.scene.material(&hit);
             // Normals on the side the photon arrives from.
             let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
@@ -211,6 +238,7 @@ mod tests {
     use super::*;
     use crate::progress::Silent;
     use crate::test_scenes;
+    use glam::Vec3;
 
     #[test]
     fn identical_maps_with_one_and_two_threads() {
@@ -248,6 +276,45 @@ mod tests {
             assert!(rel < 0.03, "bounce {k}: stored {got}, expected {expected}");
         }
         assert_eq!(traced.stats.truncated, 0);
+    }
+
+    /// A purely absorbing medium inside the furnace sphere: the first-bounce
+    /// flux is Φ e^(−σ_a R), and nothing scatters.
+    #[test]
+    fn absorbing_medium_attenuates_stored_flux() {
+        let mut scene = test_scenes::furnace(Vec3::splat(0.5), 1.0);
+        let sigma_a = Vec3::new(0.3, 0.6, 1.2);
+        scene.medium = Some(crate::medium::Medium {
+            sigma_a,
+            sigma_s: Vec3::ZERO,
+            phase: crate::medium::Phase::Schlick { k: 0.0 },
+        });
+        let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 8, ..Default::default() }, &Silent);
+        assert!(traced.volume.is_empty());
+        let expected = scene.lights[0].power() * (-sigma_a).exp();
+        let got = traced.stats.stored_flux_per_bounce[0];
+        assert!(((got - expected) / expected).abs().max_element() < 0.02, "{got} vs {expected}");
+    }
+
+    /// A scattering medium fills the volume map, identically for any thread count.
+    #[test]
+    fn scattering_medium_fills_the_volume_map_deterministically() {
+        let mut scene = Scene::load("cornell-box").unwrap();
+        scene.medium = Some(crate::medium::Medium {
+            sigma_a: Vec3::splat(0.05),
+            sigma_s: Vec3::new(0.2, 0.3, 0.4),
+            phase: crate::medium::Phase::HenyeyGreenstein { g: 0.3 },
+        });
+        let settings = TraceSettings { photons: 20_000, seed: 9, ..Default::default() };
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| trace_photons(&scene, &settings, &Silent))
+        };
+        let (a, b) = (run(1), run(2));
+        assert!(a.volume.len() > 1000);
+        assert!(a.volume.iter().all(|p| p.class() == PathClass::Volume));
+        assert_eq!(a.volume, b.volume);
+        assert_eq!(a.global, b.global);
     }
 
     #[test]
