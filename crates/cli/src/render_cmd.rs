@@ -94,8 +94,13 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// Traces photons, then splats them on the GPU or estimates them on the CPU.
-fn render_photons(args: &RenderArgs, scene: &Scene, progress: &TerminalProgress) -> Result<(Image, u64)> {
-    let gpu = match args.renderer {
+fn render_photons(
+    args: &RenderArgs,
+    renderer: RendererKind,
+    scene: &Scene,
+    progress: &TerminalProgress,
+) -> Result<(Image, u64)> {
+    let gpu = match renderer {
         RendererKind::Gpu => match GpuContext::new() {
             Ok(ctx) => Some(ctx),
             Err(e) => {
@@ -110,10 +115,11 @@ fn render_photons(args: &RenderArgs, scene: &Scene, progress: &TerminalProgress)
         trace_photons(scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, progress);
     let trace_time = trace_start.elapsed().as_secs_f64();
     eprintln!(
-        "photons: {} emitted, {} stored in the global map, {} in the caustic map; {:.2} M paths/s ({:.2} s)",
+        "photons: {} emitted, {} stored in the global map, {} in the caustic map, {} in the volume map; {:.2} M paths/s ({:.2} s)",
         traced.stats.emitted,
         traced.global.len(),
         traced.caustic.len(),
+        traced.volume.len(),
         traced.stats.emitted as f64 / trace_time / 1e6,
         trace_time
     );
@@ -199,25 +205,35 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let mut scene = Scene::load(&args.scene)?;
+    // Participating media: photon-cpu draws a homogeneous medium; the GPU
+    // renderer and the path tracer do not yet (issue #4).
+    let mut renderer = args.renderer;
     if scene.medium.is_some() {
-        bail!(
-            "{}: the scene has a [[medium]], and no renderer draws participating media yet (issue #4); remove it to render",
-            scene.source
-        );
+        match renderer {
+            RendererKind::Gpu => {
+                eprintln!("the GPU renderer does not draw participating media yet: using photon-cpu");
+                renderer = RendererKind::PhotonCpu;
+            }
+            RendererKind::Path => bail!(
+                "{}: the path tracer does not draw participating media yet (issue #4); use --renderer photon-cpu",
+                scene.source
+            ),
+            RendererKind::PhotonCpu => {}
+        }
     }
     if let Some((w, h)) = args.resolution {
         scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
-    let (image, nonfinite) = match args.renderer {
+    let (image, nonfinite) = match renderer {
         RendererKind::Path => {
             let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
             let result = path::render(&scene, &settings, &progress);
             eprintln!("path tracing: {} spp", settings.spp);
             result
         }
-        RendererKind::Gpu | RendererKind::PhotonCpu => render_photons(args, &scene, &progress)?,
+        RendererKind::Gpu | RendererKind::PhotonCpu => render_photons(args, renderer, &scene, &progress)?,
     };
     if nonfinite > 0 {
         eprintln!("warning: {nonfinite} non-finite samples were dropped");

@@ -114,17 +114,29 @@ fn bad_scene_files_are_reported_with_file_and_line() {
             SCENE.replace("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 0.0, 3.0]"),
             &["camera.toml:", "[camera]", "coincide"],
         ),
-        (
-            "fog.toml",
-            format!("{SCENE}\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n"),
-            &["fog.toml", "[[medium]]", "issue #4"],
-        ),
     ];
     for (name, text, words) in cases {
         std::fs::write(dir.join(name), text).unwrap();
         let out = hikari(&["render", name, "-o", "out.png", "-q"], &dir);
         assert_fails_with(&out, &dir, words);
     }
+}
+
+/// photon-cpu renders a scene with a medium; the default GPU renderer says it
+/// cannot and uses photon-cpu; the path tracer refuses.
+#[test]
+fn media_are_rendered_by_photon_cpu() {
+    let dir = scratch_dir("fog");
+    std::fs::write(dir.join("fog.toml"), format!("{SCENE}\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n")).unwrap();
+    let out = hikari(&["render", "fog.toml", "--photons", "2000", "-o", "fog.png", "-q"], &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("does not draw participating media yet: using photon-cpu"), "{err}");
+    assert!(err.contains("in the volume map"), "{err}");
+    assert!(dir.join("fog.png").is_file());
+    let _ = std::fs::remove_file(dir.join("fog.png"));
+    let out = hikari(&["render", "fog.toml", "--renderer", "path", "-o", "p.png"], &dir);
+    assert_fails_with(&out, &dir, &["fog.toml", "path tracer", "issue #4"]);
 }
 
 #[test]

@@ -19,10 +19,12 @@ pub struct Components {
     pub direct: bool,
     pub indirect: bool,
     pub caustic: bool,
+    /// In-scattered light from the volume map (scenes with a medium).
+    pub volume: bool,
 }
 
 impl Components {
-    pub const ALL: Components = Components { direct: true, indirect: true, caustic: true };
+    pub const ALL: Components = Components { direct: true, indirect: true, caustic: true, volume: true };
 }
 
 #[derive(Clone, Debug)]
@@ -31,6 +33,8 @@ pub struct PhotonCpuSettings {
     pub radius: Option<f32>,
     /// Caustic-map radius; None: `default_caustic_radius`.
     pub caustic_radius: Option<f32>,
+    /// Volume-map radius; None: `default_radius`.
+    pub volume_radius: Option<f32>,
     pub spp: u32,
     pub seed: u64,
     /// Shadow-ray samples per area light at each shaded point.
@@ -47,6 +51,7 @@ impl Default for PhotonCpuSettings {
         PhotonCpuSettings {
             radius: None,
             caustic_radius: None,
+            volume_radius: None,
             spp: 4,
             seed: 0,
             area_light_samples: 4,
@@ -78,6 +83,8 @@ pub struct PhotonCpuRenderer<'a> {
     /// Indirect-class photons only: what the global-map estimate shows.
     global: PhotonMap,
     caustic: PhotonMap,
+    volume: PhotonMap,
+    pub volume_radius: f32,
     pub global_params: FixedRadius,
     pub caustic_params: FixedRadius,
     settings: PhotonCpuSettings,
@@ -90,6 +97,8 @@ impl<'a> PhotonCpuRenderer<'a> {
             scene,
             global: PhotonMap::new(indirect, traced.power_unit),
             caustic: PhotonMap::new(traced.caustic.clone(), traced.power_unit),
+            volume: PhotonMap::new(traced.volume.clone(), traced.power_unit),
+            volume_radius: settings.volume_radius.unwrap_or_else(|| default_radius(scene)),
             global_params: FixedRadius {
                 radius: settings.radius.unwrap_or_else(|| default_radius(scene)),
                 normal_test: settings.normal_test,
@@ -124,11 +133,31 @@ impl<'a> PhotonCpuRenderer<'a> {
         l
     }
 
-    /// Radiance arriving along `ray`, with `depth` specular bounces so far.
+    /// Radiance arriving along `ray`, with `depth` specular bounces so far:
+    /// the surface's, attenuated by the medium, plus in-scattered light.
     pub fn radiance(&self, ray: &Ray, depth: u32, rng: &mut Rng) -> Rgb {
-        let Some(hit) = self.scene.accel.intersect(ray) else {
-            return Rgb::ZERO;
+        let hit = self.scene.accel.intersect(ray);
+        let surface = hit.map_or(Rgb::ZERO, |h| self.surface_radiance(ray, &h, depth, rng));
+        let Some(medium) = &self.scene.medium else { return surface };
+        let length = hit.map_or_else(|| self.scene.diagonal() * 2.0, |h| h.t);
+        let volume = if self.settings.components.volume {
+            crate::estimate::volume_radiance_along(
+                &self.volume,
+                medium,
+                ray.origin,
+                ray.dir,
+                length,
+                self.volume_radius,
+            )
+        } else {
+            Rgb::ZERO
         };
+        medium.transmittance(length) * surface + volume
+    }
+
+    /// Radiance leaving the surface at `hit` toward the ray's origin.
+    fn surface_radiance(&self, ray: &Ray, hit: &crate::geometry::Hit, depth: u32, rng: &mut Rng) -> Rgb {
+        let hit = *hit;
         if let Some(light) = self.scene.emitter(&hit) {
             return light.emitted_radiance(ray.dir, hit.geometric_normal);
         }
