@@ -205,8 +205,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let mut scene = Scene::load(&args.scene)?;
-    // Participating media: photon-cpu draws a homogeneous medium; the GPU
-    // renderer and the path tracer do not yet (issue #4).
+    // Participating media: photon-cpu and the path tracer draw a homogeneous
+    // medium; the GPU renderer does not yet (issue #4).
     let mut renderer = args.renderer;
     if scene.medium.is_some() {
         match renderer {
@@ -214,11 +214,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 eprintln!("the GPU renderer does not draw participating media yet: using photon-cpu");
                 renderer = RendererKind::PhotonCpu;
             }
-            RendererKind::Path => bail!(
-                "{}: the path tracer does not draw participating media yet (issue #4); use --renderer photon-cpu",
-                scene.source
-            ),
-            RendererKind::PhotonCpu => {}
+            RendererKind::PhotonCpu | RendererKind::Path => {}
         }
     }
     if let Some((w, h)) = args.resolution {

@@ -115,3 +115,23 @@ fn volume_estimate_follows_the_phase_function() {
     eprintln!("g = +0.5 / g = −0.5: photon map {ratio:.3}, integrals {want:.3}");
     assert!((ratio / want - 1.0).abs() < 0.05, "ratio {ratio} vs {want}");
 }
+
+/// The path tracer in the same fog: the full solution, whose multiple
+/// scattering (albedo 0.02) adds a few percent to the single-scattering integral.
+#[test]
+fn path_tracer_matches_single_scattering_integral() {
+    let scene = fog_scene(0.5);
+    let settings = hikari_core::render::path::PathSettings { spp: 64, seed: 5, ..Default::default() };
+    let (image, nonfinite) = hikari_core::render::path::render(&scene, &settings, &Silent);
+    assert_eq!(nonfinite, 0);
+    let (mut got, mut want) = (0.0, 0.0);
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            got += image.get(x, y).x as f64;
+            want += single_scattering(&scene, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        }
+    }
+    let rel = got / want - 1.0;
+    eprintln!("path tracer: {got:.5}, single-scattering integral {want:.5} ({:+.2}%)", rel * 100.0);
+    assert!(rel > -0.03 && rel < 0.08, "relative difference {rel}");
+}
