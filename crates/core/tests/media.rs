@@ -135,3 +135,41 @@ fn path_tracer_matches_single_scattering_integral() {
     eprintln!("path tracer: {got:.5}, single-scattering integral {want:.5} ({:+.2}%)", rel * 100.0);
     assert!(rel > -0.03 && rel < 0.08, "relative difference {rel}");
 }
+
+/// photon-cpu against the path tracer on `fog-stage` (64×48): the spot's
+/// cone in the fog. Region of interest: pixels whose centre ray crosses the
+/// cone (sampled every 2 cm before its surface hit) and then hits a surface
+/// outside the cone, so in-scattered light is most of their value; the means
+/// over that mask must agree within 10%.
+#[test]
+fn fog_stage_cone_matches_path_tracer() {
+    let mut scene = Scene::load("fog-stage").unwrap();
+    scene.camera = scene.camera.with_resolution(64, 48).unwrap();
+    let hikari_core::light::Light::Spot { position, axis, cutoff, .. } = scene.lights[0] else { panic!("spot light") };
+    let in_cone = |p: glam::Vec3| (p - position).normalize().dot(axis) > cutoff.cos();
+    let mut mask = Vec::new();
+    for y in 0..48 {
+        for x in 0..64 {
+            let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let keep = scene.accel.intersect(&ray).is_some_and(|hit| {
+                let steps = (hit.t / 0.02) as u32;
+                !in_cone(hit.point) && (0..steps).any(|i| in_cone(ray.at(i as f32 * 0.02)))
+            });
+            mask.push(keep);
+        }
+    }
+    let kept = mask.iter().filter(|&&m| m).count();
+    assert!(kept > 300, "only {kept} pixels in the region of interest");
+    let traced = trace_photons(&scene, &TraceSettings { photons: 100_000, seed: 4, ..Default::default() }, &Silent);
+    let settings = PhotonCpuSettings { spp: 1, ..Default::default() };
+    let (photon, _) = PhotonCpuRenderer::new(&scene, &traced, &settings).render(&Silent);
+    let path_settings = hikari_core::render::path::PathSettings { spp: 32, seed: 6, ..Default::default() };
+    let (truth, _) = hikari_core::render::path::render(&scene, &path_settings, &Silent);
+    let mean = |img: &hikari_core::render::Image| {
+        img.pixels.iter().zip(&mask).filter(|(_, m)| **m).map(|(p, _)| ((p.x + p.y + p.z) / 3.0) as f64).sum::<f64>()
+            / kept as f64
+    };
+    let (p, t) = (mean(&photon), mean(&truth));
+    eprintln!("fog-stage cone ({kept} pixels): photon-cpu {p:.5}, path {t:.5} ({:+.2}%)", (p / t - 1.0) * 100.0);
+    assert!((p / t - 1.0).abs() < 0.10);
+}

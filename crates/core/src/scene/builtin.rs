@@ -1,7 +1,7 @@
 //! Built-in scenes: scene files stored in the repository's `scenes/` folder
 //! and embedded in the binary, so users can copy and edit them.
 
-pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic"];
+pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic", "fog-stage"];
 
 pub const DEFAULT: &str = "cornell-box";
 
@@ -9,6 +9,7 @@ pub fn source(name: &str) -> Option<&'static str> {
     match name {
         "cornell-box" => Some(include_str!("../../../../scenes/cornell-box.toml")),
         "cornell-caustic" => Some(include_str!("../../../../scenes/cornell-caustic.toml")),
+        "fog-stage" => Some(include_str!("../../../../scenes/fog-stage.toml")),
         _ => None,
     }
 }
