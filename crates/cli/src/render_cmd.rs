@@ -132,9 +132,7 @@ fn render_photons(
         normal_test: args.normal_test,
         ..Default::default()
     };
-    let build_start = Instant::now();
-    let cpu = photon_cpu::PhotonCpuRenderer::new(scene, &traced, &settings);
-    let (global, caustic) = (cpu.global_params, cpu.caustic_params);
+    let (global, caustic) = settings.estimate_params(scene);
     eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
     if let Some(ctx) = gpu {
         let adapter = ctx.describe();
@@ -163,6 +161,8 @@ fn render_photons(
         );
         return Ok(result);
     }
+    let build_start = Instant::now();
+    let cpu = photon_cpu::PhotonCpuRenderer::new(scene, &traced, &settings);
     let build_time = build_start.elapsed().as_secs_f64();
     let render_start = Instant::now();
     let result = cpu.render(progress);

@@ -4,7 +4,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec2;
 use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, k_nearest_radiance};
-use hikari_core::photon::{PathClass, PhotonMap, TraceSettings, trace_photons};
+use hikari_core::photon::{PhotonMap, TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::{Rng, cosine_hemisphere, local_to_world, uniform_sphere};
@@ -51,8 +51,7 @@ fn photon_tracing(c: &mut Criterion) {
 fn estimates(c: &mut Criterion) {
     let scene = Scene::load("cornell-box").unwrap();
     let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 1, ..Default::default() }, &Silent);
-    let indirect: Vec<_> = traced.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect();
-    let map = PhotonMap::new(indirect, traced.power_unit);
+    let map = PhotonMap::new(traced.indirect(), traced.power_unit);
     let mut rng = Rng::for_item(2, 0);
     let queries: Vec<_> = (0..1024)
         .filter_map(|_| {

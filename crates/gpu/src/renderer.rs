@@ -15,7 +15,7 @@ use crate::splat::{PhotonBuffer, SplatParams, SplatPass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
 use hikari_core::lod::LodSettings;
-use hikari_core::photon::{PathClass, Photon, TracedPhotons};
+use hikari_core::photon::TracedPhotons;
 use hikari_core::render::Image;
 use hikari_core::scene::Scene;
 
@@ -126,12 +126,6 @@ pub struct GpuRenderer {
     camera_position: Vec3,
 }
 
-/// The photons the global-map estimate shows: indirect ones only, as in
-/// `photon-cpu` (direct light and caustics are rendered separately).
-pub fn global_map_photons(traced: &TracedPhotons) -> Vec<Photon> {
-    traced.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect()
-}
-
 /// Near and far planes enclosing the scene's bounding box.
 fn depth_range(scene: &Scene) -> (f32, f32) {
     let (lo, hi) = scene.accel.bounds();
@@ -180,7 +174,7 @@ impl GpuRenderer {
         };
         let (near, far) = depth_range(scene);
         let scene_buffers = SceneBuffers::upload(device, scene);
-        let global_photons = global_map_photons(traced);
+        let global_photons = traced.indirect();
         let specular_pass = SpecularPass::new(
             device,
             scene,
@@ -211,7 +205,7 @@ impl GpuRenderer {
             lights,
             scene: scene_buffers,
             global_lod: lod_pass
-                .create_output(device, &PhotonBuffer::upload(device, &global_map_photons(traced), "global photons")),
+                .create_output(device, &PhotonBuffer::upload(device, &traced.indirect(), "global photons")),
             caustic_lod: lod_pass
                 .create_output(device, &PhotonBuffer::upload(device, &traced.caustic, "caustic photons")),
             lod_pass,

@@ -5,9 +5,8 @@
 use hikari_core::lod::{detail_level, group_of, power_scale};
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
-use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use hikari_core::render::photon_cpu::PhotonCpuSettings;
 use hikari_core::scene::Scene;
-use hikari_gpu::renderer::global_map_photons;
 use hikari_gpu::test_support::context_or_skip;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
@@ -19,12 +18,12 @@ fn lod_draws_the_predicted_photons_and_keeps_the_image_mean() {
     let mut scene = Scene::load("cornell-box").unwrap();
     scene.camera = scene.camera.with_resolution(64, 64).unwrap();
     let traced = trace_photons(&scene, &TraceSettings { photons: 10_000, seed: 3, ..Default::default() }, &Silent);
-    let cpu = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
-    let mut gpu = GpuRenderer::new(ctx, &scene, &traced, GpuSettings::new(cpu.global_params, cpu.caustic_params));
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let mut gpu = GpuRenderer::new(ctx, &scene, &traced, GpuSettings::new(global, caustic));
 
     // LOD off: every photon is drawn.
     gpu.render();
-    let photons = global_map_photons(&traced);
+    let photons = traced.indirect();
     assert_eq!(gpu.drawn_photons().unwrap().0 as usize, photons.len());
     let mean = |v: &[glam::Vec4]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>() / v.len() as f64;
     let off = mean(&gpu.read(&gpu.targets.indirect).unwrap());

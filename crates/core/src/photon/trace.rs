@@ -52,6 +52,14 @@ pub struct TracedPhotons {
     pub stats: TraceStats,
 }
 
+impl TracedPhotons {
+    /// The global map's `Indirect` photons: what the global-map estimate
+    /// shows, since direct light and caustics are rendered separately.
+    pub fn indirect(&self) -> Vec<Photon> {
+        self.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect()
+    }
+}
+
 /// Photons per parallel work item: large enough to amortise scheduling.
 const CHUNK: u64 = 4096;
 

@@ -8,7 +8,7 @@ use super::{Image, direct_diffuse, render_pixels};
 use crate::estimate::{FixedRadius, fixed_radius_radiance};
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, dielectric_split, reflect};
-use crate::photon::{PathClass, PhotonMap, TracedPhotons};
+use crate::photon::{PhotonMap, TracedPhotons};
 use crate::progress::Progress;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -68,6 +68,20 @@ impl Default for PhotonCpuSettings {
     }
 }
 
+impl PhotonCpuSettings {
+    /// The global-map and caustic-map estimates these settings ask for in
+    /// `scene` (defaults filled in): what the GPU renderer uses too.
+    pub fn estimate_params(&self, scene: &Scene) -> (FixedRadius, FixedRadius) {
+        let global =
+            FixedRadius { radius: self.radius.unwrap_or_else(|| default_radius(scene)), normal_test: self.normal_test };
+        let caustic = FixedRadius {
+            radius: self.caustic_radius.unwrap_or_else(|| default_caustic_radius(scene)),
+            normal_test: self.normal_test,
+        };
+        (global, caustic)
+    }
+}
+
 /// Default global radius: 3% of the scene's bounding-box diagonal.
 pub fn default_radius(scene: &Scene) -> f32 {
     0.03 * scene.diagonal()
@@ -92,21 +106,15 @@ pub struct PhotonCpuRenderer<'a> {
 
 impl<'a> PhotonCpuRenderer<'a> {
     pub fn new(scene: &'a Scene, traced: &TracedPhotons, settings: &PhotonCpuSettings) -> Self {
-        let indirect = traced.global.iter().filter(|p| p.class() == PathClass::Indirect).copied().collect();
+        let (global_params, caustic_params) = settings.estimate_params(scene);
         PhotonCpuRenderer {
             scene,
-            global: PhotonMap::new(indirect, traced.power_unit),
+            global: PhotonMap::new(traced.indirect(), traced.power_unit),
             caustic: PhotonMap::new(traced.caustic.clone(), traced.power_unit),
             volume: PhotonMap::new(traced.volume.clone(), traced.power_unit),
             volume_radius: settings.volume_radius.unwrap_or_else(|| default_radius(scene)),
-            global_params: FixedRadius {
-                radius: settings.radius.unwrap_or_else(|| default_radius(scene)),
-                normal_test: settings.normal_test,
-            },
-            caustic_params: FixedRadius {
-                radius: settings.caustic_radius.unwrap_or_else(|| default_caustic_radius(scene)),
-                normal_test: settings.normal_test,
-            },
+            global_params,
+            caustic_params,
             settings: settings.clone(),
         }
     }
