@@ -208,7 +208,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Participating media: photon-cpu and the path tracer draw a homogeneous
     // medium; the GPU renderer does not yet (issue #4).
     let mut renderer = args.renderer;
-    if scene.medium.is_some() {
+    if !scene.media.is_empty() {
         match renderer {
             RendererKind::Gpu => {
                 eprintln!("the GPU renderer does not draw participating media yet: using photon-cpu");

@@ -83,14 +83,17 @@ pub fn fixed_radius_radiance(
 /// p(μ_p) · ΔΦ_p / ((4/3)π r³) · t_p · T(s_p), where t_p is the length of the
 /// segment inside the sphere, s_p the point of that chord nearest the photon,
 /// μ_p the cosine between the photon's direction and the direction toward
-/// the eye, and T the medium's transmittance from the eye.
+/// the eye, p the phase function of the photon's slot in `phases`, and
+/// `transmittance(s)` that of the media from the eye to distance s (exact in
+/// photon-cpu; interpolated between depth slices in the GPU's twin).
 pub fn volume_radiance_along(
     map: &PhotonMap,
-    medium: &crate::medium::Medium,
+    phases: &[crate::medium::Phase],
     origin: Vec3,
     dir: Vec3,
     length: f32,
     radius: f32,
+    transmittance: impl Fn(f32) -> Rgb,
 ) -> Rgb {
     let photons = map.photons();
     if photons.is_empty() || !(length > 0.0) {
@@ -124,7 +127,8 @@ pub fn volume_radiance_along(
         }
         let s_p = t_closest.clamp(t0, t1);
         let mu = photon.direction().dot(-dir);
-        sum += medium.transmittance(s_p) * map.power_in_units(index as usize) * (medium.phase.eval(mu) * (t1 - t0));
+        let phase = phases[photon.phase_slot()].eval(mu);
+        sum += transmittance(s_p) * map.power_in_units(index as usize) * (phase * (t1 - t0));
     }
     sum * norm * map.power_unit
 }

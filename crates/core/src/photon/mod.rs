@@ -27,8 +27,6 @@ pub enum PathClass {
     /// At least one diffuse bounce (or volume scattering) before this hit
     /// (the global-map estimate).
     Indirect = 2,
-    /// A scattering event in a participating medium (the volume map).
-    Volume = 3,
 }
 
 /// A stored photon: 20 bytes, `#[repr(C)]` so it can be uploaded as is.
@@ -38,7 +36,9 @@ pub struct Photon {
     pub position: [f32; 3],
     /// Power in units of the map's `power_unit`, RGB9E5-encoded.
     pub power_rgb9e5: u32,
-    /// Bits 0–29: octahedral incident direction; bits 30–31: `PathClass`.
+    /// Bits 0–29: octahedral incident direction; bits 30–31: `PathClass`
+    /// in the surface maps, the phase slot (`medium::Media::phases`) of the
+    /// medium that scattered it in the volume map.
     pub direction_and_class: u32,
 }
 
@@ -48,6 +48,17 @@ impl Photon {
             position: position.to_array(),
             power_rgb9e5: encoding::encode_rgb9e5(power_in_units),
             direction_and_class: encoding::encode_octahedral_15(direction) | ((class as u32) << 30),
+        }
+    }
+
+    /// A scattering event in a medium (the volume map), with the phase slot
+    /// of the medium that scattered it.
+    pub fn volume(position: Vec3, power_in_units: Rgb, direction: Vec3, phase_slot: u8) -> Self {
+        debug_assert!((phase_slot as usize) < crate::medium::MAX_PHASES);
+        Photon {
+            position: position.to_array(),
+            power_rgb9e5: encoding::encode_rgb9e5(power_in_units),
+            direction_and_class: encoding::encode_octahedral_15(direction) | ((phase_slot as u32 & 3) << 30),
         }
     }
 
@@ -69,9 +80,14 @@ impl Photon {
         match self.direction_and_class >> 30 {
             0 => PathClass::Direct,
             1 => PathClass::Caustic,
-            2 => PathClass::Indirect,
-            _ => PathClass::Volume,
+            // Surface photons never hold 3.
+            _ => PathClass::Indirect,
         }
+    }
+
+    /// Volume-map photons: which phase function scattered this one.
+    pub fn phase_slot(&self) -> usize {
+        (self.direction_and_class >> 30) as usize
     }
 }
 

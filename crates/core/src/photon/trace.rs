@@ -155,23 +155,23 @@ impl PathTracer<'_> {
 
         for _ in 0..self.settings.max_bounces {
             let hit = self.scene.accel.intersect(&ray);
-            // Free flight through the medium, if any (eq. 5.10–5.12).
-            if let Some(medium) = &self.scene.medium {
-                match medium.sample_flight(rng.next_f32(), hit.map_or(f32::INFINITY, |h| h.t)) {
+            // Free flight through the media, if any (eq. 5.10–5.12).
+            let media = &self.scene.media;
+            if !media.is_empty() {
+                match media.sample_flight(ray.origin, ray.dir, hit.map_or(f32::INFINITY, |h| h.t), rng.next_f32()) {
                     Flight::Passed { weight } => power *= weight,
-                    Flight::Interaction { distance, weight } => {
-                        let lambda = medium.scattering_probability();
+                    Flight::Interaction { distance, weight, mask } => {
+                        let (lambda, albedo) = media.scattering(mask);
                         if rng.next_f32() >= lambda {
                             return; // absorbed
                         }
-                        // Scattered: power × (σ_s/σ_t)/Λ per channel, stored as it leaves.
-                        let sigma_t = medium.sigma_t();
-                        let albedo = Rgb::select(sigma_t.cmpgt(Rgb::ZERO), medium.sigma_s / sigma_t, Rgb::ZERO);
-                        power *= weight * albedo / lambda;
+                        // Scattered: stored with the power it leaves with.
+                        power *= weight * albedo;
                         let x = ray.at(distance);
-                        self.out.volume.push(Photon::new(x, power, ray.dir, PathClass::Volume));
+                        let scatterer = media.choose_scatterer(mask, rng.next_f32());
+                        self.out.volume.push(Photon::volume(x, power, ray.dir, scatterer.phase_slot));
                         diffuse_bounces += 1;
-                        ray = Ray::new(x, medium.phase.sample(ray.dir, rng.next_2d()));
+                        ray = Ray::new(x, scatterer.medium.phase.sample(ray.dir, rng.next_2d()));
                         continue;
                     }
                 }
@@ -244,6 +244,7 @@ impl PathTracer<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::medium::{Media, Medium, Phase};
     use crate::progress::Silent;
     use crate::test_scenes;
     use glam::Vec3;
@@ -292,11 +293,7 @@ mod tests {
     fn absorbing_medium_attenuates_stored_flux() {
         let mut scene = test_scenes::furnace(Vec3::splat(0.5), 1.0);
         let sigma_a = Vec3::new(0.3, 0.6, 1.2);
-        scene.medium = Some(crate::medium::Medium {
-            sigma_a,
-            sigma_s: Vec3::ZERO,
-            phase: crate::medium::Phase::Schlick { k: 0.0 },
-        });
+        scene.media = Media::homogeneous(Medium { sigma_a, sigma_s: Vec3::ZERO, phase: Phase::Schlick { k: 0.0 } });
         let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 8, ..Default::default() }, &Silent);
         assert!(traced.volume.is_empty());
         let expected = scene.lights[0].power() * (-sigma_a).exp();
@@ -308,10 +305,10 @@ mod tests {
     #[test]
     fn scattering_medium_fills_the_volume_map_deterministically() {
         let mut scene = Scene::load("cornell-box").unwrap();
-        scene.medium = Some(crate::medium::Medium {
+        scene.media = Media::homogeneous(Medium {
             sigma_a: Vec3::splat(0.05),
             sigma_s: Vec3::new(0.2, 0.3, 0.4),
-            phase: crate::medium::Phase::HenyeyGreenstein { g: 0.3 },
+            phase: Phase::HenyeyGreenstein { g: 0.3 },
         });
         let settings = TraceSettings { photons: 20_000, seed: 9, ..Default::default() };
         let run = |threads| {
@@ -320,9 +317,32 @@ mod tests {
         };
         let (a, b) = (run(1), run(2));
         assert!(a.volume.len() > 1000);
-        assert!(a.volume.iter().all(|p| p.class() == PathClass::Volume));
+        assert!(a.volume.iter().all(|p| p.phase_slot() == 0));
         assert_eq!(a.volume, b.volume);
         assert_eq!(a.global, b.global);
+    }
+
+    /// Two media filling the same space, with different phase functions:
+    /// each stores its share σ_s,i / Σσ_s of the scattering events, under its
+    /// own phase slot.
+    #[test]
+    fn overlapping_media_scatter_in_proportion_to_sigma_s() {
+        let mut scene = Scene::load("cornell-box").unwrap();
+        let medium = |sigma_s: f32, g: f32| {
+            (
+                Medium {
+                    sigma_a: Vec3::splat(0.02),
+                    sigma_s: Vec3::splat(sigma_s),
+                    phase: Phase::HenyeyGreenstein { g },
+                },
+                None,
+            )
+        };
+        scene.media = Media::new(vec![medium(0.1, 0.5), medium(0.3, -0.3)]).unwrap();
+        let traced = trace_photons(&scene, &TraceSettings { photons: 40_000, seed: 10, ..Default::default() }, &Silent);
+        let second = traced.volume.iter().filter(|p| p.phase_slot() == 1).count() as f64;
+        let share = second / traced.volume.len() as f64;
+        assert!(traced.volume.len() > 5000 && (share - 0.75).abs() < 0.015, "{share} of {}", traced.volume.len());
     }
 
     #[test]

@@ -26,7 +26,7 @@ pub fn direct_diffuse(scene: &Scene, x: Vec3, normal: Vec3, albedo: Rgb, area_sa
             let mut shadow = Ray::new(x, s.wi);
             shadow.t_max = s.distance * (1.0 - 1e-4);
             if !scene.accel.occluded(&shadow) {
-                let transmittance = scene.medium.as_ref().map_or(Rgb::ONE, |m| m.transmittance(s.distance));
+                let transmittance = scene.media.transmittance(x, s.wi, s.distance);
                 light_sum += s.radiance * transmittance * (cos / s.pdf);
             }
         }

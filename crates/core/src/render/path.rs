@@ -1,14 +1,14 @@
 //! `path`: a unidirectional path tracer with next-event estimation and, for
 //! area lights, multiple importance sampling (power heuristic). Ground truth
-//! for the photon renderers. In a homogeneous medium it samples free flights
-//! (the photon tracer's, with the same RGB weights), does next-event
-//! estimation at scattering points through the phase function, and
-//! attenuates shadow rays by the transmittance.
+//! for the photon renderers. In media (homogeneous or regions) it samples
+//! free flights (the photon tracer's, with the same RGB weights), does
+//! next-event estimation at scattering points through the phase function,
+//! and attenuates shadow rays by the transmittance.
 
 use super::{Image, render_pixels};
 use crate::geometry::Ray;
 use crate::material::{Event, Material, Rgb, dielectric_split, mean, reflect};
-use crate::medium::{Flight, Medium};
+use crate::medium::{Flight, Phase};
 use crate::progress::Progress;
 use crate::sampling::{Rng, cosine_hemisphere, local_to_world, power_heuristic};
 use crate::scene::Scene;
@@ -44,23 +44,25 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
     let mut previous = Previous::Specular;
     for _ in 0..settings.max_depth {
         let hit = scene.accel.intersect(&ray);
-        if let Some(medium) = &scene.medium {
-            match medium.sample_flight(rng.next_f32(), hit.map_or(f32::INFINITY, |h| h.t)) {
+        let media = &scene.media;
+        if !media.is_empty() {
+            match media.sample_flight(ray.origin, ray.dir, hit.map_or(f32::INFINITY, |h| h.t), rng.next_f32()) {
                 Flight::Passed { weight } => beta *= weight,
-                Flight::Interaction { distance, weight } => {
-                    let lambda = medium.scattering_probability();
+                Flight::Interaction { distance, weight, mask } => {
+                    let (lambda, albedo) = media.scattering(mask);
                     if rng.next_f32() >= lambda {
                         break; // absorbed
                     }
-                    let sigma_t = medium.sigma_t();
-                    let albedo = Rgb::select(sigma_t.cmpgt(Rgb::ZERO), medium.sigma_s / sigma_t, Rgb::ZERO);
-                    beta *= weight * albedo / lambda;
+                    beta *= weight * albedo;
                     let x = ray.at(distance);
-                    l += beta * medium_next_event(scene, medium, x, ray.dir, rng);
+                    // One medium scatters, chosen ∝ σ_s: its phase function
+                    // serves both light sampling and the next direction.
+                    let phase = media.choose_scatterer(mask, rng.next_f32()).medium.phase;
+                    l += beta * medium_next_event(scene, &phase, x, ray.dir, rng);
                     // Light reaching x along −wi continues along ray.dir
                     // backwards: μ = wi · ray.dir, sampled from the phase function.
-                    let wi = medium.phase.sample(ray.dir, rng.next_2d());
-                    previous = Previous::Diffuse { point: x, pdf: medium.phase.eval(wi.dot(ray.dir)) };
+                    let wi = phase.sample(ray.dir, rng.next_2d());
+                    previous = Previous::Diffuse { point: x, pdf: phase.eval(wi.dot(ray.dir)) };
                     ray = Ray::new(x, wi);
                     continue;
                 }
@@ -142,7 +144,7 @@ fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng:
             continue;
         }
         let weight = if s.is_delta { 1.0 } else { power_heuristic(s.pdf, p_diffuse * cos / PI) };
-        let transmittance = scene.medium.as_ref().map_or(Rgb::ONE, |m| m.transmittance(s.distance));
+        let transmittance = scene.media.transmittance(x, s.wi, s.distance);
         sum += albedo / PI * s.radiance * transmittance * (cos * weight / s.pdf);
     }
     sum
@@ -151,7 +153,7 @@ fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng:
 /// Light scattered at medium point `x` toward the eye (travelling along −`dir`
 /// to reach it): one sample per light through the phase function, MIS-weighted
 /// against phase sampling for area lights.
-fn medium_next_event(scene: &Scene, medium: &Medium, x: Vec3, dir: Vec3, rng: &mut Rng) -> Rgb {
+fn medium_next_event(scene: &Scene, phase_function: &Phase, x: Vec3, dir: Vec3, rng: &mut Rng) -> Rgb {
     let mut sum = Rgb::ZERO;
     for light in &scene.lights {
         let Some(s) = light.sample_incident(x, rng.next_2d()) else { continue };
@@ -163,9 +165,9 @@ fn medium_next_event(scene: &Scene, medium: &Medium, x: Vec3, dir: Vec3, rng: &m
         if scene.accel.occluded(&shadow) {
             continue;
         }
-        let phase = medium.phase.eval(s.wi.dot(dir));
+        let phase = phase_function.eval(s.wi.dot(dir));
         let weight = if s.is_delta { 1.0 } else { power_heuristic(s.pdf, phase) };
-        sum += s.radiance * medium.transmittance(s.distance) * (phase * weight / s.pdf);
+        sum += s.radiance * scene.media.transmittance(x, s.wi, s.distance) * (phase * weight / s.pdf);
     }
     sum
 }

@@ -8,6 +8,7 @@ use super::{Image, direct_diffuse, render_pixels};
 use crate::estimate::{FixedRadius, fixed_radius_radiance};
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, dielectric_split, reflect};
+use crate::medium::MediaAlong;
 use crate::photon::{PhotonMap, TracedPhotons};
 use crate::progress::Progress;
 use crate::sampling::Rng;
@@ -146,21 +147,26 @@ impl<'a> PhotonCpuRenderer<'a> {
     pub fn radiance(&self, ray: &Ray, depth: u32, rng: &mut Rng) -> Rgb {
         let hit = self.scene.accel.intersect(ray);
         let surface = hit.map_or(Rgb::ZERO, |h| self.surface_radiance(ray, &h, depth, rng));
-        let Some(medium) = &self.scene.medium else { return surface };
+        let media = &self.scene.media;
+        if media.is_empty() {
+            return surface;
+        }
         let length = hit.map_or_else(|| self.scene.diagonal() * 2.0, |h| h.t);
+        let along = MediaAlong::new(media, ray.origin, ray.dir, length);
         let volume = if self.settings.components.volume {
             crate::estimate::volume_radiance_along(
                 &self.volume,
-                medium,
+                media.phases(),
                 ray.origin,
                 ray.dir,
                 length,
                 self.volume_radius,
+                |s| along.transmittance(s),
             )
         } else {
             Rgb::ZERO
         };
-        medium.transmittance(length) * surface + volume
+        along.transmittance(length) * surface + volume
     }
 
     /// Radiance leaving the surface at `hit` toward the ray's origin.

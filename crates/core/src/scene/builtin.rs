@@ -1,7 +1,7 @@
 //! Built-in scenes: scene files stored in the repository's `scenes/` folder
 //! and embedded in the binary, so users can copy and edit them.
 
-pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic", "fog-stage"];
+pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic", "fog-stage", "fog-stage-layered"];
 
 pub const DEFAULT: &str = "cornell-box";
 
@@ -10,6 +10,15 @@ pub fn source(name: &str) -> Option<&'static str> {
         "cornell-box" => Some(include_str!("../../../../scenes/cornell-box.toml")),
         "cornell-caustic" => Some(include_str!("../../../../scenes/cornell-caustic.toml")),
         "fog-stage" => Some(include_str!("../../../../scenes/fog-stage.toml")),
+        "fog-stage-layered" => Some(include_str!("../../../../scenes/fog-stage-layered.toml")),
+        _ => None,
+    }
+}
+
+/// Meshes the built-in scenes use, by the path their scene files give.
+pub fn mesh(path: &str) -> Option<&'static str> {
+    match path {
+        "meshes/fog-layer.obj" => Some(include_str!("../../../../scenes/meshes/fog-layer.obj")),
         _ => None,
     }
 }

@@ -7,7 +7,7 @@ use crate::camera::Camera;
 use crate::geometry::{Accel, Sphere, Triangle, TriangleNormals};
 use crate::light::Light;
 use crate::material::Material;
-use crate::medium::{Medium, Phase};
+use crate::medium::{Media, Medium, Phase, RegionMesh};
 use glam::{Mat3, Vec3};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -141,27 +141,35 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         });
     }
 
-    let mut medium = None;
+    let mut media = Vec::new();
     for (i, m) in desc.medium.iter().enumerate() {
         let p = place(m.span(), format!("[[medium]] #{}", i + 1));
-        let loaded = load_medium(m.get_ref(), &p)?;
-        if medium.replace(loaded).is_some() {
-            return Err(p.error("only one medium filling the whole scene is supported so far (regions: issue #4)"));
-        }
+        let medium = load_medium(m.get_ref(), &p)?;
+        let region = match &m.get_ref().region {
+            None => None,
+            Some(mesh) => {
+                let path = base_dir.map_or_else(|| Path::new(mesh).to_path_buf(), |d| d.join(mesh));
+                let triangles = load_obj(&path, &p)?.into_iter().map(|t| t.v).collect();
+                let region = RegionMesh::new(triangles).map_err(|e| p.error(format!("region {mesh}: {e}")))?;
+                Some(region)
+            }
+        };
+        media.push((medium, region));
     }
+    let media = Media::new(media).map_err(|e| SceneError {
+        file: file.to_string(),
+        position: None,
+        context: "[[medium]]".into(),
+        message: e,
+    })?;
 
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = geometry.triangles.into_iter().unzip();
     let (spheres, sphere_surfaces): (Vec<_>, Vec<_>) = geometry.spheres.into_iter().unzip();
     let accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
-    Ok(Scene { source: file.to_string(), camera, materials, surfaces: geometry.surfaces, lights, accel, medium })
+    Ok(Scene { source: file.to_string(), camera, materials, surfaces: geometry.surfaces, lights, accel, media })
 }
 
 fn load_medium(m: &MediumDesc, p: &Place) -> Result<Medium, SceneError> {
-    if m.region.is_some() {
-        return Err(p.error(
-            "media bounded by a `region` mesh are not supported yet (issue #4); omit `region` to fill the scene",
-        ));
-    }
     let sigma_a = p.color("sigma_a", m.sigma_a, None)?;
     let sigma_s = p.color("sigma_s", m.sigma_s, None)?;
     if (sigma_a + sigma_s).max_element() <= 0.0 {
@@ -343,12 +351,15 @@ fn add_box(geo: &mut GeometryBuilder, center: Vec3, h: Vec3, rot: Mat3, surface:
 }
 
 fn load_obj(path: &Path, p: &Place) -> Result<Vec<Triangle>, SceneError> {
-    if !path.is_file() {
-        return Err(p.error(format!("mesh file {} not found", path.display())));
-    }
-    let (models, _) =
-        tobj::load_obj(path, &tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() })
-            .map_err(|e| p.error(format!("cannot read mesh {}: {e}", path.display())))?;
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    // Built-in scenes read their meshes from the copies embedded in the binary.
+    let embedded = p.file.starts_with("builtin:").then(|| super::builtin::mesh(&path.to_string_lossy())).flatten();
+    let loaded = match embedded {
+        Some(text) => tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Err(tobj::LoadError::OpenFileFailed)),
+        None if !path.is_file() => return Err(p.error(format!("mesh file {} not found", path.display()))),
+        None => tobj::load_obj(path, &options),
+    };
+    let (models, _) = loaded.map_err(|e| p.error(format!("cannot read mesh {}: {e}", path.display())))?;
     let mut tris = Vec::new();
     for model in models {
         let m = &model.mesh;
@@ -580,7 +591,7 @@ intensity = [1.0, 1.0, 1.0]
     fn media_load_and_bad_media_are_rejected() {
         let fog = "\n[[medium]]\nsigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.2, 0.3, 0.4]\nphase = \"hg\"\ng = 0.5\n";
         let s = parse(&format!("{BASE}{fog}"), "test.toml", None).unwrap();
-        let m = s.medium.unwrap();
+        let m = s.media.entries()[0].medium;
         assert_eq!(m.phase, Phase::HenyeyGreenstein { g: 0.5 });
         assert_eq!(m.sigma_s, Vec3::new(0.2, 0.3, 0.4));
         for (bad, words) in [
@@ -588,13 +599,40 @@ intensity = [1.0, 1.0, 1.0]
             (fog.replace("g = 0.5", "k = 0.5"), "does not apply"),
             (fog.replace("sigma_a = [0.1, 0.1, 0.1]", "sigma_a = [-0.1, 0.1, 0.1]"), "negative"),
             (fog.replace("phase = \"hg\"", "phase = \"rayleigh\""), "unknown phase"),
-            (format!("{fog}region = \"fog.obj\"\n"), "not supported yet"),
-            (format!("{fog}{fog}"), "only one medium"),
+            (format!("{fog}region = \"fog.obj\"\n"), "not found"),
             ("\n[[medium]]\n".to_string(), "does nothing"),
         ] {
             let e = err(&format!("{BASE}{bad}"));
             assert!(e.context.starts_with("[[medium]]") && e.message.contains(words), "{e}");
         }
+    }
+
+    #[test]
+    fn region_media_load_and_open_regions_are_rejected() {
+        let dir = std::env::temp_dir().join(format!("hikari-region-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut obj = String::new();
+        let tris = crate::medium::region::box_triangles(Vec3::ZERO, Vec3::ONE);
+        for t in &tris {
+            for v in t {
+                obj += &format!("v {} {} {}\n", v.x, v.y, v.z);
+            }
+        }
+        let faces: Vec<String> =
+            (0..tris.len()).map(|i| format!("f {} {} {}", 3 * i + 1, 3 * i + 2, 3 * i + 3)).collect();
+        std::fs::write(dir.join("closed.obj"), format!("{obj}{}\n", faces.join("\n"))).unwrap();
+        std::fs::write(dir.join("open.obj"), format!("{obj}{}\n", faces[1..].join("\n"))).unwrap();
+        let fog = |region: &str| format!("{BASE}\n[[medium]]\nsigma_s = [0.5, 0.5, 0.5]\nregion = \"{region}\"\n");
+        let s = parse(&fog("closed.obj"), "test.toml", Some(&dir)).unwrap();
+        assert!(
+            s.media.has_regions() && s.media.mask_at(Vec3::splat(0.5)) == 1 && s.media.mask_at(Vec3::splat(2.0)) == 0
+        );
+        let e = parse(&fog("open.obj"), "test.toml", Some(&dir)).err().unwrap();
+        assert!(e.message.contains("open.obj") && e.message.contains("not closed") && e.position.is_some(), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
+        let hg = |g: f32| format!("\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\nphase = \"hg\"\ng = {g}\n");
+        let five: String = (0..5).map(|i| hg(i as f32 * 0.1)).collect();
+        assert!(err(&format!("{BASE}{five}")).message.contains("phase functions"));
     }
 
     #[test]

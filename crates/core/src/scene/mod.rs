@@ -29,8 +29,8 @@ pub struct Scene {
     pub surfaces: Vec<Surface>,
     pub lights: Vec<Light>,
     pub accel: Accel,
-    /// A participating medium filling the whole scene, if any.
-    pub medium: Option<crate::medium::Medium>,
+    /// Participating media (none: clear air).
+    pub media: crate::medium::Media,
 }
 
 impl Scene {
