@@ -64,6 +64,12 @@ pub struct RenderArgs {
     /// shadow-mapped points on the light (gpu).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
     pub area_light_samples: u32,
+    /// Volume-map radius in scene units [default: 3% of the scene diagonal].
+    #[arg(long, allow_negative_numbers = true)]
+    pub volume_radius: Option<f32>,
+    /// Optical-depth slices along each view ray through region media (gpu).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub volume_slices: u32,
     /// Count only photons that arrived from the side the surface faces the
     /// eye (stops light leaking through thin walls; darkens inside corners).
     #[arg(long)]
@@ -130,6 +136,7 @@ fn render_photons(
         seed: args.seed,
         area_light_samples: args.area_light_samples,
         normal_test: args.normal_test,
+        volume_radius: args.volume_radius,
         ..Default::default()
     };
     let (global, caustic) = settings.estimate_params(scene);
@@ -147,6 +154,8 @@ fn render_photons(
             area_light_samples: args.area_light_samples,
             shadow_map_size: args.shadow_map_size,
             lod,
+            volume_radius: args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene)),
+            volume_slices: args.volume_slices,
             ..GpuSettings::new(global, caustic)
         };
         let setup_start = Instant::now();
@@ -186,6 +195,7 @@ fn positive(name: &str, v: Option<f32>) -> Result<()> {
 pub fn run(args: &RenderArgs) -> Result<()> {
     positive("radius", args.radius)?;
     positive("caustic-radius", args.caustic_radius)?;
+    positive("volume-radius", args.volume_radius)?;
     for (name, v) in [("lod-near", args.lod_near), ("lod-far", args.lod_far)] {
         if let Some(d) = v {
             if !(d.is_finite() && d >= 0.0) {
@@ -205,16 +215,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let mut scene = Scene::load(&args.scene)?;
-    // Participating media: photon-cpu and the path tracer draw a homogeneous
-    // medium; the GPU renderer does not yet (issue #4).
     let mut renderer = args.renderer;
-    if !scene.media.is_empty() {
-        match renderer {
-            RendererKind::Gpu => {
-                eprintln!("the GPU renderer does not draw participating media yet: using photon-cpu");
-                renderer = RendererKind::PhotonCpu;
-            }
-            RendererKind::PhotonCpu | RendererKind::Path => {}
+    if renderer == RendererKind::Gpu {
+        if let Some(reason) = GpuRenderer::unsupported(&scene) {
+            eprintln!("{reason}: using photon-cpu");
+            renderer = RendererKind::PhotonCpu;
         }
     }
     if let Some((w, h)) = args.resolution {

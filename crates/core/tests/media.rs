@@ -160,7 +160,11 @@ fn fog_stage_matches_path_tracer(name: &str) {
     let kept = mask.iter().filter(|&&m| m).count();
     assert!(kept > 300, "only {kept} pixels in the region of interest");
     let traced = trace_photons(&scene, &TraceSettings { photons: 100_000, seed: 4, ..Default::default() }, &Silent);
-    let settings = PhotonCpuSettings { spp: 1, ..Default::default() };
+    // Several samples per pixel on both sides: the path tracer's spread over
+    // the pixel, and pixel-centre rays alone read ~7% darker on this mask,
+    // whose pixels border the lit floor and box (measured: 0.1278 centre
+    // rays vs 0.1376 spread, both renderers agreeing within 0.2% on each).
+    let settings = PhotonCpuSettings { spp: 8, ..Default::default() };
     let (photon, _) = PhotonCpuRenderer::new(&scene, &traced, &settings).render(&Silent);
     let path_settings = hikari_core::render::path::PathSettings { spp: 32, seed: 6, ..Default::default() };
     let (truth, _) = hikari_core::render::path::render(&scene, &path_settings, &Silent);
@@ -174,10 +178,10 @@ fn fog_stage_matches_path_tracer(name: &str) {
         sum / n as f64
     };
     let (p, t) = (mean(&photon, false), mean(&truth, false));
-    eprintln!("{name} cone ({kept} pixels): photon-cpu {p:.7}, path {t:.7} ({:+.2}%)", (p / t - 1.0) * 100.0);
+    eprintln!("{name} cone ({kept} pixels): photon-cpu {p:.5}, path {t:.5} ({:+.2}%)", (p / t - 1.0) * 100.0);
     assert!((p / t - 1.0).abs() < 0.10);
     let (p, t) = (mean(&photon, true), mean(&truth, true));
-    eprintln!("{name} whole image: photon-cpu {p:.7}, path {t:.7} ({:+.2}%)", (p / t - 1.0) * 100.0);
+    eprintln!("{name} whole image: photon-cpu {p:.6}, path {t:.7} ({:+.2}%)", (p / t - 1.0) * 100.0);
     assert!((p / t - 1.0).abs() < 0.05);
 }
 

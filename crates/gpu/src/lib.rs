@@ -14,6 +14,7 @@ pub mod context;
 pub mod direct;
 pub mod gbuffer;
 pub mod lod;
+pub mod media;
 pub mod readback;
 pub mod renderer;
 pub mod resolve;
@@ -21,6 +22,7 @@ pub mod scene_upload;
 pub mod shadow;
 pub mod specular;
 pub mod splat;
+pub mod volume;
 
 pub use context::{GpuContext, GpuError};
 pub use renderer::{GpuRenderer, GpuSettings};

@@ -6,6 +6,16 @@ use glam::Vec4;
 /// Reads a 2D `Rgba32Float` or `Rgba16Float` texture as row-major RGBA,
 /// row 0 at the top.
 pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>, GpuError> {
+    read_rgba_layer(ctx, texture, 0)
+}
+
+/// Every layer of a 2D-array texture, each as `read_rgba` reads one.
+pub fn read_rgba_layers(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec<Vec4>>, GpuError> {
+    (0..texture.depth_or_array_layers()).map(|layer| read_rgba_layer(ctx, texture, layer)).collect()
+}
+
+/// One layer of a 2D (array) texture.
+pub fn read_rgba_layer(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -> Result<Vec<Vec4>, GpuError> {
     let (width, height) = (texture.width(), texture.height());
     let texel_bytes = match texture.format() {
         wgpu::TextureFormat::Rgba32Float => 16,
@@ -25,7 +35,7 @@ pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>,
         wgpu::TexelCopyTextureInfo {
             texture,
             mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
+            origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
             aspect: wgpu::TextureAspect::All,
         },
         wgpu::TexelCopyBufferInfo {

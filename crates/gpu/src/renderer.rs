@@ -1,10 +1,12 @@
-//! The GPU frame: G-buffer, photon splats of the global and caustic maps,
-//! then (by later passes) direct light and the resolve.
+//! The GPU frame: G-buffer, shadow maps, optical-depth slices, direct light,
+//! photon splats of the global, caustic and volume maps, the specular pass
+//! and the resolve.
 
 use crate::context::{GpuContext, GpuError};
 use crate::direct::DirectPass;
 use crate::gbuffer::{GBuffer, GBufferParams, GBufferPass};
 use crate::lod::{LodOutput, LodPass};
+use crate::media::GpuMedia;
 use crate::readback::read_rgba;
 use crate::resolve::ResolvePass;
 use crate::scene_upload::SceneBuffers;
@@ -12,6 +14,7 @@ use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
 use crate::splat::{PhotonBuffer, SplatParams, SplatPass};
+use crate::volume::{VolumeParams, VolumePass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
 use hikari_core::lod::LodSettings;
@@ -35,6 +38,10 @@ pub struct GpuSettings {
     pub lod: Option<LodSettings>,
     /// Mirror/glass bounces followed from the eye (as photon-cpu's).
     pub max_specular_depth: u32,
+    /// Radius of the volume photons' spheres (photon-cpu's `volume_radius`).
+    pub volume_radius: f32,
+    /// Optical-depth slices along each view ray through region media.
+    pub volume_slices: u32,
 }
 
 impl GpuSettings {
@@ -47,6 +54,8 @@ impl GpuSettings {
             shadow_bias: 0.01,
             lod: None,
             max_specular_depth: 8,
+            volume_radius: global.radius,
+            volume_slices: 8,
         }
     }
 }
@@ -63,6 +72,8 @@ pub struct FrameTargets {
     pub direct: wgpu::Texture,
     pub indirect: wgpu::Texture,
     pub caustic: wgpu::Texture,
+    /// Light the media scatter toward the eye.
+    pub volume: wgpu::Texture,
     pub shadow_maps: ShadowMaps,
 }
 
@@ -71,11 +82,15 @@ pub struct FrameTargets {
 pub enum Stage {
     GBuffer,
     Shadows,
+    /// Region media rasterized into optical-depth slices.
+    OpticalDepth,
     Direct,
     /// LOD cull and splat of the global map.
     GlobalSplat,
     /// LOD cull and splat of the caustic map.
     CausticSplat,
+    /// LOD cull and splat of the volume map.
+    VolumeSplat,
     /// Mirrors and glass seen by the camera, ray-traced to diffuse hits.
     Specular,
     /// The sum of all radiance targets.
@@ -83,12 +98,14 @@ pub enum Stage {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 7] = [
+    pub const ALL: [Stage; 9] = [
         Stage::GBuffer,
         Stage::Shadows,
+        Stage::OpticalDepth,
         Stage::Direct,
         Stage::GlobalSplat,
         Stage::CausticSplat,
+        Stage::VolumeSplat,
         Stage::Specular,
         Stage::Resolve,
     ];
@@ -97,9 +114,11 @@ impl Stage {
         match self {
             Stage::GBuffer => "g-buffer",
             Stage::Shadows => "shadow maps",
+            Stage::OpticalDepth => "optical depth",
             Stage::Direct => "direct light",
             Stage::GlobalSplat => "global splat",
             Stage::CausticSplat => "caustic splat",
+            Stage::VolumeSplat => "volume splat",
             Stage::Specular => "specular",
             Stage::Resolve => "resolve",
         }
@@ -114,6 +133,10 @@ pub struct GpuRenderer {
     direct_pass: DirectPass,
     specular_pass: SpecularPass,
     resolve_pass: ResolvePass,
+    media: GpuMedia,
+    volume_pass: VolumePass,
+    volume_lod: LodOutput,
+    has_media: bool,
     lights: GpuLights,
     scene: SceneBuffers,
     lod_pass: LodPass,
@@ -145,6 +168,14 @@ fn depth_range(scene: &Scene) -> (f32, f32) {
 }
 
 impl GpuRenderer {
+    /// Why this renderer cannot draw `scene` faithfully, if it cannot: the
+    /// specular pass does not attenuate or scatter along its rays, so
+    /// mirrors and glass in media are left to photon-cpu.
+    pub fn unsupported(scene: &Scene) -> Option<&'static str> {
+        (!scene.media.is_empty() && crate::specular::has_specular_surfaces(scene))
+            .then_some("the GPU renderer does not draw mirrors or glass inside participating media")
+    }
+
     pub fn new(ctx: GpuContext, scene: &Scene, traced: &TracedPhotons, settings: GpuSettings) -> Self {
         let device = &ctx.device;
         let (w, h) = (scene.camera.width, scene.camera.height);
@@ -170,6 +201,7 @@ impl GpuRenderer {
             direct: radiance_target("direct radiance"),
             indirect: radiance_target("indirect radiance"),
             caustic: radiance_target("caustic radiance"),
+            volume: radiance_target("volume radiance"),
             shadow_maps: shadow_pass.create_maps(device, &lights.views, settings.shadow_map_size),
         };
         let (near, far) = depth_range(scene);
@@ -192,9 +224,31 @@ impl GpuRenderer {
                 shadow_bias: settings.shadow_bias,
             },
         );
+        let clip_from_world = scene.camera.clip_from_view(near, far) * scene.camera.view_from_world();
+        let media = GpuMedia::new(
+            device,
+            scene,
+            settings.volume_slices,
+            &targets.gbuffer,
+            clip_from_world,
+            ctx.radiance_format,
+        );
+        let volume_params = VolumeParams {
+            clip_from_world: clip_from_world.to_cols_array_2d(),
+            radius: settings.volume_radius,
+            power_unit: traced.power_unit,
+            _pad0: 0,
+            _pad1: 0,
+        };
+        let volume_pass = VolumePass::new(device, ctx.radiance_format, &volume_params, &media, &targets.gbuffer);
         let t = &targets;
-        let resolve_pass =
-            ResolvePass::new(device, [&t.gbuffer.emission, &t.direct, &t.indirect, &t.caustic, &specular_pass.output]);
+        let resolve_pass = ResolvePass::new(
+            device,
+            [&t.gbuffer.emission, &t.direct, &t.indirect, &t.caustic, &specular_pass.output],
+            &t.volume,
+            &t.gbuffer,
+            &media,
+        );
         GpuRenderer {
             resolve_pass,
             specular_pass,
@@ -208,11 +262,15 @@ impl GpuRenderer {
                 .create_output(device, &PhotonBuffer::upload(device, &traced.indirect(), "global photons")),
             caustic_lod: lod_pass
                 .create_output(device, &PhotonBuffer::upload(device, &traced.caustic, "caustic photons")),
+            volume_lod: lod_pass.create_output(device, &PhotonBuffer::upload(device, &traced.volume, "volume photons")),
+            has_media: !scene.media.is_empty(),
+            media,
+            volume_pass,
             lod_pass,
             power_unit: traced.power_unit,
             settings,
             targets,
-            clip_from_world: scene.camera.clip_from_view(near, far) * scene.camera.view_from_world(),
+            clip_from_world,
             camera_position: scene.camera.position,
             ctx,
         }
@@ -317,14 +375,33 @@ impl GpuRenderer {
                 self.gbuffer_pass.record(device, encoder, &self.scene, &params, &self.targets.gbuffer);
             }
             Stage::Shadows => self.shadow_pass.record(encoder, &self.scene, &self.targets.shadow_maps),
+            Stage::OpticalDepth => self.media.record(encoder),
             Stage::Direct => {
                 let view = self.targets.direct.create_view(&Default::default());
                 let bias = self.settings.shadow_bias;
                 let t = &self.targets;
-                self.direct_pass.record(device, encoder, &t.gbuffer, &self.lights, &t.shadow_maps, bias, &view);
+                self.direct_pass.record(
+                    device,
+                    encoder,
+                    &t.gbuffer,
+                    &self.lights,
+                    &t.shadow_maps,
+                    bias,
+                    &self.media,
+                    &view,
+                );
             }
             Stage::GlobalSplat => splat(encoder, &self.global_lod, &self.settings.global, &self.targets.indirect),
             Stage::CausticSplat => splat(encoder, &self.caustic_lod, &self.settings.caustic, &self.targets.caustic),
+            Stage::VolumeSplat => {
+                // Without media the target is only cleared: the resolve reads it.
+                if self.has_media {
+                    self.lod_pass.record(&self.ctx.queue, encoder, &self.volume_lod, self.camera_position, lod);
+                }
+                let view = self.targets.volume.create_view(&Default::default());
+                let photons = if self.has_media { &self.volume_lod } else { &self.caustic_lod };
+                self.volume_pass.record(encoder, photons, &view, self.has_media);
+            }
             Stage::Specular => self.specular_pass.record(encoder),
             Stage::Resolve => self.resolve_pass.record(encoder),
         }
@@ -339,6 +416,21 @@ impl GpuRenderer {
     pub fn drawn_photons(&self) -> Result<(u32, u32), GpuError> {
         let count = |o: &LodOutput| crate::readback::read_u32s(&self.ctx, &o.draw_args, 4).map(|v| v[1]);
         Ok((count(&self.global_lod)?, count(&self.caustic_lod)?))
+    }
+
+    /// Volume photons drawn in the last frame.
+    pub fn drawn_volume_photons(&self) -> Result<u32, GpuError> {
+        crate::readback::read_u32s(&self.ctx, &self.volume_lod.draw_args, 4).map(|v| v[1])
+    }
+
+    /// The regions' optical-depth slices, layer by layer.
+    pub fn read_slices(&self) -> Result<Vec<Vec<Vec4>>, GpuError> {
+        crate::readback::read_rgba_layers(&self.ctx, &self.media.slices)
+    }
+
+    /// The media parameters the passes see.
+    pub fn media_params(&self) -> &crate::media::MediaParams {
+        &self.media.params
     }
 
     pub fn read(&self, texture: &wgpu::Texture) -> Result<Vec<Vec4>, GpuError> {

@@ -20,7 +20,9 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("direct.wgsl", hikari_gpu::direct::shader_source()),
         ("lod.wgsl", hikari_gpu::lod::SHADER.to_string()),
         ("specular.wgsl", hikari_gpu::specular::shader_source()),
-        ("resolve.wgsl", hikari_gpu::resolve::SHADER.to_string()),
+        ("resolve.wgsl", hikari_gpu::resolve::shader_source()),
+        ("optical_depth.wgsl", hikari_gpu::media::optical_depth_shader_source()),
+        ("volume.wgsl", hikari_gpu::volume::shader_source()),
     ]
 }
 
@@ -129,6 +131,35 @@ fn shared_structs_match_wgsl_layouts() {
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
     assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
+    let volume = hikari_gpu::volume::shader_source();
+    assert_layout!(
+        volume,
+        "VolumeParams",
+        hikari_gpu::volume::VolumeParams,
+        [clip_from_world, radius, power_unit, _pad0, _pad1]
+    );
+    assert_layout!(
+        volume,
+        "MediaParams",
+        hikari_gpu::media::MediaParams,
+        [
+            camera_position,
+            max_distance,
+            forward,
+            tan_half_fov,
+            right,
+            aspect,
+            up,
+            slices,
+            global_sigma_t,
+            region_triangles,
+            phases,
+            image_size,
+            _pad0,
+            _pad1
+        ]
+    );
+    assert_layout!(volume, "RegionTriangle", hikari_gpu::media::RegionTriangle, [a, b, c, sigma_t]);
     let lod = hikari_gpu::lod::SHADER.to_string();
     assert_layout!(
         lod,

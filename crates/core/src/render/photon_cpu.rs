@@ -128,6 +128,10 @@ impl<'a> PhotonCpuRenderer<'a> {
         &self.caustic
     }
 
+    pub fn volume_map(&self) -> &PhotonMap {
+        &self.volume
+    }
+
     /// The photon-map part of the light leaving a diffuse point: indirect
     /// (global map) plus caustics (caustic map), per the enabled components.
     pub fn photon_radiance(&self, x: glam::Vec3, normal: glam::Vec3, albedo: Rgb) -> Rgb {

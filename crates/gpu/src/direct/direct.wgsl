@@ -1,4 +1,5 @@
-// Direct light at every visible diffuse pixel (light_eval.wgsl prepended).
+// Direct light at every visible diffuse pixel, attenuated by the media on the
+// way from each light sample (media.wgsl and light_eval.wgsl prepended).
 
 @group(0) @binding(0) var<uniform> direct_params: DirectParams;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
@@ -8,6 +9,15 @@
 @group(0) @binding(5) var gbuffer_position: texture_2d<f32>;
 @group(0) @binding(6) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(7) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(8) var<uniform> media: MediaParams;
+@group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
+
+// Light reaching x from a light sample through the media (eq. 5.8, 5.26).
+fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
+    let d = light_position - x;
+    let len = length(d);
+    return exp(-segment_optical_depth(x, d / len, len));
+}
 
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {

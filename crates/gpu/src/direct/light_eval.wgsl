@@ -2,8 +2,9 @@
 // each light's exact unshadowed irradiance times the fraction of its
 // shadow-mapped sample points that see the point. The counterpart of
 // hikari_core::render::direct_diffuse, which integrates the same by shadow rays.
-// The includer declares `direct_params`, `lights`, `samples`, `views` and
-// `shadow_maps`.
+// The includer declares `direct_params`, `lights`, `samples`, `views`,
+// `shadow_maps`, and `light_transmittance(x, sample_position)` (the media's
+// transmittance between them; 1 where media are not drawn).
 
 const PI_D: f32 = 3.14159265358979323846;
 
@@ -140,11 +141,14 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
         if (all(e == vec3<f32>(0.0))) {
             continue;
         }
-        var seen = 0u;
+        var seen = vec3<f32>(0.0);
         for (var k = 0u; k < l.sample_count; k++) {
-            seen += u32(visible(samples[l.first_sample + k], x, n));
+            let s = samples[l.first_sample + k];
+            if (visible(s, x, n)) {
+                seen += light_transmittance(x, s.position);
+            }
         }
-        sum += e * (f32(seen) / f32(l.sample_count));
+        sum += e * (seen / f32(l.sample_count));
     }
     return albedo / PI_D * sum;
 }

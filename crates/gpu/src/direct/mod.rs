@@ -11,7 +11,7 @@ use wgpu::util::DeviceExt;
 pub const LIGHT_EVAL_WGSL: &str = include_str!("light_eval.wgsl");
 
 pub fn shader_source() -> String {
-    format!("{}\n{}", LIGHT_EVAL_WGSL, include_str!("direct.wgsl"))
+    format!("{}\n{}\n{}", crate::media::MEDIA_WGSL, LIGHT_EVAL_WGSL, include_str!("direct.wgsl"))
 }
 
 /// Mirrors `DirectParams` in direct.wgsl.
@@ -49,6 +49,8 @@ impl DirectPass {
                 entry(5, texture(D2)),
                 entry(6, texture(D2)),
                 entry(7, texture(D2)),
+                entry(8, uniform()),
+                entry(9, storage(true)),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -93,6 +95,7 @@ impl DirectPass {
         lights: &GpuLights,
         maps: &ShadowMaps,
         bias: f32,
+        media: &crate::media::GpuMedia,
         target: &wgpu::TextureView,
     ) {
         let params = DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, _pad: 0 };
@@ -129,24 +132,11 @@ impl DirectPass {
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&position) },
                 wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&normal) },
                 wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&albedo) },
+                wgpu::BindGroupEntry { binding: 8, resource: media.params_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() },
             ],
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("direct light"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = crate::binding::color_pass(encoder, "direct light", target, true);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.draw(0..3, 0..1);

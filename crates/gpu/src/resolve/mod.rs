@@ -1,7 +1,9 @@
 //! The resolve pass: sums the frame's radiance targets into one linear
 //! `Rgba32Float` image (the only texture read back for output).
 
-pub const SHADER: &str = include_str!("resolve.wgsl");
+pub fn shader_source() -> String {
+    format!("{}\n{}\n{}", crate::media::MEDIA_WGSL, crate::media::VIEW_DEPTH_WGSL, include_str!("resolve.wgsl"))
+}
 const WORKGROUP: u32 = 8;
 
 pub struct ResolvePass {
@@ -11,18 +13,30 @@ pub struct ResolvePass {
 }
 
 impl ResolvePass {
-    /// `inputs`: emission, direct, indirect, caustic, specular (same size).
-    pub fn new(device: &wgpu::Device, inputs: [&wgpu::Texture; 5]) -> Self {
+    /// `inputs`: emission, direct, indirect, caustic, specular (same size);
+    /// `volume`: the volume splat's target.
+    pub fn new(
+        device: &wgpu::Device,
+        inputs: [&wgpu::Texture; 5],
+        volume: &wgpu::Texture,
+        gbuffer: &crate::gbuffer::GBuffer,
+        media: &crate::media::GpuMedia,
+    ) -> Self {
         let (width, height) = (inputs[0].width(), inputs[0].height());
-        use crate::binding::{entry, storage_texture_rgba32f, texture};
+        use crate::binding::{entry, storage, storage_texture_rgba32f, texture, uniform};
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("resolve.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         let stage = wgpu::ShaderStages::COMPUTE;
         let mut entries: Vec<wgpu::BindGroupLayoutEntry> =
             (0..5).map(|b| entry(b, stage, texture(wgpu::TextureViewDimension::D2))).collect();
         entries.push(entry(5, stage, storage_texture_rgba32f()));
+        entries.push(entry(6, stage, texture(wgpu::TextureViewDimension::D2)));
+        entries.push(entry(7, stage, texture(wgpu::TextureViewDimension::D2)));
+        entries.push(entry(8, stage, uniform()));
+        entries.push(entry(9, stage, storage(true)));
+        entries.push(entry(10, stage, texture(wgpu::TextureViewDimension::D2Array)));
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -52,11 +66,20 @@ impl ResolvePass {
         });
         let mut views: Vec<wgpu::TextureView> = inputs.iter().map(|t| t.create_view(&Default::default())).collect();
         views.push(output.create_view(&Default::default()));
-        let bind_entries: Vec<wgpu::BindGroupEntry> = views
+        views.push(volume.create_view(&Default::default()));
+        views.push(gbuffer.position.create_view(&Default::default()));
+        let slices = media.slices.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let mut bind_entries: Vec<wgpu::BindGroupEntry> = views
             .iter()
             .enumerate()
             .map(|(i, v)| wgpu::BindGroupEntry { binding: i as u32, resource: wgpu::BindingResource::TextureView(v) })
             .collect();
+        bind_entries.push(wgpu::BindGroupEntry { binding: 8, resource: media.params_buffer.as_entire_binding() });
+        bind_entries.push(wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() });
+        bind_entries.push(wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&slices) });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &layout,

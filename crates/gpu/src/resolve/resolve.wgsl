@@ -1,6 +1,8 @@
-// Resolve: the frame's linear radiance, emission + direct + indirect +
-// caustics + specular. Tone mapping happens on output (hikari_core::output),
-// the same for every renderer.
+// Resolve: the frame's linear radiance: the surface light (emission + direct
+// + indirect + caustics + specular) attenuated by the media between the eye
+// and the surface, plus the light the media scatter toward the eye. Tone
+// mapping happens on output (hikari_core::output), the same for every
+// renderer. Prepended with media.wgsl and view_depth.wgsl.
 
 @group(0) @binding(0) var emission: texture_2d<f32>;
 @group(0) @binding(1) var direct: texture_2d<f32>;
@@ -8,6 +10,11 @@
 @group(0) @binding(3) var caustic: texture_2d<f32>;
 @group(0) @binding(4) var specular: texture_2d<f32>;
 @group(0) @binding(5) var output: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(6) var volume: texture_2d<f32>;
+@group(0) @binding(7) var gbuffer_position: texture_2d<f32>;
+@group(0) @binding(8) var<uniform> media: MediaParams;
+@group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
+@group(0) @binding(10) var slices_tex: texture_2d_array<f32>;
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -16,7 +23,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let p = vec2<i32>(id.xy);
-    let sum = textureLoad(emission, p, 0).rgb + textureLoad(direct, p, 0).rgb + textureLoad(indirect, p, 0).rgb
+    let surface = textureLoad(emission, p, 0).rgb + textureLoad(direct, p, 0).rgb + textureLoad(indirect, p, 0).rgb
         + textureLoad(caustic, p, 0).rgb + textureLoad(specular, p, 0).rgb;
+    let ray = view_ray(textureLoad(gbuffer_position, p, 0), vec2<f32>(p) + 0.5);
+    let transmittance = exp(-view_optical_depth(p, ray.w, ray.w));
+    let sum = transmittance * surface + textureLoad(volume, p, 0).rgb;
     textureStore(output, p, vec4<f32>(sum, 1.0));
 }

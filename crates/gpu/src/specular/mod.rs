@@ -18,6 +18,15 @@ use wgpu::util::DeviceExt;
 
 const WORKGROUP: u32 = 8;
 
+/// Whether any surface is a mirror, glass or partly mirroring: the pass
+/// runs only then.
+pub fn has_specular_surfaces(scene: &Scene) -> bool {
+    scene.surfaces.iter().any(|s| {
+        let m = &scene.materials[s.material as usize];
+        matches!(m, Material::Mirror { .. } | Material::Glass { .. }) || m.mirror_reflectance().max_element() > 0.0
+    })
+}
+
 pub fn shader_source() -> String {
     format!("{}\n{}\n{}", crate::ESTIMATE_WGSL, crate::direct::LIGHT_EVAL_WGSL, include_str!("specular.wgsl"))
 }
@@ -208,10 +217,7 @@ impl SpecularPass {
                 wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
             ],
         });
-        let enabled = scene.surfaces.iter().any(|s| {
-            let m = &scene.materials[s.material as usize];
-            matches!(m, Material::Mirror { .. } | Material::Glass { .. }) || m.mirror_reflectance().max_element() > 0.0
-        });
+        let enabled = has_specular_surfaces(scene);
         SpecularPass { pipeline, bind_group, width, height, enabled, output }
     }
 

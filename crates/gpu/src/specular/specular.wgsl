@@ -54,6 +54,12 @@ struct Surface {
     _pad: u32,
 }
 
+// The specular pass does not draw media (the CLI sends scenes with both
+// media and mirrors or glass to photon-cpu).
+fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(1.0);
+}
+
 @group(0) @binding(0) var<uniform> params: SpecularParams;
 @group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
 @group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;

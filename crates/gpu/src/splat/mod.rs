@@ -26,8 +26,65 @@ pub const PHOTON_ATTRIBUTES: [wgpu::VertexAttribute; 4] = [
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32, offset: 20, shader_location: 3 },
 ];
 
+/// The photon footprint vertex shader shared with the volume splat.
+pub const FOOTPRINT_WGSL: &str = include_str!("footprint.wgsl");
+
 pub fn shader_source() -> String {
-    format!("{}\n{}", crate::ESTIMATE_WGSL, include_str!("splat.wgsl"))
+    format!("{}\n{FOOTPRINT_WGSL}\n{}", crate::ESTIMATE_WGSL, include_str!("splat.wgsl"))
+}
+
+/// The per-instance photon stream of the splats.
+pub fn photon_instances() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<crate::lod::LodPhoton>() as u64,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &PHOTON_ATTRIBUTES,
+    }
+}
+
+/// A render pipeline (`vs_main`, `fs_main`) that adds its fragments into a
+/// float target: the photon splats (a triangle strip per instance when
+/// `buffers` holds the photon stream) and the optical-depth pass (a list).
+pub fn additive_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+    buffers: &[Option<wgpu::VertexBufferLayout>],
+    label: &str,
+) -> wgpu::RenderPipeline {
+    let additive = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let topology =
+        if buffers.is_empty() { wgpu::PrimitiveTopology::TriangleList } else { wgpu::PrimitiveTopology::TriangleStrip };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers,
+        },
+        primitive: wgpu::PrimitiveState { topology, cull_mode: None, ..Default::default() },
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState {
+                format,
+                blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Photons uploaded once per photon map, drawn every frame.
@@ -80,44 +137,8 @@ impl SplatPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("splat"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<crate::lod::LodPhoton>() as u64,
-                    step_mode: wgpu::VertexStepMode::Instance,
-                    attributes: &PHOTON_ATTRIBUTES,
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleStrip,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: target_format,
-                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline =
+            additive_pipeline(device, &pipeline_layout, &module, target_format, &[Some(photon_instances())], "splat");
         SplatPass { pipeline, layout }
     }
 
@@ -151,20 +172,7 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&albedo) },
             ],
         });
-        let load = if clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("photon splat"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = crate::binding::color_pass(encoder, "photon splat", target, clear);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &bind_group, &[]);
         pass.set_vertex_buffer(0, photons.survivors.slice(..));

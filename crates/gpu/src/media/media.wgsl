@@ -1,0 +1,94 @@
+// Participating media on the GPU (METHOD.md §5), mirrored from
+// hikari_core::medium: phase functions, the view ray of a pixel, and the
+// optical depth along any segment (for light reaching a surface).
+// Prepended to the shaders that use media; the includer declares `media`
+// and `regions` (view_depth.wgsl adds the optical depth along view rays).
+
+const PI_M: f32 = 3.14159265358979323846;
+
+struct MediaParams {
+    camera_position: vec3<f32>,
+    // Length of view rays that hit nothing (photon-cpu's: twice the scene diagonal).
+    max_distance: f32,
+    // The camera basis of hikari_core::camera::Camera::ray.
+    forward: vec3<f32>,
+    tan_half_fov: f32,
+    right: vec3<f32>,
+    aspect: f32,
+    up: vec3<f32>,
+    // Optical-depth slices along each view ray (0: no region meshes).
+    slices: u32,
+    // σ_t of the media filling the whole scene.
+    global_sigma_t: vec3<f32>,
+    region_triangles: u32,
+    // Per phase slot: x = kind (0 Schlick, 1 Henyey–Greenstein), y = k or g.
+    phases: array<vec4<f32>, 4>,
+    image_size: vec2<f32>,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// A triangle of a region mesh, wound with its normal out of the medium, and
+// that medium's σ_t.
+struct RegionTriangle {
+    a: vec4<f32>,
+    b: vec4<f32>,
+    c: vec4<f32>,
+    sigma_t: vec4<f32>,
+}
+
+// hikari_core::medium::Phase::eval, μ the cosine between propagation directions.
+fn phase_eval(slot: u32, mu: f32) -> f32 {
+    let p = media.phases[slot];
+    if (p.x == 0.0) {
+        let k = p.y;
+        let d = 1.0 - k * mu;
+        return (1.0 - k * k) / (4.0 * PI_M * d * d);
+    }
+    let g = p.y;
+    let d = 1.0 + g * g - 2.0 * g * mu;
+    return (1.0 - g * g) / (4.0 * PI_M * d * sqrt(d));
+}
+
+// The view ray through a pixel: unit direction (xyz) and the distance to the
+// visible surface (w), or `max_distance` where the pixel sees no surface.
+fn view_ray(gbuffer_pos: vec4<f32>, frag_xy: vec2<f32>) -> vec4<f32> {
+    if (gbuffer_pos.w != 0.0) {
+        let d = gbuffer_pos.xyz - media.camera_position;
+        let l = length(d);
+        return vec4<f32>(d / l, l);
+    }
+    let size = media.image_size;
+    let x = (2.0 * frag_xy.x / size.x - 1.0) * media.tan_half_fov * media.aspect;
+    let y = (1.0 - 2.0 * frag_xy.y / size.y) * media.tan_half_fov;
+    return vec4<f32>(normalize(media.forward + media.right * x + media.up * y), media.max_distance);
+}
+
+// ∫ σ_t along origin + t·dir, t in [0, len]: Σ over region crossings ahead of
+// sign · σ_t · min(t, len), + leaving and − entering (the identity of
+// hikari_core::medium::region), plus the media filling the scene.
+fn segment_optical_depth(origin: vec3<f32>, dir: vec3<f32>, len: f32) -> vec3<f32> {
+    var tau = media.global_sigma_t * len;
+    for (var i = 0u; i < media.region_triangles; i++) {
+        let tri = regions[i];
+        let e1 = tri.b.xyz - tri.a.xyz;
+        let e2 = tri.c.xyz - tri.a.xyz;
+        let p = cross(dir, e2);
+        let det = dot(e1, p);
+        if (abs(det) < 1e-12) {
+            continue;
+        }
+        let inv = 1.0 / det;
+        let s = origin - tri.a.xyz;
+        let u = dot(s, p) * inv;
+        let q = cross(s, e1);
+        let v = dot(dir, q) * inv;
+        let t = dot(e2, q) * inv;
+        if (u < 0.0 || v < 0.0 || u + v > 1.0 || t <= 0.0) {
+            continue;
+        }
+        let leaving = dot(cross(e1, e2), dir) > 0.0;
+        tau += select(-1.0, 1.0, leaving) * tri.sigma_t.xyz * min(t, len);
+    }
+    return max(tau, vec3<f32>(0.0));
+}
