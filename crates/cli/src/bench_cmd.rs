@@ -1,6 +1,6 @@
-//! `hikari bench`: the seed's chapter-6 table for surfaces, on this machine's
-//! GPU: frames per second and a per-pass breakdown (wall-clock around each
-//! pass's submit). Photon tracing is not timed.
+//! `hikari bench`: the seed's chapter-6 tables for surfaces and media, on
+//! this machine's GPU: frames per second and a per-pass breakdown (GPU
+//! timestamps where the adapter has them). Photon tracing is not timed.
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -27,9 +27,17 @@ struct Row {
     label: &'static str,
     scene: &'static str,
     size: (u32, u32),
+    /// Emitted photons, or (media rows) the volume photons wanted: the
+    /// emitted count is then chosen to store about that many.
     photons: u64,
+    volume: bool,
     lod: Option<LodSettings>,
 }
+
+/// The seed's fog-scene LOD settings, in scene units as given (its scene's
+/// size is not stated; fog-stage is 8 units wide).
+const SEED_FOG_LOD: LodSettings = LodSettings { near: 25.0, far: 3.0, groups: 20 };
+const SEED_FOG_LOD_FAR: LodSettings = LodSettings { near: 0.0, far: 20.0, groups: 20 };
 
 pub fn run(args: &BenchArgs) -> Result<()> {
     let ctx = GpuContext::new().context("hikari bench measures the GPU renderer")?;
@@ -43,6 +51,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene: "cornell-box",
             size: (512, 512),
             photons: 10_000,
+            volume: false,
             lod: None,
         },
         Row {
@@ -50,6 +59,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene: "cornell-box",
             size: (512, 512),
             photons: 10_000,
+            volume: false,
             lod: Some(SEED_CORNELL_LOD),
         },
         Row {
@@ -57,7 +67,32 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene: "cornell-box",
             size: (512, 512),
             photons: 2_000,
+            volume: false,
             lod: None,
+        },
+        Row {
+            label: "fog-stage, 50,000 volume photons, LOD off",
+            scene: "fog-stage",
+            size: (512, 512),
+            photons: 50_000,
+            volume: true,
+            lod: None,
+        },
+        Row {
+            label: "fog-stage, 50,000 volume photons, LOD n=25 f=3",
+            scene: "fog-stage",
+            size: (512, 512),
+            photons: 50_000,
+            volume: true,
+            lod: Some(SEED_FOG_LOD),
+        },
+        Row {
+            label: "fog-stage, 25,000 volume photons, LOD n=0 f=20",
+            scene: "fog-stage",
+            size: (512, 512),
+            photons: 25_000,
+            volume: true,
+            lod: Some(SEED_FOG_LOD_FAR),
         },
     ];
     if args.large {
@@ -66,6 +101,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             scene: "cornell-box",
             size: (1920, 1080),
             photons: 1_000_000,
+            volume: false,
+            lod: None,
+        });
+        rows.push(Row {
+            label: "fog-stage 1920x1080, 1,000,000 volume photons, LOD off",
+            scene: "fog-stage",
+            size: (1920, 1080),
+            photons: 1_000_000,
+            volume: true,
             lod: None,
         });
     }
@@ -82,9 +126,21 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u32)> {
     let mut scene = Scene::load(row.scene)?;
     scene.camera = scene.camera.with_resolution(row.size.0, row.size.1).map_err(anyhow::Error::msg)?;
-    let traced = trace_photons(&scene, &TraceSettings { photons: row.photons, seed: 1, ..Default::default() }, &Silent);
+    let trace = |photons| trace_photons(&scene, &TraceSettings { photons, seed: 1, ..Default::default() }, &Silent);
+    let traced = if row.volume {
+        // Volume photons per emitted path, from a small trial.
+        let trial = trace(10_000);
+        let per_path = (trial.volume.len() as f64 / 10_000.0).max(1e-3);
+        trace((row.photons as f64 / per_path).round().max(1.0) as u64)
+    } else {
+        trace(row.photons)
+    };
     let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
-    let settings = GpuSettings { lod: row.lod, ..GpuSettings::new(global, caustic) };
+    let settings = GpuSettings {
+        lod: row.lod,
+        volume_radius: hikari_core::render::photon_cpu::default_radius(&scene),
+        ..GpuSettings::new(global, caustic)
+    };
     let renderer = GpuRenderer::new(ctx, &scene, &traced, settings);
     renderer.render();
     renderer.wait()?;
@@ -94,16 +150,20 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
     }
     renderer.wait()?;
     let frame = start.elapsed().as_secs_f64() / frames as f64;
-    let (drawn, _) = renderer.drawn_photons()?;
+    let (global_drawn, _) = renderer.drawn_photons()?;
+    let (drawn, what) = if row.volume {
+        (renderer.drawn_volume_photons()?, format!("of {} volume photons drawn", traced.volume.len()))
+    } else {
+        (global_drawn, format!("of {} global photons drawn", traced.indirect().len()))
+    };
     let (breakdown, timestamps) = renderer.render_timed()?;
     println!(
-        "{} at {}x{}: {:.2} fps ({:.2} ms/frame), {} global photons drawn",
+        "{} at {}x{}: {:.2} fps ({:.2} ms/frame), {drawn} {what}",
         row.label,
         row.size.0,
         row.size.1,
         1.0 / frame,
         frame * 1e3,
-        drawn
     );
     let parts: Vec<String> =
         breakdown.iter().map(|(stage, t): &(Stage, f64)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
