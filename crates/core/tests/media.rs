@@ -136,18 +136,18 @@ fn path_tracer_matches_single_scattering_integral() {
     assert!(rel > -0.03 && rel < 0.08, "relative difference {rel}");
 }
 
-/// photon-cpu against the path tracer on a fog stage (64×48): the spot's
+/// photon-cpu against the path tracer on a fog stage (64×64): the spot's
 /// cone in the fog. Region of interest: pixels whose centre ray crosses the
 /// cone (sampled every 2 cm before its surface hit) and then hits a surface
 /// outside the cone, so in-scattered light is most of their value; the means
 /// over that mask, and over the whole image, must agree within 10% and 5%.
 fn fog_stage_matches_path_tracer(name: &str) {
     let mut scene = Scene::load(name).unwrap();
-    scene.camera = scene.camera.with_resolution(64, 48).unwrap();
+    scene.camera = scene.camera.with_resolution(64, 64).unwrap();
     let hikari_core::light::Light::Spot { position, axis, cutoff, .. } = scene.lights[0] else { panic!("spot light") };
     let in_cone = |p: glam::Vec3| (p - position).normalize().dot(axis) > cutoff.cos();
     let mut mask = Vec::new();
-    for y in 0..48 {
+    for y in 0..64 {
         for x in 0..64 {
             let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let keep = scene.accel.intersect(&ray).is_some_and(|hit| {

@@ -58,3 +58,42 @@ fn lod_draws_the_predicted_photons_and_keeps_the_image_mean() {
     let second = gpu.read(&gpu.targets.indirect).unwrap();
     assert!(first.iter().zip(&second).all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits)));
 }
+
+/// LOD applies to volume photons too: the volume splat draws the CPU's
+/// predicted survivors, and the in-scattered light keeps its mean roughly.
+#[test]
+fn lod_culls_volume_photons_and_keeps_the_mean() {
+    let Some(ctx) = context_or_skip("volume lod") else { return };
+    let mut scene = Scene::load("fog-stage").unwrap();
+    scene.camera = scene.camera.with_resolution(64, 48).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 4_000, seed: 3, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let mut gpu = GpuRenderer::new(ctx, &scene, &traced, GpuSettings::new(global, caustic));
+    gpu.render();
+    let photons = &traced.volume;
+    assert_eq!(gpu.drawn_volume_photons().unwrap() as usize, photons.len());
+    let mean = |v: &[glam::Vec4]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>() / v.len() as f64;
+    let off = mean(&gpu.read(&gpu.targets.volume).unwrap());
+    // The seed's fog setting n = 25, f = 3.
+    let lod = hikari_core::lod::LodSettings { near: 25.0, far: 3.0, groups: 20 };
+    gpu.settings.lod = Some(lod);
+    gpu.render();
+    let n = photons.len() as u32;
+    let predicted = photons
+        .iter()
+        .enumerate()
+        .filter(|(i, p)| {
+            let q = detail_level((p.position() - scene.camera.position).length(), &lod);
+            power_scale(q, group_of(*i as u32, n, lod.groups), lod.groups) > 0.0
+        })
+        .count();
+    let drawn = gpu.drawn_volume_photons().unwrap() as usize;
+    let on = mean(&gpu.read(&gpu.targets.volume).unwrap());
+    eprintln!("volume LOD: {drawn} of {} drawn (predicted {predicted}); mean off {off:.5}, on {on:.5}", photons.len());
+    assert!(drawn.abs_diff(predicted) <= photons.len() / 1000 + 1, "drawn {drawn}, predicted {predicted}");
+    assert!(drawn < photons.len() * 9 / 10, "LOD culled too little: {drawn} of {}", photons.len());
+    // LOD keeps the expected power, but the few photons within reach of
+    // the eye (in the fog) reach every pixel, so one culled or rescaled
+    // changes the mean by percents: a loose bound.
+    assert!((on - off).abs() / off < 0.10);
+}
