@@ -2,7 +2,8 @@
 //! LOD pass leaves for the indirect draw equals the CPU's prediction), and
 //! the image keeps its brightness.
 
-use hikari_core::lod::{detail_level, group_of, power_scale};
+use hikari_core::lod::{LodSettings, detail_level, group_of, power_scale};
+use hikari_core::photon::Photon;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::PhotonCpuSettings;
@@ -11,6 +12,19 @@ use hikari_gpu::test_support::context_or_skip;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
 use hikari_gpu::renderer::SEED_CORNELL_LOD;
+
+/// How many photons the CPU's LOD (hikari_core::lod) keeps.
+fn predicted_survivors(photons: &[Photon], eye: glam::Vec3, lod: &LodSettings) -> usize {
+    let n = photons.len() as u32;
+    photons
+        .iter()
+        .enumerate()
+        .filter(|(i, p)| {
+            let q = detail_level((p.position() - eye).length(), lod);
+            power_scale(q, group_of(*i as u32, n, lod.groups), lod.groups) > 0.0
+        })
+        .count()
+}
 
 #[test]
 fn lod_draws_the_predicted_photons_and_keeps_the_image_mean() {
@@ -32,15 +46,7 @@ fn lod_draws_the_predicted_photons_and_keeps_the_image_mean() {
     let lod = SEED_CORNELL_LOD;
     gpu.settings.lod = Some(lod);
     gpu.render();
-    let n = photons.len() as u32;
-    let predicted = photons
-        .iter()
-        .enumerate()
-        .filter(|(i, p)| {
-            let q = detail_level((p.position() - scene.camera.position).length(), &lod);
-            power_scale(q, group_of(*i as u32, n, lod.groups), lod.groups) > 0.0
-        })
-        .count();
+    let predicted = predicted_survivors(&photons, scene.camera.position, &lod);
     let drawn = gpu.drawn_photons().unwrap().0 as usize;
     eprintln!("LOD: {drawn} of {} photons drawn (predicted {predicted})", photons.len());
     // Float rounding may move a photon sitting exactly on a group boundary.
@@ -75,18 +81,10 @@ fn lod_culls_volume_photons_and_keeps_the_mean() {
     let mean = |v: &[glam::Vec4]| v.iter().map(|p| (p.x + p.y + p.z) as f64).sum::<f64>() / v.len() as f64;
     let off = mean(&gpu.read(&gpu.targets.volume).unwrap());
     // The seed's fog setting n = 25, f = 3.
-    let lod = hikari_core::lod::LodSettings { near: 25.0, far: 3.0, groups: 20 };
+    let lod = LodSettings { near: 25.0, far: 3.0, groups: 20 };
     gpu.settings.lod = Some(lod);
     gpu.render();
-    let n = photons.len() as u32;
-    let predicted = photons
-        .iter()
-        .enumerate()
-        .filter(|(i, p)| {
-            let q = detail_level((p.position() - scene.camera.position).length(), &lod);
-            power_scale(q, group_of(*i as u32, n, lod.groups), lod.groups) > 0.0
-        })
-        .count();
+    let predicted = predicted_survivors(photons, scene.camera.position, &lod);
     let drawn = gpu.drawn_volume_photons().unwrap() as usize;
     let on = mean(&gpu.read(&gpu.targets.volume).unwrap());
     eprintln!("volume LOD: {drawn} of {} drawn (predicted {predicted}); mean off {off:.5}, on {on:.5}", photons.len());

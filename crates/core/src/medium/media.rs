@@ -201,12 +201,21 @@ impl Media {
     /// optical depth −ln(1−ξ) is spent in the mean channel σ̄, and per-channel
     /// weights T_c/T̄ (× σ_t,c/σ̄ at an interaction) keep RGB unbiased.
     pub fn sample_flight(&self, origin: Vec3, dir: Vec3, t_max: f32, xi: f32) -> Flight {
+        // Photon tracing calls this per flight: media filling the scene are
+        // one piece, so skip the allocation and crossing search for them.
+        let single;
         let mut segments = Vec::new();
-        self.segments(origin, dir, t_max, &mut segments);
+        let pieces: &[Segment] = if self.has_regions() {
+            self.segments(origin, dir, t_max, &mut segments);
+            &segments
+        } else {
+            single = [Segment { t0: 0.0, t1: t_max, mask: self.global_mask() }];
+            &single
+        };
         let target = -(1.0 - xi).ln();
         let mut tau_bar = 0.0f32;
         let mut tau = Rgb::ZERO;
-        for s in &segments {
+        for s in pieces {
             let sigma_t = self.sigma_t(s.mask);
             let sigma_bar = mean(sigma_t);
             if sigma_bar <= 0.0 {
