@@ -5,7 +5,7 @@
 //! Each primitive carries the id of the surface (object) it belongs to.
 
 use super::{Ray, Sphere, Triangle};
-use glam::{Vec3, Vec3A};
+use glam::{UVec2, Vec3, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
 use std::time::Duration;
 
@@ -37,6 +37,16 @@ struct PackedPrim {
 }
 
 const SPHERE_BIT: u32 = 1 << 31;
+
+/// What the hit record needs per primitive, precomputed so that a hit costs
+/// no normalisation: the unit geometric normal of a triangle (unused for
+/// spheres), whether it has smooth normals to interpolate, and its surface.
+#[derive(Clone, Copy)]
+struct PrimInfo {
+    normal: Vec3,
+    smooth: bool,
+    surface: u32,
+}
 
 impl PackedPrim {
     /// Ray parameter of the nearest hit in (t_min, ray.t_max), with the
@@ -77,6 +87,8 @@ pub struct Accel {
     spheres: Vec<Sphere>,
     /// Surface id per primitive, in the joint index space.
     surface_of: Vec<u32>,
+    /// Hit-record data per primitive, in the joint index space.
+    info: Vec<PrimInfo>,
     bvh: Option<CwBvh>,
     /// `packed[i]` is primitive `bvh.primitive_indices[i]`.
     packed: Vec<PackedPrim>,
@@ -120,6 +132,13 @@ impl Accel {
         let mut surface_of = triangle_surfaces;
         surface_of.extend(sphere_surfaces);
         let n_tri = triangles.len();
+        let info = triangles
+            .iter()
+            .map(|t| (t.geometric_normal().normalize(), t.normals.is_some()))
+            .chain(spheres.iter().map(|_| (Vec3::ZERO, false)))
+            .zip(&surface_of)
+            .map(|((normal, smooth), &surface)| PrimInfo { normal, smooth, surface })
+            .collect();
         let packed = bvh
             .as_ref()
             .map(|b| {
@@ -147,6 +166,7 @@ impl Accel {
             triangles,
             spheres,
             surface_of,
+            info,
             bvh,
             packed,
             epsilon: super::ray_epsilon(scale),
@@ -198,37 +218,43 @@ impl Accel {
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let eps = self.epsilon;
+        let node_ray = Self::obvhs_ray(ray);
+        // The primitive test is written into obvhs's traversal loop (its
+        // `traverse!` macro) rather than passed as a closure, so the compiler
+        // inlines it: photon tracing spends most of its time here.
+        let (mut node_test_ray, mut prim_ray) = (node_ray, *ray);
         let mut best = (u32::MAX, 0.0f32, 0.0f32);
-        let mut hit = obvhs::ray::RayHit::none();
-        let mut local = *ray;
-        bvh.ray_traverse(Self::obvhs_ray(ray), &mut hit, |r, id| {
-            let packed = &self.packed[id];
-            local.t_max = r.tmax;
-            let (t, b1, b2) = packed.intersect(&local, eps);
-            if t < f32::INFINITY {
+        let mut state = bvh.new_traversal(node_ray.direction);
+        let mut node;
+        obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_test_ray, state.oct_inv4), {
+            let packed = &self.packed[state.primitive_id as usize];
+            let (t, b1, b2) = packed.intersect(&prim_ray, eps);
+            if t < prim_ray.t_max {
                 best = (packed.prim & !SPHERE_BIT, b1, b2);
+                prim_ray.t_max = t;
+                node_test_ray.tmax = t;
             }
-            t
         });
         if best.0 == u32::MAX {
             return None;
         }
-        let n_tri = self.triangles.len();
         let (prim, b1, b2) = (best.0 as usize, best.1, best.2);
-        let t = hit.t;
+        let t = prim_ray.t_max;
         let point = ray.at(t);
-        let (geometric_normal, shading_normal) = if prim < n_tri {
-            let tri = &self.triangles[prim];
-            let ng = tri.geometric_normal().normalize();
-            let ns = tri.shading_normal(b1, b2);
+        let info = self.info[prim];
+        let (geometric_normal, shading_normal) = if prim >= self.triangles.len() {
+            let s = &self.spheres[prim - self.triangles.len()];
+            let n = ((point - s.center) / s.radius).normalize();
+            (n, n)
+        } else if info.smooth {
+            let ng = info.normal;
+            let ns = self.triangles[prim].shading_normal(b1, b2);
             // Keep the shading normal on the geometric side (OBJ normals may disagree).
             (ng, if ns.dot(ng) < 0.0 { -ns } else { ns })
         } else {
-            let s = &self.spheres[prim - n_tri];
-            let n = ((point - s.center) / s.radius).normalize();
-            (n, n)
+            (info.normal, info.normal)
         };
-        Some(Hit { t, point, geometric_normal, shading_normal, surface: self.surface_of[prim] })
+        Some(Hit { t, point, geometric_normal, shading_normal, surface: info.surface })
     }
 
     /// True if anything blocks the open segment (epsilon, ray.t_max).
@@ -237,7 +263,19 @@ impl Accel {
             return false;
         };
         let eps = self.epsilon;
-        !bvh.ray_traverse_miss(Self::obvhs_ray(ray), |_, id| self.packed[id].intersect(ray, eps).0)
+        let node_ray = Self::obvhs_ray(ray);
+        let mut state = bvh.new_traversal(node_ray.direction);
+        let mut node;
+        let mut blocked = false;
+        'search: {
+            obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_ray, state.oct_inv4), {
+                if self.packed[state.primitive_id as usize].intersect(ray, eps).0 < ray.t_max {
+                    blocked = true;
+                    break 'search;
+                }
+            });
+        }
+        blocked
     }
 }
 

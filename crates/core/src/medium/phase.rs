@@ -9,7 +9,7 @@
 //! printed) measures it from the propagation direction. With this convention
 //! k > 0 and g > 0 scatter forward, as the seed states; the tests prove it.
 
-use crate::sampling::local_to_world;
+use crate::sampling::{local_to_world, unit_circle};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -54,8 +54,7 @@ impl Phase {
     pub fn sample(&self, dir: Vec3, u: Vec2) -> Vec3 {
         let mu = self.sample_mu(u.x);
         let sin = (1.0 - mu * mu).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y;
-        local_to_world(Vec3::new(sin * phi.cos(), sin * phi.sin(), mu), dir)
+        local_to_world((unit_circle(u.y) * sin).extend(mu), dir)
     }
 }
 

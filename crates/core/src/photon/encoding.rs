@@ -8,6 +8,7 @@ const EXP_BIAS: i32 = 15;
 
 /// Shared-exponent RGB (the RGB9E5 format of GL/Vulkan): 9-bit mantissas,
 /// 5-bit exponent; error ≤ 2⁻⁹ of the largest channel.
+#[inline]
 pub fn encode_rgb9e5(c: Vec3) -> u32 {
     const MAX_VALUE: f32 = 511.0 / 512.0 * 65536.0;
     let c = c.clamp(Vec3::ZERO, Vec3::splat(MAX_VALUE));
@@ -40,6 +41,7 @@ pub fn decode_rgb9e5(bits: u32) -> Vec3 {
 }
 
 /// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.
+#[inline]
 pub fn encode_octahedral_15(d: Vec3) -> u32 {
     let d = d / (d.x.abs() + d.y.abs() + d.z.abs());
     let mut p = Vec2::new(d.x, d.y);

@@ -43,6 +43,7 @@ pub struct Photon {
 }
 
 impl Photon {
+    #[inline]
     pub fn new(position: Vec3, power_in_units: Rgb, direction: Vec3, class: PathClass) -> Self {
         Photon {
             position: position.to_array(),

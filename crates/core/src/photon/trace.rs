@@ -75,7 +75,9 @@ pub fn trace_photons(scene: &Scene, settings: &TraceSettings, progress: &dyn Pro
         .into_par_iter()
         .map(|c| {
             let range = c * CHUNK..((c + 1) * CHUNK).min(n);
-            let mut out = ChunkResult::default();
+            // Room for two stored photons per path (1.7 in cornell-box), so
+            // most chunks never grow their buffer.
+            let mut out = ChunkResult { global: Vec::with_capacity(2 * CHUNK as usize), ..Default::default() };
             let mut tracer =
                 PathTracer { scene, probabilities: &probabilities, n, power_unit, settings, out: &mut out };
             for i in range.clone() {

@@ -27,12 +27,35 @@ pub fn local_to_world(local: Vec3, axis: Vec3) -> Vec3 {
     t * local.x + b * local.y + axis * local.z
 }
 
+/// (cos 2πu, sin 2πu) for u in [0, 1), within 2e-7 of the exact values.
+///
+/// Every bounce of every photon picks an azimuth, and libm's `sin_cos` was
+/// 8% of photon-tracing time; this reduces to an octant (|angle| ≤ π/4) and
+/// evaluates short Taylor polynomials there, which is exact enough for
+/// sampling and several times cheaper.
+pub fn unit_circle(u: f32) -> Vec2 {
+    let x = u * 4.0;
+    // Nearest quadrant by truncation (x ≥ 0): `round` is a libm call on
+    // baseline x86-64.
+    let quadrant = (x + 0.5) as i32;
+    let a = (x - quadrant as f32) * (PI / 2.0);
+    let a2 = a * a;
+    let sin = a * (1.0 + a2 * (-1.0 / 6.0 + a2 * (1.0 / 120.0 + a2 * (-1.0 / 5040.0 + a2 * (1.0 / 362_880.0)))));
+    let cos = 1.0 + a2 * (-0.5 + a2 * (1.0 / 24.0 + a2 * (-1.0 / 720.0 + a2 * (1.0 / 40_320.0))));
+    // Rotate by the quadrant's multiple of π/2.
+    match quadrant & 3 {
+        0 => Vec2::new(cos, sin),
+        1 => Vec2::new(-sin, cos),
+        2 => Vec2::new(-cos, -sin),
+        _ => Vec2::new(sin, -cos),
+    }
+}
+
 /// Uniform direction on the unit sphere; density 1/(4π).
 pub fn uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    (unit_circle(u.y) * r).extend(z)
 }
 
 pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
@@ -42,8 +65,7 @@ pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
 pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
     let cos_theta = (1.0 - u.x).sqrt();
     let sin_theta = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+    (unit_circle(u.y) * sin_theta).extend(cos_theta)
 }
 
 pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
@@ -55,8 +77,7 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
 pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
     let cos_theta = 1.0 - u.x * (1.0 - cos_max);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta)
+    (unit_circle(u.y) * sin_theta).extend(cos_theta)
 }
 
 pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
@@ -73,6 +94,19 @@ pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
 mod tests {
     use super::chi2::{assert_direction_distribution, assert_unit_density};
     use super::*;
+
+    #[test]
+    fn unit_circle_matches_sin_cos() {
+        let mut worst = 0.0f64;
+        for i in 0..=100_000 {
+            // The whole range, quadrant boundaries included, and a value just below 1.
+            let u = if i == 100_000 { 1.0 - f32::EPSILON / 2.0 } else { i as f32 / 100_000.0 };
+            let phi = 2.0 * std::f64::consts::PI * u as f64;
+            let got = unit_circle(u);
+            worst = worst.max((got.x as f64 - phi.cos()).abs()).max((got.y as f64 - phi.sin()).abs());
+        }
+        assert!(worst < 2e-7, "worst error {worst}");
+    }
 
     #[test]
     fn basis_is_orthonormal() {
