@@ -176,7 +176,7 @@ fn render_photons(
     let render_start = Instant::now();
     let result = cpu.render(progress);
     eprintln!(
-        "photon-cpu: kd-trees {build_time:.2} s, render {:.2} s ({} spp)",
+        "photon-cpu: photon-map indexes {build_time:.2} s, render {:.2} s ({} spp)",
         render_start.elapsed().as_secs_f64(),
         settings.spp
     );

@@ -3,8 +3,8 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec2;
-use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, k_nearest_radiance};
-use hikari_core::photon::{PhotonMap, TraceSettings, trace_photons};
+use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, k_nearest_radiance, volume_radiance_along};
+use hikari_core::photon::{PhotonMap, TraceSettings, VolumePhotonMap, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::{Rng, cosine_hemisphere, local_to_world, uniform_sphere};
@@ -82,6 +82,37 @@ fn estimates(c: &mut Criterion) {
     black_box(uniform_sphere(Vec2::ZERO));
 }
 
+/// The CPU volume estimate along view rays in fog-stage (camera in the fog):
+/// the default 200k paths store about 553k volume photons.
+fn volume_estimate(c: &mut Criterion) {
+    let scene = Scene::load("fog-stage").unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 1, ..Default::default() }, &Silent);
+    let radius = hikari_core::render::photon_cpu::default_radius(&scene);
+    let map = VolumePhotonMap::new(traced.volume.clone(), traced.power_unit, radius);
+    let sigma_t = scene.media.sigma_t(scene.media.global_mask());
+    let mut rng = Rng::for_item(3, 0);
+    let rays: Vec<_> = (0..256)
+        .map(|_| {
+            let ray = scene.camera.ray(Vec2::new(rng.next_f32() * 512.0, rng.next_f32() * 384.0));
+            let length = scene.accel.intersect(&ray).map_or(scene.diagonal() * 2.0, |h| h.t);
+            (ray, length)
+        })
+        .collect();
+    let mut group = c.benchmark_group("estimates");
+    group.throughput(Throughput::Elements(rays.len() as u64));
+    group.bench_function(format!("volume_along_ray_fog_stage_{}k_photons", map.len() / 1000), |b| {
+        b.iter(|| {
+            rays.iter()
+                .map(|(ray, length)| {
+                    let transmittance = |s: f32| (-sigma_t * s).exp();
+                    volume_radiance_along(&map, scene.media.phases(), ray.origin, ray.dir, *length, transmittance).x
+                })
+                .sum::<f32>()
+        })
+    });
+    group.finish();
+}
+
 fn photon_cpu_frame(c: &mut Criterion) {
     let scene = Scene::load("cornell-box").unwrap();
     let mut group = c.benchmark_group("photon_cpu");
@@ -97,5 +128,5 @@ fn photon_cpu_frame(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_casting, photon_tracing, estimates, photon_cpu_frame);
+criterion_group!(benches, ray_casting, photon_tracing, estimates, volume_estimate, photon_cpu_frame);
 criterion_main!(benches);

@@ -7,7 +7,7 @@
 //! f_r = albedo/π), photon power in watts.
 
 use crate::material::Rgb;
-use crate::photon::{PathClass, Photon, PhotonMap};
+use crate::photon::{PathClass, Photon, PhotonMap, VolumePhotonMap};
 use glam::Vec3;
 use std::f32::consts::PI;
 
@@ -87,49 +87,37 @@ pub fn fixed_radius_radiance(
 /// `transmittance(s)` that of the media from the eye to distance s (exact in
 /// photon-cpu; interpolated between depth slices in the GPU's twin).
 pub fn volume_radiance_along(
-    map: &PhotonMap,
+    map: &VolumePhotonMap,
     phases: &[crate::medium::Phase],
     origin: Vec3,
     dir: Vec3,
     length: f32,
-    radius: f32,
     transmittance: impl Fn(f32) -> Rgb,
 ) -> Rgb {
-    let photons = map.photons();
-    if photons.is_empty() || !(length > 0.0) {
+    if map.is_empty() || !(length > 0.0) {
         return Rgb::ZERO;
     }
-    // Photons within r of the segment lie within 1.12 r of one of these
-    // query centres, r apart: gather their indices, each once.
-    let steps = ((length.min(1e6) / radius).ceil() as usize).max(1);
-    let mut found: Vec<u32> = Vec::new();
-    for i in 0..=steps {
-        let centre = origin + dir * (length.min(1e6) * i as f32 / steps as f32);
-        map.for_each_index_within(centre, radius * 1.12, |index, _| found.push(index as u32));
-    }
-    found.sort_unstable();
-    found.dedup();
+    let radius = map.radius();
     let r2 = radius * radius;
     let norm = 1.0 / (4.0 / 3.0 * PI * r2 * radius);
     let mut sum = Rgb::ZERO;
-    for &index in &found {
-        let photon = &photons[index as usize];
-        let to_photon = photon.position() - origin;
+    map.for_each_near_segment(origin, dir, length, |photon| {
+        let to_photon = photon.position - origin;
         let t_closest = to_photon.dot(dir);
         let h2 = to_photon.length_squared() - t_closest * t_closest;
         if h2 > r2 {
-            continue;
+            return;
         }
         let half = (r2 - h2).max(0.0).sqrt();
         let (t0, t1) = ((t_closest - half).max(0.0), (t_closest + half).min(length));
         if t1 <= t0 {
-            continue;
+            return;
         }
         let s_p = t_closest.clamp(t0, t1);
-        let mu = photon.direction().dot(-dir);
-        let phase = phases[photon.phase_slot()].eval(mu);
-        sum += transmittance(s_p) * map.power_in_units(index as usize) * (phase * (t1 - t0));
-    }
+        let mu = photon.direction.dot(-dir);
+        let phase = phases[photon.phase_slot].eval(mu);
+        sum += transmittance(s_p) * photon.power * (phase * (t1 - t0));
+    });
     sum * norm * map.power_unit
 }
 

@@ -170,8 +170,7 @@ fn volume_twin(scene: &Scene, traced: &TracedPhotons, slices: u32) -> Option<Twi
                 let lo = if k == 0 { Vec3::ZERO } else { ends[k - 1] };
                 (-lo.lerp(ends[k], u - k as f32)).exp()
             };
-            let want =
-                volume_radiance_along(cpu.volume_map(), media.phases(), eye, dir, l, cpu.volume_radius, transmittance);
+            let want = volume_radiance_along(cpu.volume_map(), media.phases(), eye, dir, l, transmittance);
             let got = volume[i].truncate();
             if want.max_element() <= 0.0 && got.max_element() <= 0.0 {
                 continue;

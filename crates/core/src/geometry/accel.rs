@@ -202,23 +202,11 @@ impl Accel {
         self.spheres.len()
     }
 
-    /// The ray as obvhs sees it for node tests. Its CWBVH slab test turns an
-    /// exactly zero direction component into inf·0 = NaN and misses every box,
-    /// so such components are nudged to a tiny value; the primitive tests
-    /// still use the exact ray.
-    fn obvhs_ray(ray: &Ray) -> obvhs::ray::Ray {
-        let nudge = |d: f32| {
-            if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d }
-        };
-        let dir = Vec3A::new(nudge(ray.dir.x), nudge(ray.dir.y), nudge(ray.dir.z));
-        obvhs::ray::Ray::new(ray.origin.into(), dir, 0.0, ray.t_max)
-    }
-
     /// Closest intersection in (epsilon, ray.t_max).
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let bvh = self.bvh.as_ref()?;
         let eps = self.epsilon;
-        let node_ray = Self::obvhs_ray(ray);
+        let node_ray = super::obvhs_ray(ray.origin, ray.dir, ray.t_max);
         // The primitive test is written into obvhs's traversal loop (its
         // `traverse!` macro) rather than passed as a closure, so the compiler
         // inlines it: photon tracing spends most of its time here.
@@ -263,7 +251,7 @@ impl Accel {
             return false;
         };
         let eps = self.epsilon;
-        let node_ray = Self::obvhs_ray(ray);
+        let node_ray = super::obvhs_ray(ray.origin, ray.dir, ray.t_max);
         let mut state = bvh.new_traversal(node_ray.direction);
         let mut node;
         let mut blocked = false;

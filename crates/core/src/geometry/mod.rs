@@ -34,3 +34,15 @@ impl Ray {
 pub fn ray_epsilon(scene_scale: f32) -> f32 {
     scene_scale * 1e-5
 }
+
+/// A ray as obvhs sees it for node tests. Its CWBVH slab test turns an
+/// exactly zero direction component into inf·0 = NaN and misses every box,
+/// so such components are nudged to a tiny value; primitive tests still use
+/// the exact ray.
+pub(crate) fn obvhs_ray(origin: Vec3, dir: Vec3, t_max: f32) -> obvhs::ray::Ray {
+    let nudge = |d: f32| {
+        if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d }
+    };
+    let dir = glam::Vec3A::new(nudge(dir.x), nudge(dir.y), nudge(dir.z));
+    obvhs::ray::Ray::new(origin.into(), dir, 0.0, t_max)
+}

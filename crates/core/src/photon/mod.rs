@@ -9,9 +9,11 @@
 mod encoding;
 mod map;
 mod trace;
+mod volume_map;
 
 pub use map::PhotonMap;
 pub use trace::{TraceSettings, TraceStats, TracedPhotons, trace_photons};
+pub use volume_map::{VolumePhoton, VolumePhotonMap};
 
 use crate::material::Rgb;
 use glam::Vec3;

@@ -9,7 +9,7 @@ use crate::estimate::{FixedRadius, fixed_radius_radiance};
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, dielectric_split, reflect};
 use crate::medium::MediaAlong;
-use crate::photon::{PhotonMap, TracedPhotons};
+use crate::photon::{PhotonMap, TracedPhotons, VolumePhotonMap};
 use crate::progress::Progress;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -98,7 +98,7 @@ pub struct PhotonCpuRenderer<'a> {
     /// Indirect-class photons only: what the global-map estimate shows.
     global: PhotonMap,
     caustic: PhotonMap,
-    volume: PhotonMap,
+    volume: VolumePhotonMap,
     pub volume_radius: f32,
     pub global_params: FixedRadius,
     pub caustic_params: FixedRadius,
@@ -108,12 +108,13 @@ pub struct PhotonCpuRenderer<'a> {
 impl<'a> PhotonCpuRenderer<'a> {
     pub fn new(scene: &'a Scene, traced: &TracedPhotons, settings: &PhotonCpuSettings) -> Self {
         let (global_params, caustic_params) = settings.estimate_params(scene);
+        let volume_radius = settings.volume_radius.unwrap_or_else(|| default_radius(scene));
         PhotonCpuRenderer {
             scene,
             global: PhotonMap::new(traced.indirect(), traced.power_unit),
             caustic: PhotonMap::new(traced.caustic.clone(), traced.power_unit),
-            volume: PhotonMap::new(traced.volume.clone(), traced.power_unit),
-            volume_radius: settings.volume_radius.unwrap_or_else(|| default_radius(scene)),
+            volume: VolumePhotonMap::new(traced.volume.clone(), traced.power_unit, volume_radius),
+            volume_radius,
             global_params,
             caustic_params,
             settings: settings.clone(),
@@ -128,7 +129,7 @@ impl<'a> PhotonCpuRenderer<'a> {
         &self.caustic
     }
 
-    pub fn volume_map(&self) -> &PhotonMap {
+    pub fn volume_map(&self) -> &VolumePhotonMap {
         &self.volume
     }
 
@@ -158,15 +159,9 @@ impl<'a> PhotonCpuRenderer<'a> {
         let length = hit.map_or_else(|| self.scene.diagonal() * 2.0, |h| h.t);
         let along = MediaAlong::new(media, ray.origin, ray.dir, length);
         let volume = if self.settings.components.volume {
-            crate::estimate::volume_radiance_along(
-                &self.volume,
-                media.phases(),
-                ray.origin,
-                ray.dir,
-                length,
-                self.volume_radius,
-                |s| along.transmittance(s),
-            )
+            crate::estimate::volume_radiance_along(&self.volume, media.phases(), ray.origin, ray.dir, length, |s| {
+                along.transmittance(s)
+            })
         } else {
             Rgb::ZERO
         };
