@@ -108,7 +108,13 @@ fn render_photons(
 ) -> Result<(Image, u64)> {
     let gpu = match renderer {
         RendererKind::Gpu => match GpuContext::new() {
-            Ok(ctx) => Some(ctx),
+            Ok(ctx) => match GpuRenderer::unsupported_on(scene, &ctx) {
+                Some(reason) => {
+                    eprintln!("{reason}: using photon-cpu");
+                    None
+                }
+                None => Some(ctx),
+            },
             Err(e) => {
                 eprintln!("{e}: falling back to the CPU renderer (photon-cpu)");
                 None
@@ -215,13 +221,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let mut scene = Scene::load(&args.scene)?;
-    let mut renderer = args.renderer;
-    if renderer == RendererKind::Gpu {
-        if let Some(reason) = GpuRenderer::unsupported(&scene) {
-            eprintln!("{reason}: using photon-cpu");
-            renderer = RendererKind::PhotonCpu;
-        }
-    }
+    let renderer = args.renderer;
     if let Some((w, h)) = args.resolution {
         scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
     }

@@ -124,8 +124,7 @@ fn bad_scene_files_are_reported_with_file_and_line() {
 
 /// A scene with a medium renders with the default GPU renderer (or the
 /// CPU fallback when the machine has no adapter), photon-cpu and the path
-/// tracer; with glass in the fog the GPU renderer says it cannot and uses
-/// photon-cpu.
+/// tracer, with glass in the fog too (on the GPU where it is a hardware one).
 #[test]
 fn media_are_rendered() {
     let dir = scratch_dir("fog");
@@ -148,7 +147,12 @@ fn media_are_rendered() {
     let out = hikari(&["render", "glass.toml", "--photons", "2000", "-o", "g.png", "-q"], &dir);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("mirrors or glass inside participating media: using photon-cpu"), "{err}");
+    // A hardware GPU draws it; lavapipe and no adapter at all leave it to photon-cpu.
+    assert!(
+        err.contains("gpu:") || err.contains("need a hardware GPU") || err.contains("falling back to the CPU renderer"),
+        "{err}"
+    );
+    assert!(dir.join("g.png").is_file());
     let _ = std::fs::remove_file(dir.join("g.png"));
 }
 

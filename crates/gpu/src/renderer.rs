@@ -168,12 +168,18 @@ fn depth_range(scene: &Scene) -> (f32, f32) {
 }
 
 impl GpuRenderer {
-    /// Why this renderer cannot draw `scene` faithfully, if it cannot: the
-    /// specular pass does not attenuate or scatter along its rays, so
-    /// mirrors and glass in media are left to photon-cpu.
-    pub fn unsupported(scene: &Scene) -> Option<&'static str> {
-        (!scene.media.is_empty() && crate::specular::has_specular_surfaces(scene))
-            .then_some("the GPU renderer does not draw mirrors or glass inside participating media")
+    /// Why this renderer should not draw `scene` on `ctx`, if so. Mirrors
+    /// and glass in media make the specular pass gather the volume map along
+    /// every segment of every path; lavapipe (like other software adapters
+    /// built on llvmpipe) runs at most 65,535 loop iterations per shader
+    /// invocation and then ends every loop after one pass, which silently
+    /// drops light in such scenes, so software adapters leave them to
+    /// photon-cpu.
+    pub fn unsupported_on(scene: &Scene, ctx: &GpuContext) -> Option<&'static str> {
+        let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
+        (software && !scene.media.is_empty() && crate::specular::has_specular_surfaces(scene)).then_some(
+            "mirrors or glass in participating media need a hardware GPU (software adapters cap shader loops)",
+        )
     }
 
     pub fn new(ctx: GpuContext, scene: &Scene, traced: &TracedPhotons, settings: GpuSettings) -> Self {
@@ -207,23 +213,6 @@ impl GpuRenderer {
         let (near, far) = depth_range(scene);
         let scene_buffers = SceneBuffers::upload(device, scene);
         let global_photons = traced.indirect();
-        let specular_pass = SpecularPass::new(
-            device,
-            scene,
-            &scene_buffers.surfaces,
-            &lights,
-            &targets.shadow_maps,
-            &targets.gbuffer,
-            &SpecularInputs {
-                global_photons: &global_photons,
-                caustic_photons: &traced.caustic,
-                global: settings.global,
-                caustic: settings.caustic,
-                power_unit: traced.power_unit,
-                max_depth: settings.max_specular_depth,
-                shadow_bias: settings.shadow_bias,
-            },
-        );
         let clip_from_world = scene.camera.clip_from_view(near, far) * scene.camera.view_from_world();
         let media = GpuMedia::new(
             device,
@@ -232,6 +221,26 @@ impl GpuRenderer {
             &targets.gbuffer,
             clip_from_world,
             ctx.radiance_format,
+        );
+        let specular_pass = SpecularPass::new(
+            device,
+            scene,
+            &scene_buffers.surfaces,
+            &lights,
+            &targets.shadow_maps,
+            &targets.gbuffer,
+            &media,
+            &SpecularInputs {
+                global_photons: &global_photons,
+                caustic_photons: &traced.caustic,
+                volume_photons: &traced.volume,
+                volume_radius: settings.volume_radius,
+                global: settings.global,
+                caustic: settings.caustic,
+                power_unit: traced.power_unit,
+                max_depth: settings.max_specular_depth,
+                shadow_bias: settings.shadow_bias,
+            },
         );
         let volume_params = VolumeParams {
             clip_from_world: clip_from_world.to_cols_array_2d(),

@@ -125,7 +125,15 @@ fn shared_structs_match_wgsl_layouts() {
             caustic_radius,
             caustic_buckets,
             caustic_start_offset,
-            caustic_photon_offset
+            caustic_photon_offset,
+            volume_radius,
+            volume_buckets,
+            volume_start_offset,
+            volume_photon_offset,
+            volume_min,
+            _pad0,
+            volume_max,
+            _pad1
         ]
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);

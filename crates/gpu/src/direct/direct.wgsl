@@ -12,12 +12,6 @@
 @group(0) @binding(8) var<uniform> media: MediaParams;
 @group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
 
-// Light reaching x from a light sample through the media (eq. 5.8, 5.26).
-fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
-    let d = light_position - x;
-    let len = length(d);
-    return exp(-segment_optical_depth(x, d / len, len));
-}
 
 @vertex
 fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {

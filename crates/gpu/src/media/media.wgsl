@@ -1,6 +1,7 @@
 // Participating media on the GPU (METHOD.md §5), mirrored from
-// hikari_core::medium: phase functions, the view ray of a pixel, and the
-// optical depth along any segment (for light reaching a surface).
+// hikari_core::medium: phase functions, the view ray of a pixel, the
+// optical depth along any segment, and the transmittance light_eval.wgsl
+// asks for (light reaching a surface).
 // Prepended to the shaders that use media; the includer declares `media`
 // and `regions` (view_depth.wgsl adds the optical depth along view rays).
 
@@ -91,4 +92,11 @@ fn segment_optical_depth(origin: vec3<f32>, dir: vec3<f32>, len: f32) -> vec3<f3
         tau += select(-1.0, 1.0, leaving) * tri.sigma_t.xyz * min(t, len);
     }
     return max(tau, vec3<f32>(0.0));
+}
+
+// Light reaching x from a light sample through the media (eq. 5.8, 5.26).
+fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
+    let d = light_position - x;
+    let len = length(d);
+    return exp(-segment_optical_depth(x, d / len, len));
 }

@@ -1,10 +1,12 @@
 //! The specular pass: mirrors, glass and the mirror part of diffuse + mirror
 //! materials seen by the camera, ray-traced on
 //! the GPU through the scene BVH to their diffuse hits, which are shaded
-//! with direct light and photon gathers (see specular.wgsl).
+//! with direct light and photon gathers, every segment attenuated by the
+//! media and adding their in-scattering (see specular.wgsl).
 
 use crate::direct::DirectParams;
 use crate::gbuffer::GBuffer;
+use crate::media::GpuMedia;
 use crate::photon_grid::PhotonGrid;
 use crate::shadow::ShadowMaps;
 use crate::shadow::light_samples::GpuLights;
@@ -28,7 +30,13 @@ pub fn has_specular_surfaces(scene: &Scene) -> bool {
 }
 
 pub fn shader_source() -> String {
-    format!("{}\n{}\n{}", crate::ESTIMATE_WGSL, crate::direct::LIGHT_EVAL_WGSL, include_str!("specular.wgsl"))
+    format!(
+        "{}\n{}\n{}\n{}",
+        crate::ESTIMATE_WGSL,
+        crate::media::MEDIA_WGSL,
+        crate::direct::LIGHT_EVAL_WGSL,
+        include_str!("specular.wgsl")
+    )
 }
 
 /// Mirrors `SpecularParams` in specular.wgsl.
@@ -55,12 +63,24 @@ pub struct SpecularParams {
     pub caustic_buckets: u32,
     pub caustic_start_offset: u32,
     pub caustic_photon_offset: u32,
+    pub volume_radius: f32,
+    /// 0 when there are no volume photons.
+    pub volume_buckets: u32,
+    pub volume_start_offset: u32,
+    pub volume_photon_offset: u32,
+    /// Bounds of the volume photons' positions.
+    pub volume_min: [f32; 3],
+    pub _pad0: u32,
+    pub volume_max: [f32; 3],
+    pub _pad1: u32,
 }
 
-/// Everything the estimate needs to know about the two photon maps.
+/// Everything the estimate needs to know about the photon maps.
 pub struct SpecularInputs<'a> {
     pub global_photons: &'a [Photon],
     pub caustic_photons: &'a [Photon],
+    pub volume_photons: &'a [Photon],
+    pub volume_radius: f32,
     pub global: FixedRadius,
     pub caustic: FixedRadius,
     pub power_unit: f32,
@@ -88,6 +108,7 @@ impl SpecularPass {
         lights: &GpuLights,
         maps: &ShadowMaps,
         gbuffer: &GBuffer,
+        media: &GpuMedia,
         inputs: &SpecularInputs,
     ) -> Self {
         let (width, height) = (gbuffer.width, gbuffer.height);
@@ -114,6 +135,7 @@ impl SpecularPass {
                 entry(10, texture(D2Array)),
                 entry(11, texture(D2)),
                 entry(12, storage_texture_rgba32f()),
+                entry(13, uniform()),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -130,14 +152,30 @@ impl SpecularPass {
             cache: None,
         });
 
-        // Static scene data: the flat BVH and both photon grids, concatenated.
+        // Static scene data: the flat BVH and the three photon grids in one
+        // buffer of words (all bucket starts, then all photons).
         let bvh = FlatBvh::new(&scene.accel);
         let global = PhotonGrid::new(inputs.global_photons, inputs.global.radius);
         let caustic = PhotonGrid::new(inputs.caustic_photons, inputs.caustic.radius);
-        let mut starts = global.starts.clone();
-        starts.extend(&caustic.starts);
-        let mut photons = global.photons.clone();
-        photons.extend(&caustic.photons);
+        let volume = PhotonGrid::new(inputs.volume_photons, inputs.volume_radius);
+        let grids = [&global, &caustic, &volume];
+        let mut words: Vec<u32> = Vec::new();
+        let mut start_offsets = [0u32; 3];
+        for (offset, grid) in start_offsets.iter_mut().zip(grids) {
+            *offset = words.len() as u32;
+            words.extend(&grid.starts);
+        }
+        let mut photon_offsets = [0u32; 3];
+        for (offset, grid) in photon_offsets.iter_mut().zip(grids) {
+            *offset = words.len() as u32;
+            words.extend_from_slice(bytemuck::cast_slice(&grid.photons));
+        }
+        let volume_bounds = inputs
+            .volume_photons
+            .iter()
+            .fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
+                (lo.min(p.position()), hi.max(p.position()))
+            });
         let (forward, right, up, tan_half_fov) = scene.camera.basis();
         let params = SpecularParams {
             camera_position: scene.camera.position.to_array(),
@@ -154,12 +192,20 @@ impl SpecularPass {
             power_unit: inputs.power_unit,
             global_radius: inputs.global.radius,
             global_buckets: global.buckets,
-            global_start_offset: 0,
-            global_photon_offset: 0,
+            global_start_offset: start_offsets[0],
+            global_photon_offset: photon_offsets[0],
             caustic_radius: inputs.caustic.radius,
             caustic_buckets: caustic.buckets,
-            caustic_start_offset: global.starts.len() as u32,
-            caustic_photon_offset: global.photons.len() as u32,
+            caustic_start_offset: start_offsets[1],
+            caustic_photon_offset: photon_offsets[1],
+            volume_radius: inputs.volume_radius,
+            volume_buckets: if inputs.volume_photons.is_empty() { 0 } else { volume.buckets },
+            volume_start_offset: start_offsets[2],
+            volume_photon_offset: photon_offsets[2],
+            volume_min: volume_bounds.0.to_array(),
+            _pad0: 0,
+            volume_max: volume_bounds.1.to_array(),
+            _pad1: 0,
         };
         let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
             // wgpu refuses empty bindings: pad to one zero word.
@@ -170,8 +216,7 @@ impl SpecularPass {
         let params_buffer = buffer("specular params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
         let nodes = buffer("bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage_usage);
         let prims = buffer("bvh prims", bytemuck::cast_slice(&bvh.prims), storage_usage);
-        let starts = buffer("grid starts", bytemuck::cast_slice(&starts), storage_usage);
-        let photons = buffer("grid photons", bytemuck::cast_slice(&photons), storage_usage);
+        let grid = buffer("photon grids", bytemuck::cast_slice(&words), storage_usage);
         let direct_params = DirectParams {
             light_count: lights.lights.len() as u32,
             shadow_size: maps.size,
@@ -206,8 +251,8 @@ impl SpecularPass {
                 wgpu::BindGroupEntry { binding: 1, resource: nodes.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: prims.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: surfaces.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: starts.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: photons.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: grid.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: media.regions.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: direct_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 7, resource: lights_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 8, resource: samples_buffer.as_entire_binding() },
@@ -215,6 +260,7 @@ impl SpecularPass {
                 wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&maps_view) },
                 wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&normal_view) },
                 wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
+                wgpu::BindGroupEntry { binding: 13, resource: media.params_buffer.as_entire_binding() },
             ],
         });
         let enabled = has_specular_surfaces(scene);

@@ -4,7 +4,10 @@
 // total internal reflection) through the scene BVH up to `max_depth`
 // bounces, and shade each diffuse hit, weighted by its throughput, with
 // direct light (light_eval.wgsl) and fixed-radius gathers over both photon
-// maps (estimate.wgsl). Prepended with estimate.wgsl and light_eval.wgsl.
+// maps (estimate.wgsl). In media every segment of the path is attenuated
+// and adds the in-scattering along it from the volume map, as photon-cpu's
+// recursion does. Prepended with estimate.wgsl, media.wgsl and
+// light_eval.wgsl.
 
 struct SpecularParams {
     camera_position: vec3<f32>,
@@ -27,6 +30,15 @@ struct SpecularParams {
     caustic_buckets: u32,
     caustic_start_offset: u32,
     caustic_photon_offset: u32,
+    volume_radius: f32,
+    volume_buckets: u32,
+    volume_start_offset: u32,
+    volume_photon_offset: u32,
+    // Bounds of the volume photons' positions.
+    volume_min: vec3<f32>,
+    _pad0: u32,
+    volume_max: vec3<f32>,
+    _pad1: u32,
 }
 
 struct FlatNode {
@@ -54,19 +66,14 @@ struct Surface {
     _pad: u32,
 }
 
-// The specular pass does not draw media (the CLI sends scenes with both
-// media and mirrors or glass to photon-cpu).
-fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
-    return vec3<f32>(1.0);
-}
-
 @group(0) @binding(0) var<uniform> params: SpecularParams;
 @group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
 @group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;
 @group(0) @binding(3) var<storage, read> surfaces: array<Surface>;
-// Both photon grids' bucket starts, then both grids' photons (5 words each).
-@group(0) @binding(4) var<storage, read> grid_starts: array<u32>;
-@group(0) @binding(5) var<storage, read> grid_photons: array<u32>;
+// The three photon grids (global, caustic, volume) in one buffer: their
+// bucket starts, then their photons (5 words each); the offsets are words.
+@group(0) @binding(4) var<storage, read> grid: array<u32>;
+@group(0) @binding(5) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(6) var<uniform> direct_params: DirectParams;
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var<storage, read> samples: array<LightSample>;
@@ -74,6 +81,7 @@ fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
 @group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(13) var<uniform> media: MediaParams;
 
 const NO_HIT: f32 = 3.0e38;
 
@@ -210,19 +218,133 @@ fn gather(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>, radius: f32, buckets: u
         }
         seen[seen_count] = b;
         seen_count += 1u;
-        let start = grid_starts[start_offset + b];
-        let end = grid_starts[start_offset + b + 1u];
+        let start = grid[start_offset + b];
+        let end = grid[start_offset + b + 1u];
         for (var i = start; i < end; i++) {
-            let base = 5u * (photon_offset + i);
-            let p = vec3<f32>(bitcast<f32>(grid_photons[base]), bitcast<f32>(grid_photons[base + 1u]), bitcast<f32>(grid_photons[base + 2u]));
+            let base = photon_offset + 5u * i;
+            let p = vec3<f32>(bitcast<f32>(grid[base]), bitcast<f32>(grid[base + 1u]), bitcast<f32>(grid[base + 2u]));
             let d = p - x;
-            let dir = decode_octahedral_15(grid_photons[base + 4u] & 0x3fffffffu);
+            let dir = decode_octahedral_15(grid[base + 4u] & 0x3fffffffu);
             if (photon_accepted(dot(d, d), dir, n, radius, params.normal_test != 0u)) {
-                power += decode_rgb9e5(grid_photons[base + 3u]);
+                power += decode_rgb9e5(grid[base + 3u]);
             }
         }
     }
     return radiance_per_power(albedo, radius) * power * params.power_unit;
+}
+
+fn has_media() -> bool {
+    return any(media.global_sigma_t > vec3<f32>(0.0)) || media.region_triangles > 0u;
+}
+
+// Transmittance from o to o + s·d: closed form for media filling the scene,
+// the exact region-crossing sum otherwise.
+fn transmittance_along(o: vec3<f32>, d: vec3<f32>, s: f32) -> vec3<f32> {
+    if (media.region_triangles == 0u) {
+        return exp(-media.global_sigma_t * s);
+    }
+    return exp(-segment_optical_depth(o, d, s));
+}
+
+// The photons of the volume grid in the 27 cells around `cell` whose chord
+// point s_p (the point of the segment nearest the photon) lies in
+// [t_enter, t_exit): hikari_core::estimate::volume_radiance_along's terms.
+// The DDA below hands consecutive cells adjoining intervals, so each photon
+// within r of the segment is counted once, by the cell its s_p falls in.
+fn volume_cell(o: vec3<f32>, d: vec3<f32>, len: f32, cell: vec3<i32>, t_enter: f32, t_exit: f32) -> vec3<f32> {
+    let r = params.volume_radius;
+    let r2 = r * r;
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < 27u; k++) {
+        let neighbour = cell + vec3<i32>(i32(k % 3u) - 1, i32((k / 3u) % 3u) - 1, i32(k / 9u) - 1);
+        let b = bucket_of(neighbour, params.volume_buckets);
+        let start = grid[params.volume_start_offset + b];
+        let end = grid[params.volume_start_offset + b + 1u];
+        for (var i = start; i < end; i++) {
+            let base = params.volume_photon_offset + 5u * i;
+            let p = vec3<f32>(bitcast<f32>(grid[base]), bitcast<f32>(grid[base + 1u]), bitcast<f32>(grid[base + 2u]));
+            // A bucket shared by two of the 27 cells is read twice: count a
+            // photon only from its own cell (cheaper than remembering the
+            // buckets read, which costs loop iterations lavapipe caps).
+            if (any(vec3<i32>(floor(p / r)) != neighbour)) {
+                continue;
+            }
+            let to_photon = p - o;
+            let t_closest = dot(to_photon, d);
+            let h2 = dot(to_photon, to_photon) - t_closest * t_closest;
+            if (h2 > r2) {
+                continue;
+            }
+            let half = sqrt(max(r2 - h2, 0.0));
+            let t0 = max(t_closest - half, 0.0);
+            let t1 = min(t_closest + half, len);
+            if (t1 <= t0) {
+                continue;
+            }
+            let s_p = clamp(t_closest, t0, t1);
+            if (s_p < t_enter || s_p >= t_exit) {
+                continue;
+            }
+            let code = grid[base + 4u];
+            let mu = dot(decode_octahedral_15(code & 0x3fffffffu), -d);
+            let phase = phase_eval(code >> 30u, mu);
+            sum += transmittance_along(o, d, s_p) * decode_rgb9e5(grid[base + 3u]) * (phase * (t1 - t0));
+        }
+    }
+    return sum;
+}
+
+// In-scattered radiance reaching o along the segment o + t·d, t in [0, len]
+// (photon-cpu's volume_radiance_along): the grid's cells (`volume_radius`
+// wide) are walked in order along the segment (Amanatides–Woo).
+fn volume_along(o: vec3<f32>, d: vec3<f32>, len: f32) -> vec3<f32> {
+    if (params.volume_buckets == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let r = params.volume_radius;
+    let inv = safe_inverse(d);
+    // Only the part of the segment within r of the photons' bounding box
+    // can gather anything: walk that part (escaping rays would otherwise
+    // walk up to `max_distance`).
+    let t_lo = (params.volume_min - vec3<f32>(r) - o) * inv;
+    let t_hi = (params.volume_max + vec3<f32>(r) - o) * inv;
+    let t_start = max(max(max(min(t_lo.x, t_hi.x), min(t_lo.y, t_hi.y)), min(t_lo.z, t_hi.z)), 0.0);
+    let t_end = min(min(min(max(t_lo.x, t_hi.x), max(t_lo.y, t_hi.y)), max(t_lo.z, t_hi.z)), len);
+    if (t_start > t_end) {
+        return vec3<f32>(0.0);
+    }
+    var cell = vec3<i32>(floor((o + d * t_start) / r));
+    let step = vec3<i32>(select(vec3<i32>(-1), vec3<i32>(1), d >= vec3<f32>(0.0)));
+    let next_plane = (vec3<f32>(cell) + select(vec3<f32>(0.0), vec3<f32>(1.0), d >= vec3<f32>(0.0))) * r;
+    var t_next = (next_plane - o) * inv;
+    let t_delta = abs(inv) * r;
+    // Photons whose chord point lies before t_start (or after t_end) are
+    // more than r from the box, so the first and last cells take all
+    // chord points on their side.
+    var t_enter = -1.0;
+    var sum = vec3<f32>(0.0);
+    // Bounded walk: a segment crosses at most 3 · len / r + 3 cells.
+    for (var n = 0u; n < 100000u; n++) {
+        let t_exit = min(t_next.x, min(t_next.y, t_next.z));
+        let last = t_exit >= t_end;
+        sum += volume_cell(o, d, len, cell, t_enter, select(t_exit, NO_HIT, last));
+        if (last) {
+            break;
+        }
+        t_enter = t_exit;
+        if (t_next.x == t_exit) {
+            cell.x += step.x;
+            t_next.x += t_delta.x;
+        } else if (t_next.y == t_exit) {
+            cell.y += step.y;
+            t_next.y += t_delta.y;
+        } else {
+            cell.z += step.z;
+            t_next.z += t_delta.z;
+        }
+    }
+    let norm = 1.0 / (4.0 / 3.0 * PI_M * r * r * r);
+    return sum * norm * params.power_unit;
 }
 
 struct Branch {
@@ -263,6 +385,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         top -= 1u;
         let b = stack[top];
         let hit = trace(b.origin, b.dir);
+        // Media along this segment (photon-cpu's `radiance`): a ray that
+        // hits nothing still crosses `max_distance` of them. The segment from
+        // the eye (depth 0) is the raster passes' (volume splat, resolve).
+        var weight = b.weight;
+        if (b.depth > 0u && has_media()) {
+            let len = select(hit.t, media.max_distance, hit.t >= NO_HIT);
+            radiance += b.weight * volume_along(b.origin, b.dir, len);
+            weight *= transmittance_along(b.origin, b.dir, len);
+        }
         if (hit.t >= NO_HIT) {
             continue;
         }
@@ -283,16 +414,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 if (b.depth > 0u) {
                     let g = gather(x, n, s.albedo, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
                     let c = gather(x, n, s.albedo, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
-                    radiance += b.weight * (direct_radiance(x, n, s.albedo) + g + c);
+                    radiance += weight * (direct_radiance(x, n, s.albedo) + g + c);
                 }
                 if (any(s.specular > vec3<f32>(0.0)) && can_bounce && top < STACK) {
-                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), b.weight * s.specular);
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * s.specular);
                     top += 1u;
                 }
             }
             case 1u: {
                 if (can_bounce && top < STACK) {
-                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), b.weight * s.albedo);
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * s.albedo);
                     top += 1u;
                 }
             }
@@ -312,18 +443,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     }
                     if (reflectance < 1.0 && top < STACK) {
                         let refracted = normalize(eta * b.dir + (eta * cos_i - cos_t) * n);
-                        stack[top] = Branch(x, b.depth + 1u, refracted, b.weight * (1.0 - reflectance));
+                        stack[top] = Branch(x, b.depth + 1u, refracted, weight * (1.0 - reflectance));
                         top += 1u;
                     }
                     if (reflectance > 0.0 && top < STACK) {
-                        stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), b.weight * reflectance);
+                        stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * reflectance);
                         top += 1u;
                     }
                 }
             }
             default: {
                 if (front) {
-                    radiance += b.weight * s.emission;
+                    radiance += weight * s.emission;
                 }
             }
         }
