@@ -53,11 +53,7 @@ impl DirectPass {
                 entry(9, storage(true)),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("direct"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "direct", &layout);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("direct"),
             layout: Some(&pipeline_layout),

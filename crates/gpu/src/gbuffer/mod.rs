@@ -94,11 +94,7 @@ impl GBufferPass {
                 crate::binding::entry(1, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("gbuffer"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "gbuffer", &layout);
         let target =
             Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -115,13 +111,7 @@ impl GBufferPass {
                 })],
             },
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: Some(crate::binding::nearest_depth(DEPTH_FORMAT)),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,

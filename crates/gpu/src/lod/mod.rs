@@ -77,20 +77,9 @@ impl LodPass {
                 entry(4, storage(false)),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("lod"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "lod", &layout);
         let pipeline = |entry_point: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: Default::default(),
-                cache: None,
-            })
+            crate::binding::compute_pipeline(device, entry_point, &pipeline_layout, &module, entry_point)
         };
         LodPass { count: pipeline("count"), scan: pipeline("scan"), scatter: pipeline("scatter"), layout }
     }

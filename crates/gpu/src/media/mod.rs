@@ -187,11 +187,7 @@ impl GpuMedia {
             label: Some("optical_depth.wgsl"),
             source: wgpu::ShaderSource::Wgsl(optical_depth_shader_source().into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("optical depth"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "optical depth", &layout);
         let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &[], "optical depth");
         GpuMedia { params, params_buffer, regions, slices: slices_texture, pipeline, bind_group }
     }

@@ -39,31 +39,9 @@ impl ResolvePass {
         entries.push(entry(10, stage, texture(wgpu::TextureViewDimension::D2Array)));
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("resolve"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("resolve"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("resolved radiance"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "resolve", &layout);
+        let pipeline = crate::binding::compute_pipeline(device, "resolve", &pipeline_layout, &module, "main");
+        let output = crate::binding::storage_output_texture(device, "resolved radiance", width, height);
         let mut views: Vec<wgpu::TextureView> = inputs.iter().map(|t| t.create_view(&Default::default())).collect();
         views.push(output.create_view(&Default::default()));
         views.push(volume.create_view(&Default::default()));

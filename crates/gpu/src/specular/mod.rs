@@ -138,19 +138,8 @@ impl SpecularPass {
                 entry(13, uniform()),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("specular"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("specular"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
+        let pipeline = crate::binding::compute_pipeline(device, "specular", &pipeline_layout, &module, "main");
 
         // Static scene data: the flat BVH and the three photon grids in one
         // buffer of words (all bucket starts, then all photons).
@@ -227,18 +216,7 @@ impl SpecularPass {
             buffer("specular direct params", bytemuck::bytes_of(&direct_params), wgpu::BufferUsages::UNIFORM);
         let lights_buffer = buffer("specular lights", bytemuck::cast_slice(&lights.lights), storage_usage);
         let samples_buffer = buffer("specular light samples", bytemuck::cast_slice(&lights.samples), storage_usage);
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("specular radiance"),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let output = crate::binding::storage_output_texture(device, "specular radiance", width, height);
         let maps_view =
             maps.texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(D2Array), ..Default::default() });
         let normal_view = gbuffer.normal.create_view(&Default::default());

@@ -132,11 +132,7 @@ impl SplatPass {
                 entry(3, wgpu::ShaderStages::FRAGMENT, texture(D2)),
             ],
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("splat"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "splat", &layout);
         let pipeline =
             additive_pipeline(device, &pipeline_layout, &module, target_format, &[Some(photon_instances())], "splat");
         SplatPass { pipeline, layout }

@@ -81,11 +81,7 @@ impl VolumePass {
             label: Some("volume.wgsl"),
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("volume splat"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "volume splat", &layout);
         let instances = [Some(crate::splat::photon_instances())];
         let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &instances, "volume");
         VolumePass { pipeline, bind_group }
