@@ -15,7 +15,8 @@ use std::time::Instant;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum RendererKind {
     /// The seed's photon splatting on the GPU (falls back to photon-cpu
-    /// when no GPU adapter is found).
+    /// when no GPU adapter is found, or on a software adapter for media
+    /// seen through mirrors or glass).
     Gpu,
     /// The seed's fixed-radius photon mapping on the CPU.
     PhotonCpu,
