@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs the whole hikari test suite on a fresh Debian 12 machine: installs what
 # the machine lacks (Mesa's software Vulkan driver for the GPU tests), then
-# runs every test of the workspace.
+# runs every test of the workspace. GPU tests fail, not skip, without an
+# adapter; the CLI tests also run the renderer on Mesa's OpenGL.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -141,12 +141,11 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         volume_radius: hikari_core::render::photon_cpu::default_radius(&scene),
         ..GpuSettings::new(global, caustic)
     };
-    let renderer = GpuRenderer::new(ctx, &scene, &traced, settings);
-    renderer.render();
-    renderer.wait()?;
+    let renderer = GpuRenderer::new(ctx, &scene, &traced, settings)?;
+    renderer.render()?;
     let start = Instant::now();
     for _ in 0..frames {
-        renderer.render();
+        renderer.render()?;
     }
     renderer.wait()?;
     let frame = start.elapsed().as_secs_f64() / frames as f64;

@@ -1,22 +1,23 @@
 //! `hikari render`: load a scene, trace photons, render, write the image.
 
 use crate::progress_bar::TerminalProgress;
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use hikari_core::lod::LodSettings;
 use hikari_core::output::write_image;
+use hikari_core::photon::TracedPhotons;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::{Scene, builtin};
-use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
+use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum RendererKind {
-    /// The seed's photon splatting on the GPU (falls back to photon-cpu
-    /// when no GPU adapter is found, or on a software adapter for media
-    /// seen through mirrors or glass).
+    /// The seed's photon splatting on the GPU. Falls back to photon-cpu,
+    /// saying why, when no adapter can run it, when the scene or settings
+    /// exceed the adapter's limits, or on any GPU error.
     Gpu,
     /// The seed's fixed-radius photon mapping on the CPU.
     PhotonCpu,
@@ -34,17 +35,20 @@ pub struct RenderArgs {
     pub output: PathBuf,
     #[arg(long, value_enum, default_value_t = RendererKind::Gpu)]
     pub renderer: RendererKind,
-    /// Photon paths emitted from the lights.
-    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..))]
+    /// Photon paths emitted from the lights (1 to 100,000,000; the memory
+    /// the maps will take is printed above 2,000,000).
+    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=MAX_PHOTONS))]
     pub photons: u64,
-    /// Global-map radius r in scene units [default: 3% of the scene diagonal].
+    /// Global-map radius r in scene units, between 1e-5 and 0.5 scene
+    /// diagonals [default: 3% of the scene diagonal].
     #[arg(long, allow_negative_numbers = true)]
     pub radius: Option<f32>,
-    /// Caustic-map radius in scene units [default: 1% of the scene diagonal].
+    /// Caustic-map radius in scene units, between 1e-5 and 0.5 scene
+    /// diagonals [default: 1% of the scene diagonal].
     #[arg(long, allow_negative_numbers = true)]
     pub caustic_radius: Option<f32>,
-    /// Samples per pixel [default: 4 for photon-cpu, 64 for path].
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+    /// Samples per pixel, 1 to 65536 [default: 4 for photon-cpu, 64 for path].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: Option<u32>,
     /// Override the scene's resolution, e.g. 1280x720.
     #[arg(long, value_parser = parse_resolution)]
@@ -52,20 +56,22 @@ pub struct RenderArgs {
     /// Random seed: the same seed gives the same image whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Worker threads [default: all cores].
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// Exposure in stops applied before PNG tone mapping.
+    /// Worker threads, 1 to 1024 [default: all cores].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub threads: Option<u64>,
+    /// Exposure in stops applied before PNG tone mapping (-64 to 64).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Shadow-map side in texels for each shadow view (gpu).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_map_size: u32,
-    /// Samples per area light: shadow rays per shaded point (photon-cpu),
-    /// shadow-mapped points on the light (gpu).
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+    /// Samples per area light, 1 to 256: shadow rays per shaded point
+    /// (photon-cpu), shadow-mapped points on the light (gpu; each takes
+    /// shadow-map layers, checked against the adapter's memory).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub area_light_samples: u32,
-    /// Volume-map radius in scene units [default: 3% of the scene diagonal].
+    /// Volume-map radius in scene units, between 1e-5 and 0.5 scene
+    /// diagonals [default: 3% of the scene diagonal].
     #[arg(long, allow_negative_numbers = true)]
     pub volume_radius: Option<f32>,
     /// Optical-depth slices along each view ray through region media (gpu).
@@ -100,6 +106,84 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+/// Most photon paths `--photons` accepts: about 6 GB of photon maps in the
+/// built-in scenes (3 stored photons of 20 bytes per path).
+pub const MAX_PHOTONS: u64 = 100_000_000;
+
+/// The GPU renderer's settings for these arguments.
+fn gpu_settings(args: &RenderArgs, scene: &Scene, settings: &photon_cpu::PhotonCpuSettings) -> GpuSettings {
+    let (global, caustic) = settings.estimate_params(scene);
+    let lod = match (args.lod_near, args.lod_far) {
+        (Some(near), Some(far)) => Some(LodSettings { near, far, groups: args.lod_groups }),
+        _ => None,
+    };
+    GpuSettings {
+        area_light_samples: args.area_light_samples,
+        shadow_map_size: args.shadow_map_size,
+        lod,
+        volume_radius: args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene)),
+        volume_slices: args.volume_slices,
+        ..GpuSettings::new(global, caustic)
+    }
+}
+
+/// Photons each map will hold for `photons` paths, from a pilot trace of a
+/// few thousand paths (with 25% to spare), so limits are checked before
+/// the real trace.
+fn expected_map_sizes(scene: &Scene, photons: u64, seed: u64) -> [u64; 3] {
+    const PILOT: u64 = 4096;
+    let quiet = TerminalProgress::new(true);
+    let pilot =
+        trace_photons(scene, &TraceSettings { photons: PILOT, seed: seed ^ 0x9e37, ..Default::default() }, &quiet);
+    let per_path = |stored: usize| (stored as f64 / PILOT as f64 * photons as f64 * 1.25).ceil() as u64 + 64;
+    [per_path(pilot.indirect().len()), per_path(pilot.caustic.len()), per_path(pilot.volume.len())]
+}
+
+/// An adapter that can draw `scene` with `settings`, or None after one line
+/// saying why not.
+fn open_gpu(scene: &Scene, settings: &GpuSettings, expected: [u64; 3]) -> Option<GpuContext> {
+    let ctx = match GpuContext::new() {
+        Ok(ctx) => ctx,
+        Err(e) => {
+            eprintln!("{e}: rendering with photon-cpu instead");
+            return None;
+        }
+    };
+    if let Err(e) = GpuRenderer::check_fits(&ctx, scene, settings, expected) {
+        eprintln!("gpu {}: {e}: rendering with photon-cpu instead", ctx.describe());
+        return None;
+    }
+    Some(ctx)
+}
+
+/// One frame on the GPU, read back.
+fn render_on_gpu(
+    ctx: GpuContext,
+    scene: &Scene,
+    traced: &TracedPhotons,
+    settings: GpuSettings,
+) -> Result<(Image, u64), GpuError> {
+    let adapter = ctx.describe();
+    if !ctx.float32_blend {
+        eprintln!(
+            "note: {adapter} cannot blend 32-bit float targets; photon splats accumulate in 16-bit floats (about 3 significant digits)"
+        );
+    }
+    let setup_start = Instant::now();
+    let renderer = GpuRenderer::new(ctx, scene, traced, settings)?;
+    let setup = setup_start.elapsed().as_secs_f64();
+    let frame_start = Instant::now();
+    renderer.render()?;
+    let result = renderer.read_image()?;
+    let slices = renderer.specular_slices();
+    let split = if slices > 1 { format!(", specular gathers split into {slices} dispatches") } else { String::new() };
+    eprintln!(
+        "gpu: {adapter}; setup {setup:.2} s, frame and readback {:.3} s (1 sample per pixel{split})",
+        frame_start.elapsed().as_secs_f64()
+    );
+    Ok(result)
+}
+
 /// Traces photons, then splats them on the GPU or estimates them on the CPU.
 fn render_photons(
     args: &RenderArgs,
@@ -107,20 +191,30 @@ fn render_photons(
     scene: &Scene,
     progress: &TerminalProgress,
 ) -> Result<(Image, u64)> {
+    let settings = photon_cpu::PhotonCpuSettings {
+        radius: args.radius,
+        caustic_radius: args.caustic_radius,
+        spp: args.spp.unwrap_or(4),
+        seed: args.seed,
+        area_light_samples: args.area_light_samples,
+        normal_test: args.normal_test,
+        volume_radius: args.volume_radius,
+        ..Default::default()
+    };
+    let gpu_settings = gpu_settings(args, scene, &settings);
+    let needs_estimate = renderer == RendererKind::Gpu || args.photons > 2_000_000;
+    let expected = if needs_estimate { expected_map_sizes(scene, args.photons, args.seed) } else { [0; 3] };
+    if args.photons > 2_000_000 {
+        let stored: u64 = expected.iter().sum();
+        eprintln!(
+            "note: {} photon paths will store about {} M photons: about {} MiB of photon maps",
+            args.photons,
+            stored / 1_000_000,
+            stored * 20 >> 20
+        );
+    }
     let gpu = match renderer {
-        RendererKind::Gpu => match GpuContext::new() {
-            Ok(ctx) => match GpuRenderer::unsupported_on(scene, &ctx) {
-                Some(reason) => {
-                    eprintln!("{reason}: using photon-cpu");
-                    None
-                }
-                None => Some(ctx),
-            },
-            Err(e) => {
-                eprintln!("{e}: falling back to the CPU renderer (photon-cpu)");
-                None
-            }
-        },
+        RendererKind::Gpu => open_gpu(scene, &gpu_settings, expected),
         _ => None,
     };
     let trace_start = Instant::now();
@@ -136,46 +230,13 @@ fn render_photons(
         traced.stats.emitted as f64 / trace_time / 1e6,
         trace_time
     );
-    let settings = photon_cpu::PhotonCpuSettings {
-        radius: args.radius,
-        caustic_radius: args.caustic_radius,
-        spp: args.spp.unwrap_or(4),
-        seed: args.seed,
-        area_light_samples: args.area_light_samples,
-        normal_test: args.normal_test,
-        volume_radius: args.volume_radius,
-        ..Default::default()
-    };
     let (global, caustic) = settings.estimate_params(scene);
     eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
     if let Some(ctx) = gpu {
-        let adapter = ctx.describe();
-        if !ctx.float32_blend {
-            eprintln!("note: this adapter cannot blend 32-bit float targets; photon splats accumulate in Rgba16Float");
+        match render_on_gpu(ctx, scene, &traced, gpu_settings) {
+            Ok(result) => return Ok(result),
+            Err(e) => eprintln!("gpu: {e}: rendering with photon-cpu instead"),
         }
-        let lod = match (args.lod_near, args.lod_far) {
-            (Some(near), Some(far)) => Some(LodSettings { near, far, groups: args.lod_groups }),
-            _ => None,
-        };
-        let gpu_settings = GpuSettings {
-            area_light_samples: args.area_light_samples,
-            shadow_map_size: args.shadow_map_size,
-            lod,
-            volume_radius: args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene)),
-            volume_slices: args.volume_slices,
-            ..GpuSettings::new(global, caustic)
-        };
-        let setup_start = Instant::now();
-        let renderer = GpuRenderer::new(ctx, scene, &traced, gpu_settings);
-        let setup = setup_start.elapsed().as_secs_f64();
-        let frame_start = Instant::now();
-        renderer.render();
-        let result = renderer.read_image()?;
-        eprintln!(
-            "gpu: {adapter}; setup {setup:.2} s, frame and readback {:.3} s (1 sample per pixel)",
-            frame_start.elapsed().as_secs_f64()
-        );
-        return Ok(result);
     }
     let build_start = Instant::now();
     let cpu = photon_cpu::PhotonCpuRenderer::new(scene, &traced, &settings);
@@ -190,10 +251,46 @@ fn render_photons(
     Ok(result)
 }
 
+/// A bad flag or scene: the CLI exits with code 2 (as clap does for its own
+/// parse errors) and writes nothing.
+#[derive(Debug)]
+pub struct UsageError(pub String);
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+macro_rules! usage {
+    ($($arg:tt)*) => {
+        return Err(UsageError(format!($($arg)*)).into())
+    };
+}
+
+/// Radii outside [1e-5, 0.5] scene diagonals: below, the estimate's 1/r²
+/// overflows or no photon is ever found; above, every photon covers every
+/// pixel and a frame takes for ever.
+pub const RADIUS_RANGE: (f32, f32) = (1e-5, 0.5);
+
+fn radius_in_range(name: &str, v: Option<f32>, diagonal: f32) -> Result<()> {
+    if let Some(r) = v {
+        let (lo, hi) = (RADIUS_RANGE.0 * diagonal, RADIUS_RANGE.1 * diagonal);
+        if !(r >= lo && r <= hi) {
+            usage!(
+                "--{name} {r}: must be between {lo:.3e} and {hi:.3e} (1e-5 to 0.5 of this scene's diagonal {diagonal:.3})"
+            );
+        }
+    }
+    Ok(())
+}
+
 fn positive(name: &str, v: Option<f32>) -> Result<()> {
     match v {
         Some(r) if !(r.is_finite() && r > 0.0) => {
-            bail!("--{name} {r}: must be a positive, finite length")
+            usage!("--{name} {r}: must be a positive, finite length")
         }
         _ => Ok(()),
     }
@@ -206,25 +303,32 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     for (name, v) in [("lod-near", args.lod_near), ("lod-far", args.lod_far)] {
         if let Some(d) = v {
             if !(d.is_finite() && d >= 0.0) {
-                bail!("--{name} {d}: must be a finite distance ≥ 0");
+                usage!("--{name} {d}: must be a finite distance ≥ 0");
             }
         }
     }
-    if !args.exposure.is_finite() {
-        bail!("--exposure {}: must be finite", args.exposure);
+    if !(args.exposure.abs() <= 64.0) {
+        usage!("--exposure {}: must be between -64 and 64 stops", args.exposure);
     }
     let ext = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if !matches!(ext.as_deref(), Some("png" | "exr")) {
-        bail!("{}: unsupported image type (use .png or .exr)", args.output.display());
+        usage!("{}: unsupported image type (use .png or .exr)", args.output.display());
     }
     if let Some(threads) = args.threads {
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().context("setting the thread count")?;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads as usize)
+            .build_global()
+            .context("setting the thread count")?;
     }
 
-    let mut scene = Scene::load(&args.scene)?;
+    let mut scene = Scene::load(&args.scene).map_err(|e| UsageError(e.to_string()))?;
+    let diagonal = scene.diagonal();
+    radius_in_range("radius", args.radius, diagonal)?;
+    radius_in_range("caustic-radius", args.caustic_radius, diagonal)?;
+    radius_in_range("volume-radius", args.volume_radius, diagonal)?;
     let renderer = args.renderer;
     if let Some((w, h)) = args.resolution {
-        scene.camera = scene.camera.with_resolution(w, h).map_err(anyhow::Error::msg)?;
+        scene.camera = scene.camera.with_resolution(w, h).map_err(UsageError)?;
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();

@@ -13,6 +13,15 @@ pub fn uniform() -> wgpu::BindingType {
     }
 }
 
+/// A uniform bound at a dynamic offset, `size` bytes at a time.
+pub fn dynamic_uniform(size: u64) -> wgpu::BindingType {
+    wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: true,
+        min_binding_size: std::num::NonZeroU64::new(size),
+    }
+}
+
 pub fn storage(read_only: bool) -> wgpu::BindingType {
     wgpu::BindingType::Buffer {
         ty: wgpu::BufferBindingType::Storage { read_only },
@@ -26,6 +35,15 @@ pub fn texture(view_dimension: wgpu::TextureViewDimension) -> wgpu::BindingType 
     wgpu::BindingType::Texture {
         sample_type: wgpu::TextureSampleType::Float { filterable: false },
         view_dimension,
+        multisampled: false,
+    }
+}
+
+/// A depth texture array read with `textureLoad` (the shadow maps).
+pub fn depth_texture_array() -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Depth,
+        view_dimension: wgpu::TextureViewDimension::D2Array,
         multisampled: false,
     }
 }

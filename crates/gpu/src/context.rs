@@ -1,70 +1,118 @@
-//! The wgpu device: found once, shared by every pass.
+//! The wgpu device: chosen once (see `capabilities`), shared by every pass,
+//! with every GPU error turned into a `GpuError` instead of a panic.
 
+use crate::capabilities::{Capabilities, loop_budget, preference};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum GpuError {
     #[error("no GPU adapter found ({0})")]
     NoAdapter(String),
+    #[error("no GPU adapter can run the GPU renderer: {0}")]
+    Unsupported(String),
     #[error("the GPU adapter refused a device: {0}")]
     Device(String),
+    /// A wgpu validation, out-of-memory or internal error, or a lost device.
+    #[error("GPU error: {0}")]
+    Failed(String),
+    #[error("the GPU did not finish within {0:?}")]
+    Timeout(Duration),
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// The scene or the settings need more than the adapter offers.
+    #[error("{0}")]
+    TooLarge(String),
+    /// A shader would run past the adapter's loop budget even split up.
+    #[error("{0}")]
+    LoopBudget(String),
 }
+
+/// The first error the device reported outside an error scope, or its loss.
+type Fault = Arc<Mutex<Option<String>>>;
 
 pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub adapter_info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
     /// Format of the additive radiance targets: Rgba32Float where the adapter
     /// can blend it, else Rgba16Float (and `float32_blend` is false).
     pub radiance_format: wgpu::TextureFormat,
     pub float32_blend: bool,
     /// GPU timestamps can be written between passes (per-pass timings).
     pub timestamps: bool,
+    /// Loop iterations one shader invocation may run (`capabilities::loop_budget`).
+    pub loop_budget: u32,
+    /// Longest wait for submitted work before giving up.
+    pub wait_timeout: Duration,
+    fault: Fault,
 }
 
+/// Default `wait_timeout`: a software adapter needs tens of seconds for a
+/// large frame; a hung driver should not hold the CLI for ever.
+pub const WAIT_TIMEOUT: Duration = Duration::from_secs(600);
+
 impl GpuContext {
-    /// Finds an adapter (honouring `WGPU_BACKEND` and friends) and opens a device.
+    /// Enumerates the adapters (honouring `WGPU_BACKEND`), tries them in
+    /// `capabilities::preference` order and opens a device on the first
+    /// that has everything the renderer needs.
     pub fn new() -> Result<Self, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            compatible_surface: None,
-            force_fallback_adapter: false,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
-        let float32_blend = adapter.features().contains(wgpu::Features::FLOAT32_BLENDABLE);
-        let mut required_features = wgpu::Features::empty();
-        if float32_blend {
-            required_features |= wgpu::Features::FLOAT32_BLENDABLE;
+        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        if adapters.is_empty() {
+            return Err(GpuError::NoAdapter("wgpu enumerated none; WGPU_BACKEND may exclude them".into()));
         }
-        let timestamp_features = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
-        let timestamps = adapter.features().contains(timestamp_features);
-        if timestamps {
-            required_features |= timestamp_features;
+        adapters.sort_by_key(|a| preference(&a.get_info()));
+        let mut refusals = Vec::new();
+        for adapter in adapters {
+            let info = adapter.get_info();
+            match Capabilities::check(&adapter) {
+                Ok(caps) => return Self::open(adapter, caps),
+                Err(why) => refusals.push(format!("{} ({:?}) {why}", info.name, info.backend)),
+            }
         }
+        Err(GpuError::Unsupported(refusals.join(" | ")))
+    }
+
+    fn open(adapter: wgpu::Adapter, caps: Capabilities) -> Result<Self, GpuError> {
+        let limits = adapter.limits();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("hikari"),
-            required_features,
-            // The adapter's own limits: the G-buffer needs 64 bytes per sample of
-            // colour attachments, above the portable default of 32.
-            required_limits: adapter.limits(),
+            required_features: caps.features(),
+            // The adapter's own limits: the G-buffer needs 64 bytes per sample
+            // of colour attachments, and photon buffers want the largest
+            // bindings the adapter allows (sizes are checked against them).
+            required_limits: limits.clone(),
             ..Default::default()
         }))
         .map_err(|e| GpuError::Device(e.to_string()))?;
+        let fault: Fault = Arc::default();
+        let record = |fault: &Fault, what: String| {
+            let mut slot = fault.lock().unwrap_or_else(|e| e.into_inner());
+            slot.get_or_insert(what);
+        };
+        let lost = fault.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            record(&lost, format!("device lost ({reason:?}): {message}"));
+        });
+        let uncaptured = fault.clone();
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            record(&uncaptured, first_line(&error.to_string()));
+        }));
+        let info = adapter.get_info();
         Ok(GpuContext {
             device,
             queue,
-            adapter_info: adapter.get_info(),
-            radiance_format: if float32_blend {
-                wgpu::TextureFormat::Rgba32Float
-            } else {
-                wgpu::TextureFormat::Rgba16Float
-            },
-            float32_blend,
-            timestamps,
+            loop_budget: loop_budget(&info),
+            adapter_info: info,
+            limits,
+            radiance_format: caps.radiance_format(),
+            float32_blend: caps.float32_blend,
+            timestamps: caps.timestamps,
+            wait_timeout: WAIT_TIMEOUT,
+            fault,
         })
     }
 
@@ -73,4 +121,69 @@ impl GpuContext {
         let i = &self.adapter_info;
         format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
     }
+
+    /// Runs `f` under error scopes for validation, out-of-memory and internal
+    /// errors: the first error any of them caught, or a fault the device
+    /// reported meanwhile, becomes the result.
+    pub fn scoped<T>(&self, f: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let scopes = self.error_scopes();
+        let value = f();
+        scopes.finish()?;
+        self.check()?;
+        Ok(value)
+    }
+
+    /// Opens error scopes on this thread until `ErrorScopes::finish`.
+    pub fn error_scopes(&self) -> ErrorScopes {
+        ErrorScopes(
+            [wgpu::ErrorFilter::Validation, wgpu::ErrorFilter::OutOfMemory, wgpu::ErrorFilter::Internal]
+                .map(|filter| self.device.push_error_scope(filter)),
+        )
+    }
+
+    /// The device's first uncaptured error or its loss, if any.
+    pub fn check(&self) -> Result<(), GpuError> {
+        match self.fault.lock().unwrap_or_else(|e| e.into_inner()).as_ref() {
+            Some(what) => Err(GpuError::Failed(what.clone())),
+            None => Ok(()),
+        }
+    }
+
+    /// Blocks until the submitted work is done, at most `wait_timeout`.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(self.wait_timeout) }).map_err(
+            |e| match e {
+                wgpu::PollError::Timeout => GpuError::Timeout(self.wait_timeout),
+                other => GpuError::Failed(other.to_string()),
+            },
+        )?;
+        self.check()
+    }
+}
+
+/// Error scopes for validation, out-of-memory and internal errors, closed
+/// by `finish` in reverse order.
+pub struct ErrorScopes([wgpu::ErrorScopeGuard; 3]);
+
+impl ErrorScopes {
+    /// The first error the scopes caught, as a `GpuError`.
+    pub fn finish(self) -> Result<(), GpuError> {
+        let mut first = None;
+        for scope in self.0.into_iter().rev() {
+            if let Some(error) = pollster::block_on(scope.pop()) {
+                first.get_or_insert(error);
+            }
+        }
+        match first {
+            Some(error) => Err(GpuError::Failed(first_line(&error.to_string()))),
+            None => Ok(()),
+        }
+    }
+}
+
+/// wgpu's errors span many lines (the error, then its sources); the CLI
+/// prints one line.
+fn first_line(text: &str) -> String {
+    let lines: Vec<&str> = text.lines().map(str::trim).filter(|l| !l.is_empty()).collect();
+    lines.join(" ").chars().take(400).collect()
 }

@@ -10,11 +10,13 @@
 //! Each pass is a small struct with its pipeline, its shader beside it.
 
 pub mod binding;
+pub mod capabilities;
 pub mod context;
 pub mod direct;
 pub mod gbuffer;
 pub mod lod;
 pub mod media;
+pub mod memory;
 pub mod readback;
 pub mod renderer;
 pub mod resolve;
@@ -26,6 +28,10 @@ pub mod volume;
 
 pub use context::{GpuContext, GpuError};
 pub use renderer::{GpuRenderer, GpuSettings};
+
+/// `loop_iteration()` for the passes whose loops the host bounds exactly
+/// (the shared WGSL calls it in every loop; the specular pass counts).
+pub const UNCOUNTED_LOOPS_WGSL: &str = "fn loop_iteration() -> bool { return true; }\n";
 
 /// The WGSL mirror of `hikari_core::estimate`, prepended to the shaders that use it.
 pub const ESTIMATE_WGSL: &str = include_str!("estimate.wgsl");

@@ -70,7 +70,7 @@ fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| error(&e))?;
+    ctx.wait()?;
     rx.recv().map_err(|e| error(&e))?.map_err(|e| error(&e))?;
     let bytes = slice.get_mapped_range().map_err(|e| error(&e))?.to_vec();
     buffer.unmap();

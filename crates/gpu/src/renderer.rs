@@ -7,6 +7,7 @@ use crate::direct::DirectPass;
 use crate::gbuffer::{GBuffer, GBufferParams, GBufferPass};
 use crate::lod::{LodOutput, LodPass};
 use crate::media::GpuMedia;
+use crate::memory::FrameSize;
 use crate::readback::read_rgba;
 use crate::resolve::ResolvePass;
 use crate::scene_upload::SceneBuffers;
@@ -168,21 +169,64 @@ fn depth_range(scene: &Scene) -> (f32, f32) {
 }
 
 impl GpuRenderer {
-    /// Why this renderer should not draw `scene` on `ctx`, if so. Mirrors
-    /// and glass in media make the specular pass gather the volume map along
-    /// every segment of every path; lavapipe (like other software adapters
-    /// built on llvmpipe) runs at most 65,535 loop iterations per shader
-    /// invocation and then ends every loop after one pass, which silently
-    /// drops light in such scenes, so software adapters leave them to
-    /// photon-cpu.
-    pub fn unsupported_on(scene: &Scene, ctx: &GpuContext) -> Option<&'static str> {
-        let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
-        (software && !scene.media.is_empty() && crate::specular::has_specular_surfaces(scene)).then_some(
-            "mirrors or glass in participating media need a hardware GPU (software adapters cap shader loops)",
-        )
+    /// What a frame of `scene` with `settings` allocates, for `photons`
+    /// stored in the global, caustic and volume maps (known, or estimated
+    /// before tracing).
+    pub fn frame_size(scene: &Scene, settings: &GpuSettings, photons: [u64; 3]) -> FrameSize {
+        let lights = GpuLights::new(scene, settings.area_light_samples);
+        FrameSize {
+            width: scene.camera.width,
+            height: scene.camera.height,
+            shadow_map_size: settings.shadow_map_size,
+            shadow_layers: lights.views.len() as u32,
+            volume_slices: if GpuMedia::has_regions(scene) { settings.volume_slices } else { 0 },
+            photons,
+        }
     }
 
-    pub fn new(ctx: GpuContext, scene: &Scene, traced: &TracedPhotons, settings: GpuSettings) -> Self {
+    /// Checks, before anything is traced or allocated, that `scene` with
+    /// `settings` fits `ctx`: every texture and buffer within the adapter's
+    /// limits, and the direct-light shader's loops (lights × samples ×
+    /// region triangles, known here exactly) within its loop budget. The
+    /// specular pass's loops depend on the photons and are checked as it
+    /// runs (`SpecularPass`).
+    pub fn check_fits(
+        ctx: &GpuContext,
+        scene: &Scene,
+        settings: &GpuSettings,
+        photons: [u64; 3],
+    ) -> Result<(), GpuError> {
+        Self::frame_size(scene, settings, photons).check(ctx)?;
+        let lights = GpuLights::new(scene, settings.area_light_samples);
+        let iterations = crate::direct::loop_iterations(&lights, GpuMedia::region_triangle_count(scene));
+        if iterations > ctx.loop_budget as u64 {
+            return Err(GpuError::LoopBudget(format!(
+                "direct light needs {iterations} shader loop iterations per pixel (light samples × region \
+                 triangles), over this adapter's budget of {}",
+                ctx.loop_budget
+            )));
+        }
+        Ok(())
+    }
+
+    /// Creates every pass and uploads the scene and the photons, under wgpu
+    /// error scopes: an adapter that refuses anything gives an error.
+    pub fn new(
+        ctx: GpuContext,
+        scene: &Scene,
+        traced: &TracedPhotons,
+        settings: GpuSettings,
+    ) -> Result<Self, GpuError> {
+        let photons = [traced.indirect().len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
+        Self::check_fits(&ctx, scene, &settings, photons)?;
+        let scopes = ctx.error_scopes();
+        let renderer = Self::create(ctx, scene, traced, settings);
+        scopes.finish()?;
+        renderer.ctx.check()?;
+        Ok(renderer)
+    }
+
+    fn create(ctx: GpuContext, scene: &Scene, traced: &TracedPhotons, settings: GpuSettings) -> Self {
         let device = &ctx.device;
         let (w, h) = (scene.camera.width, scene.camera.height);
         let radiance_target = |label| {
@@ -208,7 +252,7 @@ impl GpuRenderer {
             indirect: radiance_target("indirect radiance"),
             caustic: radiance_target("caustic radiance"),
             volume: radiance_target("volume radiance"),
-            shadow_maps: shadow_pass.create_maps(device, &lights.views, settings.shadow_map_size),
+            shadow_maps: shadow_pass.create_maps(device, &lights.views, settings.shadow_map_size, scene.accel.bounds()),
         };
         let (near, far) = depth_range(scene);
         let scene_buffers = SceneBuffers::upload(device, scene);
@@ -240,6 +284,7 @@ impl GpuRenderer {
                 power_unit: traced.power_unit,
                 max_depth: settings.max_specular_depth,
                 shadow_bias: settings.shadow_bias,
+                iteration_budget: ctx.loop_budget,
             },
         );
         let volume_params = VolumeParams {
@@ -295,13 +340,67 @@ impl GpuRenderer {
         }
     }
 
-    /// Records and submits one frame.
-    pub fn render(&self) {
+    /// Renders one frame and waits for it. When the specular pass reports
+    /// pixels over the loop budget, its gathers are split into four times
+    /// as many dispatches and it (and the resolve) run again, up to
+    /// `specular::MAX_SLICES`; past that the frame is an error, never an
+    /// image with light silently missing.
+    pub fn render(&self) -> Result<(), GpuError> {
+        let scopes = self.ctx.error_scopes();
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         for stage in Stage::ALL {
             self.record_stage(stage, &mut encoder);
         }
         self.ctx.queue.submit([encoder.finish()]);
+        scopes.finish()?;
+        self.ctx.wait()?;
+        self.settle_specular()
+    }
+
+    /// Re-runs the specular pass with more slices until no pixel runs over
+    /// budget (see `render`).
+    fn settle_specular(&self) -> Result<(), GpuError> {
+        let pass = &self.specular_pass;
+        if !pass.enabled() {
+            return Ok(());
+        }
+        loop {
+            let status = pass.read_status(&self.ctx)?;
+            if status.over_budget == 0 {
+                return Ok(());
+            }
+            if pass.slices() >= crate::specular::MAX_SLICES {
+                return Err(GpuError::LoopBudget(format!(
+                    "mirrors/glass: {} pixel invocations need more than this adapter's {} shader loop \
+                     iterations even with the photon gathers split {} ways",
+                    status.over_budget,
+                    pass.iteration_budget(),
+                    pass.slices()
+                )));
+            }
+            pass.set_slices(pass.slices() * 4);
+            let scopes = self.ctx.error_scopes();
+            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+            self.record_stage(Stage::Specular, &mut encoder);
+            self.record_stage(Stage::Resolve, &mut encoder);
+            self.ctx.queue.submit([encoder.finish()]);
+            scopes.finish()?;
+        }
+    }
+
+    /// What the last frame's specular pass reported.
+    pub fn specular_status(&self) -> Result<crate::specular::SpecularStatus, GpuError> {
+        self.specular_pass.read_status(&self.ctx)
+    }
+
+    /// Dispatches the specular gathers are split into (grown by `render`).
+    pub fn specular_slices(&self) -> u32 {
+        self.specular_pass.slices()
+    }
+
+    /// Splits the specular gathers into `slices` dispatches from now on.
+    pub fn set_specular_slices(&self, slices: u32) {
+        self.specular_pass.set_slices(slices)
     }
 
     /// Renders one frame and times each stage: with GPU timestamps written
@@ -357,11 +456,7 @@ impl GpuRenderer {
 
     /// Blocks until the GPU has finished all submitted work.
     pub fn wait(&self) -> Result<(), GpuError> {
-        self.ctx
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map(|_| ())
-            .map_err(|e| GpuError::Readback(e.to_string()))
+        self.ctx.wait()
     }
 
     fn record_stage(&self, stage: Stage, encoder: &mut wgpu::CommandEncoder) {
@@ -411,7 +506,7 @@ impl GpuRenderer {
                 let photons = if self.has_media { &self.volume_lod } else { &self.caustic_lod };
                 self.volume_pass.record(encoder, photons, &view, self.has_media);
             }
-            Stage::Specular => self.specular_pass.record(encoder),
+            Stage::Specular => self.specular_pass.record(&self.ctx.queue, encoder),
             Stage::Resolve => self.resolve_pass.record(encoder),
         }
     }
@@ -425,6 +520,13 @@ impl GpuRenderer {
     pub fn drawn_photons(&self) -> Result<(u32, u32), GpuError> {
         let count = |o: &LodOutput| crate::readback::read_u32s(&self.ctx, &o.draw_args, 4).map(|v| v[1]);
         Ok((count(&self.global_lod)?, count(&self.caustic_lod)?))
+    }
+
+    /// The global map's splat instances of the last frame, in draw order.
+    pub fn global_survivors(&self) -> Result<Vec<crate::lod::LodPhoton>, GpuError> {
+        let drawn = crate::readback::read_u32s(&self.ctx, &self.global_lod.draw_args, 4)?[1] as u64;
+        let words = crate::readback::read_u32s(&self.ctx, &self.global_lod.survivors, drawn.max(1) * 6)?;
+        Ok(bytemuck::cast_slice::<u32, crate::lod::LodPhoton>(&words)[..drawn as usize].to_vec())
     }
 
     /// Volume photons drawn in the last frame.

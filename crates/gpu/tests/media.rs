@@ -7,7 +7,7 @@ use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
-use hikari_gpu::test_support::context_or_skip;
+use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 use std::path::Path;
 
@@ -84,7 +84,7 @@ fn slab_length(eye: Vec3, dir: Vec3, l: f32, z0: f32, z1: f32) -> f32 {
 #[test]
 fn optical_depth_pass_matches_slabs() {
     for (eye_z, label) in [(3.0, "eye outside"), (0.0, "eye inside a region")] {
-        let Some(ctx) = context_or_skip("optical depth") else { return };
+        let ctx = test_context("optical depth");
         let dir = std::env::temp_dir().join(format!("hikari-slabs-{}-{}", std::process::id(), label.len()));
         let scene = slab_scene(&dir, eye_z);
         let traced = trace_photons(&scene, &TraceSettings { photons: 1000, seed: 1, ..Default::default() }, &Silent);
@@ -94,8 +94,9 @@ fn optical_depth_pass_matches_slabs() {
             &scene,
             &traced,
             GpuSettings { volume_slices: 4, ..GpuSettings::new(global, caustic) },
-        );
-        gpu.render();
+        )
+        .expect("GPU renderer");
+        gpu.render().expect("GPU frame");
         let position = gpu.read(&gpu.targets.gbuffer.position).unwrap();
         let slices = gpu.read_slices().unwrap();
         assert_eq!(slices.len(), 4);
@@ -133,15 +134,15 @@ struct Twin {
 /// the same photons, radius and transmittance: exact for media filling the
 /// scene, the same slice interpolation for regions.
 fn volume_twin(scene: &Scene, traced: &TracedPhotons, slices: u32) -> Option<Twin> {
-    let ctx = context_or_skip("volume twin")?;
+    let ctx = test_context("volume twin");
     let cpu = PhotonCpuRenderer::new(scene, traced, &PhotonCpuSettings::default());
     let settings = GpuSettings {
         volume_radius: cpu.volume_radius,
         volume_slices: slices,
         ..GpuSettings::new(cpu.global_params, cpu.caustic_params)
     };
-    let gpu = GpuRenderer::new(ctx, scene, traced, settings);
-    gpu.render();
+    let gpu = GpuRenderer::new(ctx, scene, traced, settings).expect("GPU renderer");
+    gpu.render().expect("GPU frame");
     let position = gpu.read(&gpu.targets.gbuffer.position).unwrap();
     let volume = gpu.read(&gpu.targets.volume).unwrap();
     let params = *gpu.media_params();
@@ -216,14 +217,14 @@ fn volume_splat_equals_cpu_twin_with_regions() {
 fn whole_frame_matches_photon_cpu(name: &str) {
     let mut scene = Scene::load(name).unwrap();
     scene.camera = scene.camera.with_resolution(64, 48).unwrap();
-    let Some(ctx) = context_or_skip("media frame") else { return };
+    let ctx = test_context("media frame");
     let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, seed: 13, ..Default::default() }, &Silent);
     let cpu_settings = PhotonCpuSettings { spp: 4, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
     let settings =
         GpuSettings { volume_radius: cpu.volume_radius, ..GpuSettings::new(cpu.global_params, cpu.caustic_params) };
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
-    gpu.render();
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
+    gpu.render().expect("GPU frame");
     let (image, nonfinite) = gpu.read_image().unwrap();
     assert_eq!(nonfinite, 0);
     let (reference, _) = cpu.render(&Silent);
@@ -294,7 +295,7 @@ fn specular_in_fog_matches_photon_cpu(layered: bool) {
     // (The layered fog's region transmittance loops over its triangles per photon.)
     let photons: u64 = if layered { 250 } else { 800 };
     let scene = fog_with_specular(layered);
-    let Some(ctx) = context_or_skip("specular in fog") else { return };
+    let ctx = test_context("specular in fog");
     // Few photons: lavapipe runs at most 65,535 loop iterations per shader
     // invocation (then every loop stops after one pass), and a pixel that
     // sees glass gathers along many segments.
@@ -302,8 +303,8 @@ fn specular_in_fog_matches_photon_cpu(layered: bool) {
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings { spp: 1, ..Default::default() });
     let settings =
         GpuSettings { volume_radius: cpu.volume_radius, ..GpuSettings::new(cpu.global_params, cpu.caustic_params) };
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
-    gpu.render();
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
+    gpu.render().expect("GPU frame");
     let (image, nonfinite) = gpu.read_image().unwrap();
     assert_eq!(nonfinite, 0);
     let (reference, _) = cpu.render(&Silent);

@@ -8,7 +8,7 @@ use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
-use hikari_gpu::test_support::context_or_skip;
+use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
 struct TwinStats {
@@ -24,13 +24,13 @@ fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats,
 }
 
 fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
-    let ctx = context_or_skip("twin")?;
+    let ctx = test_context("twin");
     let traced = trace_photons(&scene, &TraceSettings { photons, seed: 11, ..Default::default() }, &Silent);
     let cpu_settings = PhotonCpuSettings { normal_test, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
     let settings = GpuSettings::new(cpu.global_params, cpu.caustic_params);
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
-    gpu.render();
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
+    gpu.render().expect("GPU frame");
     let t = &gpu.targets;
     let position = gpu.read(&t.gbuffer.position).unwrap();
     let normal = gpu.read(&t.gbuffer.normal).unwrap();

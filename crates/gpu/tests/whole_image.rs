@@ -7,7 +7,7 @@ use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
-use hikari_gpu::test_support::context_or_skip;
+use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
 const SIZE: u32 = 64;
@@ -77,7 +77,7 @@ fn compare(scene_name: &str) -> Option<(f64, usize, Option<(f64, usize)>)> {
 }
 
 fn compare_scene(scene_name: &str, mut scene: Scene) -> Option<(f64, usize, Option<(f64, usize)>)> {
-    let ctx = context_or_skip(scene_name)?;
+    let ctx = test_context(scene_name);
     scene.camera = scene.camera.with_resolution(SIZE, SIZE).unwrap();
     let traced = trace_photons(&scene, &TraceSettings { photons: 50_000, seed: 5, ..Default::default() }, &Silent);
     // One sample at the pixel centre, as the rasterizer sees it; many shadow
@@ -90,8 +90,8 @@ fn compare_scene(scene_name: &str, mut scene: Scene) -> Option<(f64, usize, Opti
         shadow_map_size: 1024,
         ..GpuSettings::new(cpu.global_params, cpu.caustic_params)
     };
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings);
-    gpu.render();
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
+    gpu.render().expect("GPU frame");
     let (gpu_image, nonfinite) = gpu.read_image().unwrap();
     assert_eq!(nonfinite, 0);
     let albedo = gpu.read(&gpu.targets.gbuffer.albedo).unwrap();

@@ -42,6 +42,7 @@ struct LightSample {
 
 struct ShadowView {
     clip_from_world: mat4x4<f32>,
+    // w: the range the stored depths are fractions of.
     light_position: vec4<f32>,
 }
 
@@ -87,6 +88,9 @@ fn unshadowed_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             var corners = array<vec3<f32>, 4>(l.position, l.position + l.axis, l.position + l.axis + l.edge_v, l.position + l.edge_v);
             var total = 0.0;
             for (var i = 0u; i < 4u; i++) {
+                if (!loop_iteration()) {
+                    break;
+                }
                 let a = normalize(corners[i] - x);
                 let b = normalize(corners[(i + 1u) % 4u] - x);
                 let theta = acos(clamp(dot(a, b), -1.0, 1.0));
@@ -127,7 +131,7 @@ fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     let size = i32(direct_params.shadow_size);
     let texel_index = clamp(vec2<i32>(uv * f32(size)), vec2<i32>(0), vec2<i32>(size - 1));
-    let stored = textureLoad(shadow_maps, texel_index, i32(layer), 0).r;
+    let stored = textureLoad(shadow_maps, texel_index, i32(layer), 0) * views[layer].light_position.w;
     return distance(xs, s.position) <= stored * (1.0 + direct_params.bias);
 }
 
@@ -136,6 +140,9 @@ fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
 fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < direct_params.light_count; i++) {
+        if (!loop_iteration()) {
+            break;
+        }
         let l = lights[i];
         let e = unshadowed_irradiance(l, x, n);
         if (all(e == vec3<f32>(0.0))) {
@@ -143,6 +150,9 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
         }
         var seen = vec3<f32>(0.0);
         for (var k = 0u; k < l.sample_count; k++) {
+            if (!loop_iteration()) {
+                break;
+            }
             let s = samples[l.first_sample + k];
             if (visible(s, x, n)) {
                 seen += light_transmittance(x, s.position);

@@ -11,7 +11,20 @@ use wgpu::util::DeviceExt;
 pub const LIGHT_EVAL_WGSL: &str = include_str!("light_eval.wgsl");
 
 pub fn shader_source() -> String {
-    format!("{}\n{}\n{}", crate::media::MEDIA_WGSL, LIGHT_EVAL_WGSL, include_str!("direct.wgsl"))
+    format!(
+        "{}\n{}\n{}\n{}",
+        crate::UNCOUNTED_LOOPS_WGSL,
+        crate::media::MEDIA_WGSL,
+        LIGHT_EVAL_WGSL,
+        include_str!("direct.wgsl")
+    )
+}
+
+/// Loop iterations one pixel of the direct pass runs at most: per light,
+/// the cap test's 4 corners, then per sample the region triangles crossed
+/// on the way to the light (light_eval.wgsl's `direct_radiance`).
+pub fn loop_iterations(lights: &GpuLights, region_triangles: usize) -> u64 {
+    lights.lights.iter().map(|l| 1 + 4 + l.sample_count as u64 * (1 + region_triangles as u64)).sum()
 }
 
 /// Mirrors `DirectParams` in direct.wgsl.
@@ -36,7 +49,7 @@ impl DirectPass {
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         use crate::binding::{storage, texture, uniform};
-        use wgpu::TextureViewDimension::{D2, D2Array};
+        use wgpu::TextureViewDimension::D2;
         let entry = |b, ty| crate::binding::entry(b, wgpu::ShaderStages::FRAGMENT, ty);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("direct"),
@@ -45,7 +58,7 @@ impl DirectPass {
                 entry(1, storage(true)),
                 entry(2, storage(true)),
                 entry(3, storage(true)),
-                entry(4, texture(D2Array)),
+                entry(4, crate::binding::depth_texture_array()),
                 entry(5, texture(D2)),
                 entry(6, texture(D2)),
                 entry(7, texture(D2)),

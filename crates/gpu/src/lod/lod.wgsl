@@ -113,12 +113,23 @@ fn workgroup_exclusive_prefix(lid: u32, value: u32) -> u32 {
     return shared_sums[lid] - value;
 }
 
+// The count and scatter dispatches are two-dimensional (x up to 65,535
+// workgroups, the portable limit), so a map may hold more than 16.7 M
+// photons; workgroups past the last are idle. Uniform per workgroup.
+fn group_index(wid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return wid.y * groups.x + wid.x;
+}
+
 @compute @workgroup_size(256)
-fn count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let keep = u32(scale_of(wid.x * WORKGROUP + lid) > 0.0);
+fn count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let g = group_index(wid, groups);
+    if (g >= params.workgroups) {
+        return;
+    }
+    let keep = u32(scale_of(g * WORKGROUP + lid) > 0.0);
     workgroup_exclusive_prefix(lid, keep);
     if (lid == 0u) {
-        group_sums[wid.x] = shared_sums[WORKGROUP - 1u];
+        group_sums[g] = shared_sums[WORKGROUP - 1u];
     }
 }
 
@@ -145,11 +156,15 @@ fn scan(@builtin(local_invocation_index) lid: u32) {
 }
 
 @compute @workgroup_size(256)
-fn scatter(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
-    let i = wid.x * WORKGROUP + lid;
+fn scatter(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    let g = group_index(wid, groups);
+    if (g >= params.workgroups) {
+        return;
+    }
+    let i = g * WORKGROUP + lid;
     let scale = scale_of(i);
     let keep = u32(scale > 0.0);
-    let slot = group_sums[wid.x] + workgroup_exclusive_prefix(lid, keep);
+    let slot = group_sums[g] + workgroup_exclusive_prefix(lid, keep);
     if (keep == 1u) {
         let p = photon_position(i);
         survivors[slot] = LodPhoton(p.x, p.y, p.z, photons[5u * i + 3u], photons[5u * i + 4u], scale);

@@ -59,6 +59,16 @@ pub struct LodPass {
     layout: wgpu::BindGroupLayout,
 }
 
+/// Workgroups per dispatch dimension that every adapter offers.
+pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
+
+/// `workgroups` laid out as x × y with x ≤ 65,535 (the shader skips the
+/// surplus of the last row).
+pub fn dispatch_grid(workgroups: u32) -> (u32, u32) {
+    let rows = workgroups.div_ceil(MAX_WORKGROUPS_PER_DIMENSION).max(1);
+    (workgroups.div_ceil(rows), rows)
+}
+
 impl LodPass {
     pub fn new(device: &wgpu::Device) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -90,7 +100,7 @@ impl LodPass {
         let survivors = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lod survivors"),
             size: capacity,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let draw_args = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -160,11 +170,27 @@ impl LodPass {
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("lod cull"), timestamp_writes: None });
         pass.set_bind_group(0, &output.bind_group, &[]);
+        let (x, y) = dispatch_grid(workgroups);
         pass.set_pipeline(&self.count);
-        pass.dispatch_workgroups(workgroups, 1, 1);
+        pass.dispatch_workgroups(x, y, 1);
         pass.set_pipeline(&self.scan);
         pass.dispatch_workgroups(1, 1, 1);
         pass.set_pipeline(&self.scatter);
-        pass.dispatch_workgroups(workgroups, 1, 1);
+        pass.dispatch_workgroups(x, y, 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dispatch_grid_covers_every_workgroup_within_the_limit() {
+        for workgroups in [1, 255, 65_535, 65_536, 131_071, 1_000_000, u32::MAX / 256] {
+            let (x, y) = dispatch_grid(workgroups);
+            assert!(x <= MAX_WORKGROUPS_PER_DIMENSION && y <= MAX_WORKGROUPS_PER_DIMENSION, "{workgroups}");
+            assert!(x as u64 * y as u64 >= workgroups as u64, "{workgroups}");
+            assert!((x as u64) * (y as u64 - 1) < workgroups as u64, "a whole idle row for {workgroups}");
+        }
     }
 }

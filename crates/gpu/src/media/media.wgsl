@@ -71,6 +71,9 @@ fn view_ray(gbuffer_pos: vec4<f32>, frag_xy: vec2<f32>) -> vec4<f32> {
 fn segment_optical_depth(origin: vec3<f32>, dir: vec3<f32>, len: f32) -> vec3<f32> {
     var tau = media.global_sigma_t * len;
     for (var i = 0u; i < media.region_triangles; i++) {
+        if (!loop_iteration()) {
+            break;
+        }
         let tri = regions[i];
         let e1 = tri.b.xyz - tri.a.xyz;
         let e2 = tri.c.xyz - tri.a.xyz;

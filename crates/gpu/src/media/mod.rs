@@ -16,7 +16,7 @@ pub const MEDIA_WGSL: &str = include_str!("media.wgsl");
 pub const VIEW_DEPTH_WGSL: &str = include_str!("view_depth.wgsl");
 
 pub fn optical_depth_shader_source() -> String {
-    format!("{MEDIA_WGSL}\n{}", include_str!("optical_depth.wgsl"))
+    format!("{}{MEDIA_WGSL}\n{}", crate::UNCOUNTED_LOOPS_WGSL, include_str!("optical_depth.wgsl"))
 }
 
 /// Mirrors `MediaParams` in media.wgsl.
@@ -84,6 +84,18 @@ impl MediaParams {
             _pad0: 0,
             _pad1: 0,
         }
+    }
+}
+
+impl GpuMedia {
+    /// Whether `scene` has media bounded by region meshes (the
+    /// optical-depth pass and its slices run only then).
+    pub fn has_regions(scene: &Scene) -> bool {
+        Self::region_triangle_count(scene) > 0
+    }
+
+    pub fn region_triangle_count(scene: &Scene) -> usize {
+        scene.media.entries().iter().filter_map(|e| e.region.as_ref()).map(|r| r.triangles().len()).sum()
     }
 }
 

@@ -2,7 +2,13 @@
 //! `Rgba32Float` image (the only texture read back for output).
 
 pub fn shader_source() -> String {
-    format!("{}\n{}\n{}", crate::media::MEDIA_WGSL, crate::media::VIEW_DEPTH_WGSL, include_str!("resolve.wgsl"))
+    format!(
+        "{}\n{}\n{}\n{}",
+        crate::UNCOUNTED_LOOPS_WGSL,
+        crate::media::MEDIA_WGSL,
+        crate::media::VIEW_DEPTH_WGSL,
+        include_str!("resolve.wgsl")
+    )
 }
 const WORKGROUP: u32 = 8;
 

@@ -1,17 +1,24 @@
 //! The shadow pass: renders, for every light sample, the distance to the
-//! nearest surface into layers of one `R32Float` texture array (a cube of
-//! six layers for point and area samples, one layer for narrow spots).
+//! nearest surface into layers of one depth texture array (a cube of six
+//! layers for point and area samples, one layer for narrow spots).
+//!
+//! The distance is written as the fragment's depth, divided by the view's
+//! `range` (stored in `light_position.w`), so the depth test itself keeps
+//! the nearest surface and no float colour target is needed: OpenGL ES
+//! adapters without `EXT_color_buffer_float` cannot render to `R32Float`,
+//! and every adapter can render and load `Depth32Float`.
 
 pub mod light_samples;
 
 use crate::gbuffer::DEPTH_FORMAT;
 use crate::scene_upload::{GpuVertex, SceneBuffers};
 use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
 use light_samples::ShadowView;
 use wgpu::util::DeviceExt;
 
 pub const SHADER: &str = include_str!("shadow.wgsl");
-pub const MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub const MAP_FORMAT: wgpu::TextureFormat = DEPTH_FORMAT;
 
 /// Mirrors `ShadowViewParams` in shadow.wgsl and `ShadowView` in direct.wgsl.
 #[repr(C)]
@@ -21,20 +28,30 @@ pub struct ShadowViewParams {
     pub light_position: [f32; 4],
 }
 
-impl From<&ShadowView> for ShadowViewParams {
-    fn from(v: &ShadowView) -> Self {
+impl ShadowViewParams {
+    /// The view of `v`, storing distances as fractions of `range`, the
+    /// distance from the light sample to the farthest corner of the scene
+    /// bounds `(lo, hi)` (so every surface's distance fits in [0, 1]).
+    pub fn new(v: &ShadowView, (lo, hi): (Vec3, Vec3)) -> Self {
         ShadowViewParams {
             clip_from_world: v.clip_from_world.to_cols_array_2d(),
-            light_position: v.light_position.extend(0.0).to_array(),
+            light_position: v.light_position.extend(shadow_range(v.light_position, lo, hi)).to_array(),
         }
     }
+}
+
+/// The farthest distance from `from` to the box `[lo, hi]`, with 1% to spare
+/// (at least a tiny positive length, so the shader can divide by it).
+pub fn shadow_range(from: Vec3, lo: Vec3, hi: Vec3) -> f32 {
+    let far = (from - lo).abs().max((from - hi).abs());
+    (far.length() * 1.01).max(1e-20)
 }
 
 pub struct ShadowMaps {
     pub size: u32,
     pub layers: u32,
+    /// `Depth32Float` layers: distance to the nearest surface / range.
     pub texture: wgpu::Texture,
-    depth: wgpu::Texture,
     view_bind_groups: Vec<wgpu::BindGroup>,
     /// All views, for the direct pass's lookups.
     pub views_buffer: wgpu::Buffer,
@@ -76,11 +93,7 @@ impl ShadowPass {
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: MAP_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
+                targets: &[],
             }),
             multiview_mask: None,
             cache: None,
@@ -88,7 +101,14 @@ impl ShadowPass {
         ShadowPass { pipeline, layout }
     }
 
-    pub fn create_maps(&self, device: &wgpu::Device, views: &[ShadowView], size: u32) -> ShadowMaps {
+    /// One layer per view of `views`, each `size²`, for a scene within `bounds`.
+    pub fn create_maps(
+        &self,
+        device: &wgpu::Device,
+        views: &[ShadowView],
+        size: u32,
+        bounds: (Vec3, Vec3),
+    ) -> ShadowMaps {
         let layers = views.len().max(1) as u32;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
@@ -100,17 +120,7 @@ impl ShadowPass {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
-        let depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("shadow depth"),
-            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
-        let params: Vec<ShadowViewParams> = views.iter().map(ShadowViewParams::from).collect();
+        let params: Vec<ShadowViewParams> = views.iter().map(|v| ShadowViewParams::new(v, bounds)).collect();
         let view_bind_groups = params
             .iter()
             .map(|p| {
@@ -132,12 +142,11 @@ impl ShadowPass {
             contents: bytemuck::cast_slice(if params.is_empty() { &zero[..] } else { &params }),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        ShadowMaps { size, layers, texture, depth, view_bind_groups, views_buffer }
+        ShadowMaps { size, layers, texture, view_bind_groups, views_buffer }
     }
 
     /// Renders every shadow view of `maps`.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, scene: &SceneBuffers, maps: &ShadowMaps) {
-        let depth_view = maps.depth.create_view(&Default::default());
         for (layer, bind_group) in maps.view_bind_groups.iter().enumerate() {
             let target = maps.texture.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
@@ -147,19 +156,11 @@ impl ShadowPass {
             });
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow view"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    // Texels that see nothing hold "infinitely far": lit.
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 1e30, g: 0.0, b: 0.0, a: 0.0 }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
+                color_attachments: &[],
+                // Texels that see nothing hold the whole range: lit.
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
+                    view: &target,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,

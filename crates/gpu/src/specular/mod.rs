@@ -31,10 +31,11 @@ pub fn has_specular_surfaces(scene: &Scene) -> bool {
 
 pub fn shader_source() -> String {
     format!(
-        "{}\n{}\n{}\n{}",
+        "{}\n{}\n{}\n{}\n{}",
         crate::ESTIMATE_WGSL,
         crate::media::MEDIA_WGSL,
         crate::direct::LIGHT_EVAL_WGSL,
+        include_str!("loop_budget.wgsl"),
         include_str!("specular.wgsl")
     )
 }
@@ -75,6 +76,31 @@ pub struct SpecularParams {
     pub _pad1: u32,
 }
 
+/// Mirrors `SliceParams` in specular.wgsl: which share of the photon
+/// gathers one dispatch computes, and its loop budget.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SliceParams {
+    pub index: u32,
+    pub count: u32,
+    pub iteration_budget: u32,
+    pub _pad: u32,
+}
+
+/// Most dispatches the gathers are split into before the pass gives up.
+pub const MAX_SLICES: u32 = 256;
+/// Uniform offsets must be multiples of 256 bytes on every adapter.
+const SLICE_STRIDE: u64 = 256;
+
+/// What the last frame's specular pass reported.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SpecularStatus {
+    /// Pixel invocations (over all slices) that ran out of loop budget.
+    pub over_budget: u32,
+    /// The most loop iterations one invocation ran.
+    pub most_iterations: u32,
+}
+
 /// Everything the estimate needs to know about the photon maps.
 pub struct SpecularInputs<'a> {
     pub global_photons: &'a [Photon],
@@ -86,6 +112,8 @@ pub struct SpecularInputs<'a> {
     pub power_unit: f32,
     pub max_depth: u32,
     pub shadow_bias: f32,
+    /// Loop iterations one invocation may run (`GpuContext::loop_budget`).
+    pub iteration_budget: u32,
 }
 
 pub struct SpecularPass {
@@ -97,6 +125,12 @@ pub struct SpecularPass {
     /// its (zero-initialised) output stays black.
     enabled: bool,
     pub output: wgpu::Texture,
+    slice_params: wgpu::Buffer,
+    status: wgpu::Buffer,
+    iteration_budget: u32,
+    /// Dispatches the gathers are split into; grows when a frame ran over
+    /// budget and is kept for the next frames.
+    slices: std::cell::Cell<u32>,
 }
 
 impl SpecularPass {
@@ -112,6 +146,7 @@ impl SpecularPass {
         inputs: &SpecularInputs,
     ) -> Self {
         let (width, height) = (gbuffer.width, gbuffer.height);
+        let iteration_budget = inputs.iteration_budget;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("specular.wgsl"),
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
@@ -132,10 +167,13 @@ impl SpecularPass {
                 entry(7, storage(true)),
                 entry(8, storage(true)),
                 entry(9, storage(true)),
-                entry(10, texture(D2Array)),
+                entry(10, crate::binding::depth_texture_array()),
                 entry(11, texture(D2)),
                 entry(12, storage_texture_rgba32f()),
                 entry(13, uniform()),
+                entry(14, storage(false)),
+                entry(15, storage(false)),
+                entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
@@ -217,6 +255,24 @@ impl SpecularPass {
         let lights_buffer = buffer("specular lights", bytemuck::cast_slice(&lights.lights), storage_usage);
         let samples_buffer = buffer("specular light samples", bytemuck::cast_slice(&lights.samples), storage_usage);
         let output = crate::binding::storage_output_texture(device, "specular radiance", width, height);
+        let accum = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("specular accumulation"),
+            size: width as u64 * height as u64 * 16,
+            usage: storage_usage,
+            mapped_at_creation: false,
+        });
+        let status = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("specular status"),
+            size: 16,
+            usage: storage_usage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let slice_params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("specular slices"),
+            size: MAX_SLICES as u64 * SLICE_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let maps_view =
             maps.texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(D2Array), ..Default::default() });
         let normal_view = gbuffer.normal.create_view(&Default::default());
@@ -239,20 +295,81 @@ impl SpecularPass {
                 wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&normal_view) },
                 wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
                 wgpu::BindGroupEntry { binding: 13, resource: media.params_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 14, resource: accum.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 15, resource: status.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 16,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &slice_params,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(std::mem::size_of::<SliceParams>() as u64),
+                    }),
+                },
             ],
         });
         let enabled = has_specular_surfaces(scene);
-        SpecularPass { pipeline, bind_group, width, height, enabled, output }
+        SpecularPass {
+            pipeline,
+            bind_group,
+            width,
+            height,
+            enabled,
+            output,
+            slice_params,
+            status,
+            iteration_budget,
+            slices: std::cell::Cell::new(0),
+        }
     }
 
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+    /// Whether the pass runs at all (the scene has specular surfaces).
+    pub fn enabled(&self) -> bool {
+        self.enabled
+    }
+
+    /// Dispatches the gathers are split into.
+    pub fn slices(&self) -> u32 {
+        self.slices.get().max(1)
+    }
+
+    /// Splits the gathers into `slices` dispatches from the next frame on.
+    pub fn set_slices(&self, slices: u32) {
+        self.slices.set(slices.clamp(1, MAX_SLICES));
+    }
+
+    /// The loop iterations one invocation may run.
+    pub fn iteration_budget(&self) -> u32 {
+        self.iteration_budget
+    }
+
+    /// What the last recorded frame reported (waits for it).
+    pub fn read_status(&self, ctx: &crate::GpuContext) -> Result<SpecularStatus, crate::GpuError> {
+        let words = crate::readback::read_u32s(ctx, &self.status, 2)?;
+        Ok(SpecularStatus { over_budget: words[0], most_iterations: words[1] })
+    }
+
+    /// Records the pass: one dispatch per slice, after clearing the status.
+    pub fn record(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder) {
         if !self.enabled {
             return;
         }
+        let count = self.slices();
+        let params: Vec<u8> = (0..count)
+            .flat_map(|index| {
+                let p = SliceParams { index, count, iteration_budget: self.iteration_budget, _pad: 0 };
+                let mut bytes = bytemuck::bytes_of(&p).to_vec();
+                bytes.resize(SLICE_STRIDE as usize, 0);
+                bytes
+            })
+            .collect();
+        queue.write_buffer(&self.slice_params, 0, &params);
+        encoder.clear_buffer(&self.status, 0, None);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("specular"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.bind_group, &[]);
-        pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+        for index in 0..count {
+            pass.set_bind_group(0, &self.bind_group, &[index * SLICE_STRIDE as u32]);
+            pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+        }
     }
 }

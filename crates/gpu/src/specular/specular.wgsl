@@ -6,8 +6,14 @@
 // direct light (light_eval.wgsl) and fixed-radius gathers over both photon
 // maps (estimate.wgsl). In media every segment of the path is attenuated
 // and adds the in-scattering along it from the volume map, as photon-cpu's
-// recursion does. Prepended with estimate.wgsl, media.wgsl and
-// light_eval.wgsl.
+// recursion does. Prepended with estimate.wgsl, media.wgsl,
+// light_eval.wgsl and loop_budget.wgsl.
+//
+// The photon gathers can be split over several dispatches ("slices"):
+// slice k reads photons k, k + S, k + 2S, … of every cell, adding to the
+// pixel's sum in `accum`; direct light and emission are added by slice 0.
+// Each dispatch retraces the same rays, so the sum over slices is the
+// unsplit sum, and no invocation runs more than its loop budget.
 
 struct SpecularParams {
     camera_position: vec3<f32>,
@@ -78,10 +84,23 @@ struct Surface {
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var<storage, read> samples: array<LightSample>;
 @group(0) @binding(9) var<storage, read> views: array<ShadowView>;
-@group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
+@group(0) @binding(10) var shadow_maps: texture_depth_2d_array;
 @group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(13) var<uniform> media: MediaParams;
+// Running sum over slices per pixel; w > 0 once any slice ran over budget.
+@group(0) @binding(14) var<storage, read_write> accum: array<vec4<f32>>;
+// [pixels over budget, most iterations one invocation ran, unused, unused].
+@group(0) @binding(15) var<storage, read_write> status: array<atomic<u32>, 4>;
+@group(0) @binding(16) var<uniform> slice: SliceParams;
+
+// Which slice this dispatch computes (mirrors specular::SliceParams).
+struct SliceParams {
+    index: u32,
+    count: u32,
+    iteration_budget: u32,
+    _pad: u32,
+}
 
 const NO_HIT: f32 = 3.0e38;
 
@@ -171,6 +190,9 @@ fn trace(o: vec3<f32>, d: vec3<f32>) -> Hit {
     var top = 1u;
     stack[0] = 0u;
     while (top > 0u) {
+        if (!loop_iteration()) {
+            break;
+        }
         top -= 1u;
         let node = nodes[stack[top]];
         if (!slab_hit(o, inv, node.min, node.max, hit.t)) {
@@ -185,6 +207,9 @@ fn trace(o: vec3<f32>, d: vec3<f32>) -> Hit {
             continue;
         }
         for (var i = node.first; i < node.first + node.prim_count; i++) {
+            if (!loop_iteration()) {
+                break;
+            }
             let t = intersect_prim(prims[i], o, d, hit.t);
             if (t < hit.t) {
                 hit = Hit(t, i);
@@ -200,29 +225,30 @@ fn bucket_of(cell: vec3<i32>, buckets: u32) -> u32 {
     return h & (buckets - 1u);
 }
 
-// Fixed-radius estimate at x from one photon grid (PhotonGrid::for_each_within).
+// Fixed-radius estimate at x from one photon grid (PhotonGrid::for_each_within),
+// over this dispatch's slice of each cell's photons. A bucket shared by two
+// of the 27 cells is read twice: a photon counts only from its own cell
+// (which costs no loop, unlike remembering the buckets read).
 fn gather(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
     let centre = vec3<i32>(floor(x / radius));
-    var seen: array<u32, 27>;
-    var seen_count = 0u;
     var power = vec3<f32>(0.0);
     for (var k = 0u; k < 27u; k++) {
-        let offset = vec3<i32>(i32(k % 3u) - 1, i32((k / 3u) % 3u) - 1, i32(k / 9u) - 1);
-        let b = bucket_of(centre + offset, buckets);
-        var duplicate = false;
-        for (var j = 0u; j < seen_count; j++) {
-            duplicate = duplicate || seen[j] == b;
+        if (!loop_iteration()) {
+            break;
         }
-        if (duplicate) {
-            continue;
-        }
-        seen[seen_count] = b;
-        seen_count += 1u;
+        let cell = centre + vec3<i32>(i32(k % 3u) - 1, i32((k / 3u) % 3u) - 1, i32(k / 9u) - 1);
+        let b = bucket_of(cell, buckets);
         let start = grid[start_offset + b];
         let end = grid[start_offset + b + 1u];
-        for (var i = start; i < end; i++) {
+        for (var i = start + slice.index; i < end; i += slice.count) {
+            if (!loop_iteration()) {
+                break;
+            }
             let base = photon_offset + 5u * i;
             let p = vec3<f32>(bitcast<f32>(grid[base]), bitcast<f32>(grid[base + 1u]), bitcast<f32>(grid[base + 2u]));
+            if (any(vec3<i32>(floor(p / radius)) != cell)) {
+                continue;
+            }
             let d = p - x;
             let dir = decode_octahedral_15(grid[base + 4u] & 0x3fffffffu);
             if (photon_accepted(dot(d, d), dir, n, radius, params.normal_test != 0u)) {
@@ -256,11 +282,17 @@ fn volume_cell(o: vec3<f32>, d: vec3<f32>, len: f32, cell: vec3<i32>, t_enter: f
     let r2 = r * r;
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < 27u; k++) {
+        if (!loop_iteration()) {
+            break;
+        }
         let neighbour = cell + vec3<i32>(i32(k % 3u) - 1, i32((k / 3u) % 3u) - 1, i32(k / 9u) - 1);
         let b = bucket_of(neighbour, params.volume_buckets);
         let start = grid[params.volume_start_offset + b];
         let end = grid[params.volume_start_offset + b + 1u];
-        for (var i = start; i < end; i++) {
+        for (var i = start + slice.index; i < end; i += slice.count) {
+            if (!loop_iteration()) {
+                break;
+            }
             let base = params.volume_photon_offset + 5u * i;
             let p = vec3<f32>(bitcast<f32>(grid[base]), bitcast<f32>(grid[base + 1u]), bitcast<f32>(grid[base + 2u]));
             // A bucket shared by two of the 27 cells is read twice: count a
@@ -325,6 +357,9 @@ fn volume_along(o: vec3<f32>, d: vec3<f32>, len: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     // Bounded walk: a segment crosses at most 3 · len / r + 3 cells.
     for (var n = 0u; n < 100000u; n++) {
+        if (!loop_iteration()) {
+            break;
+        }
         let t_exit = min(t_next.x, min(t_next.y, t_next.z));
         let last = t_exit >= t_end;
         sum += volume_cell(o, d, len, cell, t_enter, select(t_exit, NO_HIT, last));
@@ -368,7 +403,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let first = surfaces[u32(g.w)];
     let mirror_part = first.kind == 0u && any(first.specular > vec3<f32>(0.0));
     if (dot(g.xyz, g.xyz) == 0.0 || (first.kind != 1u && first.kind != 2u && !mirror_part)) {
-        textureStore(output, pixel, vec4<f32>(0.0));
+        if (slice.index + 1u == slice.count) {
+            textureStore(output, pixel, vec4<f32>(0.0));
+        }
         return;
     }
     // The primary ray through the pixel centre, as Camera::ray builds it.
@@ -382,6 +419,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var top = 1u;
     var radiance = vec3<f32>(0.0);
     while (top > 0u) {
+        if (!loop_iteration()) {
+            break;
+        }
         top -= 1u;
         let b = stack[top];
         let hit = trace(b.origin, b.dir);
@@ -412,9 +452,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 // A diffuse primary hit is shaded by the raster passes; here
                 // only its mirror part is followed.
                 if (b.depth > 0u) {
+                    if (slice.index == 0u) {
+                        radiance += weight * direct_radiance(x, n, s.albedo);
+                    }
                     let g = gather(x, n, s.albedo, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
                     let c = gather(x, n, s.albedo, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
-                    radiance += weight * (direct_radiance(x, n, s.albedo) + g + c);
+                    radiance += weight * (g + c);
                 }
                 if (any(s.specular > vec3<f32>(0.0)) && can_bounce && top < STACK) {
                     stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * s.specular);
@@ -453,11 +496,29 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
             default: {
-                if (front) {
+                if (front && slice.index == 0u) {
                     radiance += weight * s.emission;
                 }
             }
         }
     }
-    textureStore(output, pixel, vec4<f32>(radiance, 1.0));
+    finish_pixel(id.xy, radiance);
+}
+
+// Adds this slice's radiance to the pixel's sum; the last slice stores it.
+fn finish_pixel(id: vec2<u32>, radiance: vec3<f32>) {
+    let index = id.y * params.width + id.x;
+    var sum = vec4<f32>(radiance, f32(over_budget));
+    if (slice.index > 0u) {
+        let before = accum[index];
+        sum = vec4<f32>(before.xyz + radiance, max(before.w, sum.w));
+    }
+    accum[index] = sum;
+    if (slice.index + 1u == slice.count) {
+        textureStore(output, vec2<i32>(id), vec4<f32>(sum.xyz, 1.0));
+    }
+    if (over_budget) {
+        atomicAdd(&status[0], 1u);
+    }
+    atomicMax(&status[1], iterations_spent);
 }

@@ -23,7 +23,8 @@ pub struct VolumeParams {
 
 pub fn shader_source() -> String {
     format!(
-        "{}\n{}\n{}\n{}\n{}",
+        "{}\n{}\n{}\n{}\n{}\n{}",
+        crate::UNCOUNTED_LOOPS_WGSL,
         crate::ESTIMATE_WGSL,
         crate::splat::FOOTPRINT_WGSL,
         crate::media::MEDIA_WGSL,

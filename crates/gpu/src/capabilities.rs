@@ -1,0 +1,242 @@
+//! What the GPU renderer needs from an adapter, written down once, and the
+//! choice of adapter.
+//!
+//! Every format, downlevel flag and limit the passes rely on is listed here
+//! and checked before a device is opened, so an adapter that cannot run the
+//! renderer is refused with one line naming what it lacks (the CLI then
+//! renders with `photon-cpu`) instead of failing inside a pipeline. The
+//! optional features (32-bit float blending, timestamps) are chosen here too.
+
+use wgpu::{DownlevelFlags, TextureFormat, TextureFormatFeatureFlags as F, TextureUsages as U};
+
+/// Formats and what each must support.
+pub const FORMATS: [(TextureFormat, U, &str); 2] = [
+    // G-buffer targets, the specular pass's storage output, read by textureLoad.
+    (
+        TextureFormat::Rgba32Float,
+        U::RENDER_ATTACHMENT.union(U::TEXTURE_BINDING).union(U::STORAGE_BINDING),
+        "G-buffer targets and compute outputs",
+    ),
+    // Depth tests, and shadow distances written as depth and loaded later.
+    (TextureFormat::Depth32Float, U::RENDER_ATTACHMENT.union(U::TEXTURE_BINDING), "depth and shadow maps"),
+];
+
+/// Downlevel flags and why each is needed.
+pub const DOWNLEVEL: [(DownlevelFlags, &str); 4] = [
+    (DownlevelFlags::COMPUTE_SHADERS, "compute shaders (LOD cull, specular ray tracing)"),
+    (DownlevelFlags::INDIRECT_EXECUTION, "indirect draws (LOD-culled photon splats)"),
+    (DownlevelFlags::VERTEX_STORAGE, "storage buffers in vertex shaders (region meshes)"),
+    (DownlevelFlags::FRAGMENT_STORAGE, "storage buffers in fragment shaders (lights)"),
+];
+
+/// The limits a frame needs whatever the scene; scene-dependent sizes are
+/// checked by `GpuBudget::check` in `memory.rs`.
+pub fn required_limits() -> wgpu::Limits {
+    wgpu::Limits {
+        // Four Rgba32Float G-buffer targets.
+        max_color_attachments: 4,
+        max_color_attachment_bytes_per_sample: 64,
+        // The specular pass: BVH nodes and primitives, surfaces, photon
+        // grids, region triangles, lights, light samples, shadow views,
+        // its accumulation buffer and its status words.
+        max_storage_buffers_per_shader_stage: 10,
+        max_storage_textures_per_shader_stage: 1,
+        max_bindings_per_bind_group: 16,
+        max_compute_invocations_per_workgroup: 256,
+        max_compute_workgroup_size_x: 256,
+        max_compute_workgroup_storage_size: 1024,
+        ..wgpu::Limits::downlevel_defaults()
+    }
+}
+
+/// Shader loop iterations one invocation may run.
+///
+/// llvmpipe (lavapipe, and Mesa's GL on the CPU) ends every loop after one
+/// pass once a shader has run 65,535 loop iterations, with no error. It
+/// runs invocations in SIMD batches (8 lanes at 256 bits) and counts the
+/// batch's iterations, which add up to at most the sum of its lanes' own
+/// counts: so each lane gets the cap divided by the lanes (measured: at 1 M
+/// photons a glass pixel whose lanes ran at most 52,312 iterations each
+/// already lost its light). On hardware the budget keeps each invocation
+/// short, well inside OS watchdogs.
+pub fn loop_budget(info: &wgpu::AdapterInfo) -> u32 {
+    if info.device_type == wgpu::DeviceType::Cpu {
+        SOFTWARE_LOOP_CAP / software_lanes(&info.name)
+    } else {
+        HARDWARE_LOOP_BUDGET
+    }
+}
+
+/// llvmpipe's per-batch loop cap (65,535), with room for loops we do not count.
+pub const SOFTWARE_LOOP_CAP: u32 = 64_000;
+pub const HARDWARE_LOOP_BUDGET: u32 = 1 << 20;
+
+/// SIMD lanes of a software adapter: llvmpipe names its vector width
+/// ("llvmpipe (LLVM 15.0.6, 256 bits)"), 32-bit lanes; 16 when unknown.
+pub fn software_lanes(name: &str) -> u32 {
+    name.find(" bits")
+        .and_then(|end| {
+            let before = &name[..end];
+            let start = before.rfind(|c: char| !c.is_ascii_digit()).map_or(0, |i| i + 1);
+            before[start..].parse::<u32>().ok()
+        })
+        .map(|bits| (bits / 32).clamp(1, 64))
+        .unwrap_or(16)
+}
+
+/// What a usable adapter offers beyond the requirements.
+#[derive(Clone, Debug)]
+pub struct Capabilities {
+    /// Rgba32Float can be blended: the splats accumulate in it.
+    pub float32_blend: bool,
+    /// Rgba16Float is renderable and blendable (the fallback accumulation).
+    pub float16_blend: bool,
+    /// GPU timestamps can be written between passes.
+    pub timestamps: bool,
+}
+
+impl Capabilities {
+    /// The adapter's fit, or every missing requirement in one line.
+    pub fn check(adapter: &wgpu::Adapter) -> Result<Capabilities, String> {
+        let mut missing = Vec::new();
+        let downlevel = adapter.get_downlevel_capabilities();
+        for (flag, why) in DOWNLEVEL {
+            if !downlevel.flags.contains(flag) {
+                missing.push(why.to_string());
+            }
+        }
+        for (format, usages, why) in FORMATS {
+            let features = adapter.get_texture_format_features(format);
+            if !features.allowed_usages.contains(usages) {
+                missing.push(format!("{format:?} with {:?} ({why})", usages.difference(features.allowed_usages)));
+            }
+        }
+        missing.extend(limit_shortfalls(&adapter.limits(), &required_limits()));
+        let blendable = |format| {
+            let f = adapter.get_texture_format_features(format);
+            f.allowed_usages.contains(U::RENDER_ATTACHMENT) && f.flags.contains(F::BLENDABLE)
+        };
+        let float32_blend =
+            adapter.features().contains(wgpu::Features::FLOAT32_BLENDABLE) && blendable(TextureFormat::Rgba32Float);
+        let float16_blend = blendable(TextureFormat::Rgba16Float);
+        if !float32_blend && !float16_blend {
+            missing.push("a blendable float render format (Rgba32Float or Rgba16Float) for photon splats".into());
+        }
+        if !missing.is_empty() {
+            return Err(format!("lacks {}", missing.join("; ")));
+        }
+        let timestamps = adapter.features().contains(timestamp_features());
+        Ok(Capabilities { float32_blend, float16_blend, timestamps })
+    }
+
+    /// The features to request for a device.
+    pub fn features(&self) -> wgpu::Features {
+        let mut features = wgpu::Features::empty();
+        if self.float32_blend {
+            features |= wgpu::Features::FLOAT32_BLENDABLE;
+        }
+        if self.timestamps {
+            features |= timestamp_features();
+        }
+        features
+    }
+
+    /// Format of the additive radiance targets.
+    pub fn radiance_format(&self) -> TextureFormat {
+        if self.float32_blend { TextureFormat::Rgba32Float } else { TextureFormat::Rgba16Float }
+    }
+}
+
+fn timestamp_features() -> wgpu::Features {
+    wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+}
+
+/// The limits of `needed` that `offered` does not reach, as `name offered < needed`.
+pub fn limit_shortfalls(offered: &wgpu::Limits, needed: &wgpu::Limits) -> Vec<String> {
+    let mut short = Vec::new();
+    needed.check_limits_with_fail_fn(offered, false, |name, needed, offered| {
+        short.push(format!("limit {name} {offered} < {needed}"));
+    });
+    short
+}
+
+/// Adapters in the order they are tried: hardware GPUs before software ones
+/// and native APIs (Vulkan, Metal, DX12) before OpenGL.
+pub fn preference(info: &wgpu::AdapterInfo) -> (u8, u8) {
+    let kind = match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    };
+    let api = match info.backend {
+        wgpu::Backend::Vulkan | wgpu::Backend::Metal | wgpu::Backend::Dx12 => 0,
+        _ => 1,
+    };
+    (kind, api)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn info(device_type: wgpu::DeviceType, backend: wgpu::Backend) -> wgpu::AdapterInfo {
+        wgpu::AdapterInfo {
+            name: String::new(),
+            vendor: 0,
+            device: 0,
+            device_type,
+            driver: String::new(),
+            driver_info: String::new(),
+            backend,
+            ..wgpu::AdapterInfo::new(device_type, backend)
+        }
+    }
+
+    #[test]
+    fn hardware_and_native_apis_come_first() {
+        use wgpu::{Backend, DeviceType};
+        let mut adapters = [
+            info(DeviceType::Cpu, Backend::Gl),
+            info(DeviceType::Cpu, Backend::Vulkan),
+            info(DeviceType::IntegratedGpu, Backend::Gl),
+            info(DeviceType::DiscreteGpu, Backend::Vulkan),
+            info(DeviceType::IntegratedGpu, Backend::Vulkan),
+        ];
+        adapters.sort_by_key(preference);
+        let order: Vec<_> = adapters.iter().map(|a| (a.device_type, a.backend)).collect();
+        assert_eq!(
+            order,
+            [
+                (DeviceType::DiscreteGpu, Backend::Vulkan),
+                (DeviceType::IntegratedGpu, Backend::Vulkan),
+                (DeviceType::IntegratedGpu, Backend::Gl),
+                (DeviceType::Cpu, Backend::Vulkan),
+                (DeviceType::Cpu, Backend::Gl),
+            ]
+        );
+    }
+
+    #[test]
+    fn shortfalls_name_the_limit() {
+        let offered = wgpu::Limits { max_storage_buffers_per_shader_stage: 4, ..wgpu::Limits::default() };
+        let short = limit_shortfalls(&offered, &required_limits());
+        assert!(short.iter().any(|s| s.contains("max_storage_buffers_per_shader_stage 4 < 10")), "{short:?}");
+        assert!(limit_shortfalls(&required_limits(), &required_limits()).is_empty());
+    }
+
+    #[test]
+    fn software_adapters_share_the_llvmpipe_loop_cap_among_their_lanes() {
+        const { assert!(SOFTWARE_LOOP_CAP < 65_535) };
+        assert_eq!(software_lanes("llvmpipe (LLVM 15.0.6, 256 bits)"), 8);
+        assert_eq!(software_lanes("llvmpipe (LLVM 17.0.2, 512 bits)"), 16);
+        assert_eq!(software_lanes("SwiftShader Device"), 16);
+        let cpu = wgpu::AdapterInfo {
+            name: "llvmpipe (LLVM 15.0.6, 256 bits)".into(),
+            ..info(wgpu::DeviceType::Cpu, wgpu::Backend::Vulkan)
+        };
+        assert_eq!(loop_budget(&cpu), 8_000);
+        assert_eq!(loop_budget(&info(wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Vulkan)), HARDWARE_LOOP_BUDGET);
+    }
+}
