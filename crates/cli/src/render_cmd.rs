@@ -210,7 +210,7 @@ fn render_photons(
             "note: {} photon paths will store about {} M photons: about {} MiB of photon maps",
             args.photons,
             stored / 1_000_000,
-            stored * 20 >> 20
+            (stored * 20) >> 20
         );
     }
     let gpu = match renderer {
