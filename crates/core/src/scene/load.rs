@@ -177,9 +177,10 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         };
         media.push((medium, region));
     }
+    // Too many media (or phase functions): reported at the last one.
     let media = Media::new(media).map_err(|e| SceneError {
         file: file.to_string(),
-        position: None,
+        position: desc.medium.last().map(|m| line_col(text, m.span().start)),
         context: "[[medium]]".into(),
         message: e,
     })?;
