@@ -2,6 +2,7 @@
 //! pixel coordinates are continuous, pixel (i,j) covering [i,i+1)×[j,j+1).
 
 use crate::geometry::Ray;
+use crate::scene::limits;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 #[derive(Clone, Debug)]
@@ -30,11 +31,18 @@ impl Camera {
         if right == Vec3::ZERO || forward.cross(up.normalize_or_zero()).length() < 1e-4 {
             return Err("camera up is zero or parallel to the viewing direction".into());
         }
-        if !(fov_y > 0.0 && fov_y < 180.0) {
-            return Err(format!("fov_y = {fov_y} must lie strictly between 0 and 180 degrees"));
+        let (fov_min, fov_max) = limits::FOV_Y;
+        if !(fov_y >= fov_min && fov_y <= fov_max) {
+            return Err(format!("fov_y = {fov_y} must lie between {fov_min} and {fov_max} degrees"));
         }
         if width == 0 || height == 0 {
             return Err(format!("resolution {width}x{height} has a zero side"));
+        }
+        if width > limits::MAX_SIDE || height > limits::MAX_SIDE {
+            return Err(format!("resolution {width}x{height}: each side must be at most {}", limits::MAX_SIDE));
+        }
+        if width as u64 * height as u64 > limits::MAX_PIXELS {
+            return Err(format!("resolution {width}x{height} has more than {} pixels (8192x8192)", limits::MAX_PIXELS));
         }
         Ok(Camera {
             position,
@@ -150,5 +158,18 @@ mod tests {
         assert!(Camera::new(Vec3::ZERO, Vec3::Y, Vec3::Y, 40.0, 8, 8).is_err());
         assert!(Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 180.0, 8, 8).is_err());
         assert!(Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 40.0, 0, 8).is_err());
+    }
+
+    #[test]
+    fn field_of_view_and_resolution_are_bounded() {
+        let cam = |fov, w, h| Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, fov, w, h);
+        for fov in [0.009, 179.5, 1e30] {
+            assert!(cam(fov, 8, 8).unwrap_err().contains("fov_y"), "{fov}");
+        }
+        assert!(cam(0.01, 8, 8).is_ok() && cam(179.0, 8, 8).is_ok());
+        assert!(cam(40.0, 16385, 1).unwrap_err().contains("at most 16384"));
+        assert!(cam(40.0, 16384, 4096).is_ok());
+        assert!(cam(40.0, 16384, 4097).unwrap_err().contains("pixels"));
+        assert!(cam(40.0, 100_000, 100_000).is_err());
     }
 }

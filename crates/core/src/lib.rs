@@ -27,6 +27,7 @@
 
 pub mod camera;
 pub mod estimate;
+pub mod fuzz;
 pub mod geometry;
 pub mod light;
 pub mod lod;

@@ -199,7 +199,18 @@ pub fn spot_falloff(theta: f32, cutoff: f32, falloff_start: f32) -> f32 {
 pub fn spot_solid_angle(cutoff: f32, falloff_start: f32) -> f32 {
     let (b, c) = (falloff_start as f64, cutoff as f64);
     let inner = 1.0 - b.cos();
-    let ramp = if c > b { ((c - b) * b.cos() - c.sin() + b.sin()) / (c - b) } else { 0.0 };
+    // The ramp term is ((c − b)·cos b − sin c + sin b)/(c − b); written as a
+    // sum of non-negative terms so that it does not cancel when c − b is tiny:
+    // with d = c − b, m = b + d/2 and h = d/2 it is
+    // 2·sin(b + d/4)·sin(d/4) + cos(m)·(1 − sin(h)/h).
+    let d = c - b;
+    let ramp = if d > 0.0 {
+        let h = d / 2.0;
+        let one_minus_sinc = if h < 1e-3 { h * h / 6.0 - h.powi(4) / 120.0 } else { 1.0 - h.sin() / h };
+        2.0 * (b + d / 4.0).sin() * (d / 4.0).sin() + (b + h).cos() * one_minus_sinc
+    } else {
+        0.0
+    };
     (2.0 * std::f64::consts::PI * (inner + ramp)) as f32
 }
 
@@ -220,6 +231,25 @@ pub fn sample_spot_direction(cutoff: f32, falloff_start: f32, rng: &mut Rng) -> 
 mod tests {
     use super::*;
     use crate::sampling::chi2::{assert_direction_distribution, assert_unit_density};
+
+    #[test]
+    fn spot_solid_angle_is_the_closed_form_and_stable_for_thin_ramps() {
+        let closed = |c: f64, b: f64| {
+            2.0 * std::f64::consts::PI * (1.0 - b.cos() + ((c - b) * b.cos() - c.sin() + b.sin()) / (c - b))
+        };
+        for (c, b) in [(40.0f64, 20.0f64), (90.0, 0.0), (20.0, 15.0), (1.0, 0.5)] {
+            let (c, b) = (c.to_radians(), b.to_radians());
+            let ours = spot_solid_angle(c as f32, b as f32) as f64;
+            assert!((ours / closed(c, b) - 1.0).abs() < 1e-5, "{c} {b}: {ours} vs {}", closed(c, b));
+        }
+        // A ramp far thinner than f32 can show: the hard-edged cone's solid angle.
+        let c = 20f32.to_radians();
+        let hard = spot_solid_angle(c, c);
+        let thin = spot_solid_angle(c, c - 1e-7);
+        assert!((thin / hard - 1.0).abs() < 1e-5, "{thin} vs {hard}");
+        let tiny = spot_solid_angle(1e-4, 0.0);
+        assert!(tiny > 0.0 && tiny.is_finite());
+    }
 
     #[test]
     fn spot_emission_matches_falloff() {

@@ -6,8 +6,7 @@
 
 use super::{Ray, Sphere, Triangle};
 use glam::{UVec2, Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
-use std::time::Duration;
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
 
 /// What a closest-hit query found.
 #[derive(Clone, Copy, Debug)]
@@ -127,8 +126,7 @@ impl Accel {
             hi = hi.max(b.0.max.into());
         }
         let scale = if bounds.is_empty() { 1.0 } else { (hi - lo).max_element().max(1e-3) };
-        let bvh = (!bounds.is_empty())
-            .then(|| build_cwbvh(&bounds, BvhBuildParams::medium_build(), &mut Duration::default()));
+        let bvh = (!bounds.is_empty()).then(|| super::bvh_build::build_cwbvh(&bounds, BvhBuildParams::medium_build()));
         let mut surface_of = triangle_surfaces;
         surface_of.extend(sphere_surfaces);
         let n_tri = triangles.len();

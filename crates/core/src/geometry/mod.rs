@@ -2,10 +2,12 @@
 //! that answers closest-hit and occlusion queries over them.
 
 mod accel;
+mod bvh_build;
 mod flat_bvh;
 mod shapes;
 
 pub use accel::{Accel, Hit};
+pub(crate) use bvh_build::build_cwbvh;
 pub use flat_bvh::{FlatBvh, FlatNode, FlatPrim};
 pub use shapes::{Sphere, Triangle, TriangleNormals};
 

@@ -8,8 +8,7 @@
 use super::Photon;
 use crate::material::Rgb;
 use glam::{UVec2, Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh, cwbvh::builder::build_cwbvh};
-use std::time::Duration;
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
 
 /// A volume photon decoded once, as the estimate reads it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,8 +63,7 @@ impl VolumePhotonMap {
                 SphereBounds(Aabb::new(c - r, c + r))
             })
             .collect();
-        let bvh =
-            (!bounds.is_empty()).then(|| build_cwbvh(&bounds, BvhBuildParams::fast_build(), &mut Duration::default()));
+        let bvh = (!bounds.is_empty()).then(|| crate::geometry::build_cwbvh(&bounds, BvhBuildParams::fast_build()));
         let leaves = bvh
             .as_ref()
             .map(|b| b.primitive_indices.iter().map(|&i| VolumePhoton::decode(&photons[i as usize])).collect())

@@ -2,11 +2,12 @@
 
 use super::desc::{CameraDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3};
 use super::error::{SceneError, line_col};
+use super::limits::{self, MAX_COORD, MAX_EMISSION, MIN_LENGTH};
 use super::{Scene, Surface};
 use crate::camera::Camera;
 use crate::geometry::{Accel, Sphere, Triangle, TriangleNormals};
 use crate::light::Light;
-use crate::material::Material;
+use crate::material::{Material, mean};
 use crate::medium::{Media, Medium, Phase, RegionMesh};
 use glam::{Mat3, Vec3};
 use std::collections::HashMap;
@@ -31,35 +32,51 @@ impl Place<'_> {
         }
     }
 
-    fn vec3(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
-        if v.iter().all(|x| x.is_finite()) {
-            Ok(Vec3::from(v))
-        } else {
-            Err(self.error(format!("`{field}` = {v:?} is not finite")))
+    /// A point or vector: finite, each component within ±`MAX_COORD`.
+    fn coord(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(self.error(format!("`{field}` = {v:?} is not finite")));
         }
+        if v.iter().any(|x| x.abs() > MAX_COORD) {
+            return Err(self.error(format!("`{field}` = {v:?} has a component beyond ±{MAX_COORD:e}")));
+        }
+        Ok(Vec3::from(v))
+    }
+
+    /// A direction of any non-zero length (within ±`MAX_COORD`), made unit.
+    fn direction(&self, field: &str, v: V3) -> Result<Vec3, SceneError> {
+        self.coord(field, v)?.try_normalize().ok_or_else(|| self.error(format!("`{field}` = {v:?} is zero")))
     }
 
     fn required<T: Copy>(&self, field: &str, v: Option<T>) -> Result<T, SceneError> {
         v.ok_or_else(|| self.error(format!("missing field `{field}`")))
     }
 
-    fn positive(&self, field: &str, v: f32) -> Result<f32, SceneError> {
-        if v.is_finite() && v > 0.0 {
+    /// A number in [lo, hi].
+    fn in_range(&self, field: &str, v: f32, (lo, hi): (f32, f32)) -> Result<f32, SceneError> {
+        if v >= lo && v <= hi {
             Ok(v)
         } else {
-            Err(self.error(format!("`{field}` = {v} must be positive and finite")))
+            Err(self.error(format!("`{field}` = {v} must lie between {lo:e} and {hi:e}")))
         }
     }
 
-    fn color(&self, field: &str, v: V3, max: Option<f32>) -> Result<Vec3, SceneError> {
-        let c = self.vec3(field, v)?;
+    /// A radius or side: in [`MIN_LENGTH`, 2·`MAX_COORD`].
+    fn length(&self, field: &str, v: f32) -> Result<f32, SceneError> {
+        self.in_range(field, v, (MIN_LENGTH, 2.0 * MAX_COORD))
+    }
+
+    /// An RGB triple with each component in [0, max].
+    fn color(&self, field: &str, v: V3, max: f32) -> Result<Vec3, SceneError> {
+        if !v.iter().all(|x| x.is_finite()) {
+            return Err(self.error(format!("`{field}` = {v:?} is not finite")));
+        }
+        let c = Vec3::from(v);
         if c.min_element() < 0.0 {
             return Err(self.error(format!("`{field}` = {v:?} has a negative component")));
         }
-        if let Some(max) = max {
-            if c.max_element() > max {
-                return Err(self.error(format!("`{field}` = {v:?} has a component above {max}")));
-            }
+        if c.max_element() > max {
+            return Err(self.error(format!("`{field}` = {v:?} has a component above {max}")));
         }
         Ok(c)
     }
@@ -111,7 +128,9 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
             at.error(format!("unknown material \"{}\" ({hint})", obj.material.get_ref()))
         })?;
         let surface = geometry.add_surface(Surface { material, emitter: None });
+        let start = geometry.counts();
         load_object(obj, &p, base_dir, surface, &mut geometry)?;
+        geometry.check_since(start, &p)?;
     }
 
     let mut lights = Vec::new();
@@ -124,11 +143,13 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
             materials.push(Material::Emitter);
             let surface =
                 geometry.add_surface(Surface { material: emitter_material, emitter: Some(lights.len() as u32) });
+            let start = geometry.counts();
             match light {
                 Light::Sphere { center, radius, .. } => geometry.spheres.push((Sphere { center, radius }, surface)),
                 Light::Quad { corner, edge_u, edge_v, .. } => geometry.add_quad(corner, edge_u, edge_v, surface),
                 _ => unreachable!("only area lights have geometry"),
             }
+            geometry.check_since(start, &p)?;
         }
         lights.push(light);
     }
@@ -156,9 +177,10 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         };
         media.push((medium, region));
     }
+    // Too many media (or phase functions): reported at the last one.
     let media = Media::new(media).map_err(|e| SceneError {
         file: file.to_string(),
-        position: None,
+        position: desc.medium.last().map(|m| line_col(text, m.span().start)),
         context: "[[medium]]".into(),
         message: e,
     })?;
@@ -170,8 +192,18 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
 }
 
 fn load_medium(m: &MediumDesc, p: &Place) -> Result<Medium, SceneError> {
-    let sigma_a = p.color("sigma_a", m.sigma_a, None)?;
-    let sigma_s = p.color("sigma_s", m.sigma_s, None)?;
+    let sigma = |field: &str, v: V3| -> Result<Vec3, SceneError> {
+        let c = p.color(field, v, limits::MAX_SIGMA)?;
+        if c.to_array().iter().any(|&x| x > 0.0 && x < limits::MIN_SIGMA) {
+            return Err(p.error(format!(
+                "`{field}` = {v:?} has a component below {:e} that is not 0 (write 0 for none)",
+                limits::MIN_SIGMA
+            )));
+        }
+        Ok(c)
+    };
+    let sigma_a = sigma("sigma_a", m.sigma_a)?;
+    let sigma_s = sigma("sigma_s", m.sigma_s)?;
     if (sigma_a + sigma_s).max_element() <= 0.0 {
         return Err(p.error("sigma_a + sigma_s is zero in every channel: the medium does nothing"));
     }
@@ -200,9 +232,9 @@ fn load_medium(m: &MediumDesc, p: &Place) -> Result<Medium, SceneError> {
 fn load_camera(c: &CameraDesc, p: &Place) -> Result<Camera, SceneError> {
     let fov = c.fov_y;
     Camera::new(
-        p.vec3("position", c.position)?,
-        p.vec3("look_at", c.look_at)?,
-        p.vec3("up", c.up)?,
+        p.coord("position", c.position)?,
+        p.coord("look_at", c.look_at)?,
+        p.coord("up", c.up)?,
         if fov.is_finite() { fov } else { f32::NAN },
         c.resolution[0],
         c.resolution[1],
@@ -220,8 +252,8 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
     match m.kind.as_str() {
         "diffuse" => {
             p.only("a diffuse material", &given, &["albedo", "specular_reflectance"])?;
-            let albedo = p.color("albedo", p.required("albedo", m.albedo)?, Some(1.0))?;
-            let specular = p.color("specular_reflectance", m.specular_reflectance.unwrap_or([0.0; 3]), Some(1.0))?;
+            let albedo = p.color("albedo", p.required("albedo", m.albedo)?, 1.0)?;
+            let specular = p.color("specular_reflectance", m.specular_reflectance.unwrap_or([0.0; 3]), 1.0)?;
             if (albedo + specular).max_element() > 1.0 + 1e-6 {
                 return Err(
                     p.error("albedo + specular_reflectance exceeds 1 in some channel (energy would be created)")
@@ -231,11 +263,11 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
         }
         "mirror" => {
             p.only("a mirror material", &given, &["reflectance"])?;
-            Ok(Material::Mirror { reflectance: p.color("reflectance", m.reflectance.unwrap_or([1.0; 3]), Some(1.0))? })
+            Ok(Material::Mirror { reflectance: p.color("reflectance", m.reflectance.unwrap_or([1.0; 3]), 1.0)? })
         }
         "glass" => {
             p.only("a glass material", &given, &["ior"])?;
-            Ok(Material::Glass { ior: p.positive("ior", m.ior.unwrap_or(1.5))? })
+            Ok(Material::Glass { ior: p.in_range("ior", m.ior.unwrap_or(1.5), limits::IOR)? })
         }
         other => Err(p.error(format!("unknown material type \"{other}\" (expected diffuse, mirror or glass)"))),
     }
@@ -250,6 +282,38 @@ struct GeometryBuilder {
 }
 
 impl GeometryBuilder {
+    /// Checks what `p`'s entry added since `start` (triangle and sphere counts):
+    /// every vertex and sphere bound within ±`MAX_COORD`, and every triangle
+    /// with a normal that 32-bit floats can normalise (a quad far from the
+    /// origin whose edges vanish beside its corner's magnitude has none).
+    fn check_since(&self, (tri_start, sphere_start): (usize, usize), p: &Place) -> Result<(), SceneError> {
+        let inside = |x: Vec3| x.is_finite() && x.abs().max_element() <= MAX_COORD;
+        for (t, _) in &self.triangles[tri_start..] {
+            if let Some(v) = t.v.iter().find(|&&v| !inside(v)) {
+                return Err(p.error(format!("a vertex at {v} lies beyond ±{MAX_COORD:e}")));
+            }
+            if t.geometric_normal().try_normalize().is_none() {
+                return Err(p.error(format!(
+                    "a triangle {:?} is too thin to have a normal in 32-bit floats (edges too small for its distance from the origin)",
+                    t.v
+                )));
+            }
+        }
+        for (s, _) in &self.spheres[sphere_start..] {
+            if !(inside(s.center - s.radius) && inside(s.center + s.radius)) {
+                return Err(p.error(format!(
+                    "the sphere (centre {}, radius {}) reaches beyond ±{MAX_COORD:e}",
+                    s.center, s.radius
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    fn counts(&self) -> (usize, usize) {
+        (self.triangles.len(), self.spheres.len())
+    }
+
     fn add_surface(&mut self, s: Surface) -> u32 {
         self.surfaces.push(s);
         self.surfaces.len() as u32 - 1
@@ -282,10 +346,7 @@ fn load_object(
         ("translate", o.translate.is_some()),
     ];
     let rotation = |deg: Option<f32>| -> Result<Mat3, SceneError> {
-        let deg = deg.unwrap_or(0.0);
-        if !deg.is_finite() {
-            return Err(p.error("`rotate_y` is not finite"));
-        }
+        let deg = p.in_range("rotate_y", deg.unwrap_or(0.0), (-MAX_COORD, MAX_COORD))?;
         Ok(Mat3::from_rotation_y(deg.to_radians()))
     };
     match (&o.mesh, o.shape.as_deref()) {
@@ -293,42 +354,52 @@ fn load_object(
         (None, None) => Err(p.error("missing `mesh` or `shape`")),
         (Some(mesh), None) => {
             p.only("a mesh object", &given, &["rotate_y", "scale", "translate"])?;
-            let scale = p.positive("scale", o.scale.unwrap_or(1.0))?;
-            let translate = p.vec3("translate", o.translate.unwrap_or([0.0; 3]))?;
+            let scale = p.in_range("scale", o.scale.unwrap_or(1.0), (MIN_LENGTH, MAX_COORD))?;
+            let translate = p.coord("translate", o.translate.unwrap_or([0.0; 3]))?;
             let rot = rotation(o.rotate_y)?;
             let path = base_dir.map_or_else(|| Path::new(mesh).to_path_buf(), |d| d.join(mesh));
+            let start = geo.triangles.len();
             for tri in load_obj(&path, p)? {
                 let v = tri.v.map(|x| rot * (x * scale) + translate);
                 let normals = tri.normals.map(|TriangleNormals(n)| TriangleNormals(n.map(|x| (rot * x).normalize())));
-                geo.triangles.push((Triangle { v, normals }, surface));
+                let tri = Triangle { v, normals };
+                // Scaling down can make a triangle degenerate: dropped, as in the file.
+                if has_normal(&tri) {
+                    geo.triangles.push((tri, surface));
+                }
+            }
+            if geo.triangles.len() == start {
+                return Err(p.error(format!("mesh {mesh} has no triangle left of non-zero area at scale {scale}")));
             }
             Ok(())
         }
         (None, Some("sphere")) => {
             p.only("a sphere", &given, &["center", "radius"])?;
-            let center = p.vec3("center", p.required("center", o.center)?)?;
-            let radius = p.positive("radius", p.required("radius", o.radius)?)?;
+            let center = p.coord("center", p.required("center", o.center)?)?;
+            let radius = p.length("radius", p.required("radius", o.radius)?)?;
             geo.spheres.push((Sphere { center, radius }, surface));
             Ok(())
         }
         (None, Some("quad")) => {
             p.only("a quad", &given, &["corner", "edge_u", "edge_v"])?;
-            let corner = p.vec3("corner", p.required("corner", o.corner)?)?;
-            let u = p.vec3("edge_u", p.required("edge_u", o.edge_u)?)?;
-            let v = p.vec3("edge_v", p.required("edge_v", o.edge_v)?)?;
-            if u.cross(v).length() <= 1e-12 {
-                return Err(p.error("quad has zero area (edge_u and edge_v are parallel or zero)"));
-            }
+            let corner = p.coord("corner", p.required("corner", o.corner)?)?;
+            let u = p.coord("edge_u", p.required("edge_u", o.edge_u)?)?;
+            let v = p.coord("edge_v", p.required("edge_v", o.edge_v)?)?;
+            quad_area(p, "quad", u, v)?;
             geo.add_quad(corner, u, v, surface);
             Ok(())
         }
         (None, Some("box")) => {
             p.only("a box", &given, &["center", "size", "rotate_y"])?;
-            let center = p.vec3("center", p.required("center", o.center)?)?;
-            let size = p.vec3("size", p.required("size", o.size)?)?;
-            if size.min_element() <= 0.0 {
-                return Err(p.error(format!("box `size` = {:?} must be positive", o.size.unwrap())));
+            let center = p.coord("center", p.required("center", o.center)?)?;
+            let size = p.required("size", o.size)?;
+            if !size.iter().all(|x| (MIN_LENGTH..=2.0 * MAX_COORD).contains(x)) {
+                return Err(p.error(format!(
+                    "box `size` = {size:?} must be positive, each side between {MIN_LENGTH:e} and {:e}",
+                    2.0 * MAX_COORD
+                )));
             }
+            let size = Vec3::from(size);
             let rot = rotation(o.rotate_y)?;
             add_box(geo, center, size * 0.5, rot, surface);
             Ok(())
@@ -350,47 +421,118 @@ fn add_box(geo: &mut GeometryBuilder, center: Vec3, h: Vec3, rot: Mat3, surface:
     }
 }
 
+/// A triangle that 32-bit floats can give a unit normal; others count as
+/// zero-area and are dropped.
+fn has_normal(t: &Triangle) -> bool {
+    t.geometric_normal().try_normalize().is_some()
+}
+
+/// Reads a Wavefront OBJ file into triangles (non-degenerate ones only), its
+/// vertex normals made unit. Positions and normals are checked line by line
+/// first, so that an error can name the OBJ line.
 fn load_obj(path: &Path, p: &Place) -> Result<Vec<Triangle>, SceneError> {
-    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let name = path.display();
     // Built-in scenes read their meshes from the copies embedded in the binary.
     let embedded = p.file.starts_with("builtin:").then(|| super::builtin::mesh(&path.to_string_lossy())).flatten();
-    let loaded = match embedded {
-        Some(text) => tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Err(tobj::LoadError::OpenFileFailed)),
-        None if !path.is_file() => return Err(p.error(format!("mesh file {} not found", path.display()))),
-        None => tobj::load_obj(path, &options),
+    let text = match embedded {
+        Some(text) => text.to_string(),
+        None if !path.is_file() => return Err(p.error(format!("mesh file {name} not found"))),
+        None => std::fs::read_to_string(path).map_err(|e| p.error(format!("cannot read mesh {name}: {e}")))?,
     };
-    let (models, _) = loaded.map_err(|e| p.error(format!("cannot read mesh {}: {e}", path.display())))?;
+    check_obj_lines(&text, &name.to_string(), p)?;
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    // The OBJ's own materials are ignored, so `mtllib` files are not opened.
+    let loaded = tobj::load_obj_buf(&mut text.as_bytes(), &options, |_| Err(tobj::LoadError::OpenFileFailed));
+    let (models, _) = loaded.map_err(|e| p.error(format!("cannot read mesh {name}: {e}")))?;
     let mut tris = Vec::new();
     for model in models {
         let m = &model.mesh;
-        let vertex = |i: u32| {
-            Vec3::new(m.positions[3 * i as usize], m.positions[3 * i as usize + 1], m.positions[3 * i as usize + 2])
-        };
+        let at = |values: &[f32], i: u32| Vec3::from_slice(&values[3 * i as usize..3 * i as usize + 3]);
         let has_normals = m.normals.len() == m.positions.len();
-        let normal =
-            |i: u32| Vec3::new(m.normals[3 * i as usize], m.normals[3 * i as usize + 1], m.normals[3 * i as usize + 2]);
         for idx in m.indices.chunks_exact(3) {
+            let idx = [idx[0], idx[1], idx[2]];
             if idx.iter().any(|&i| 3 * i as usize + 2 >= m.positions.len()) {
-                return Err(p.error(format!("mesh {} has a face with a vertex index out of range", path.display())));
+                return Err(p.error(format!("mesh {name} has a face with a vertex index out of range")));
             }
-            let v = [vertex(idx[0]), vertex(idx[1]), vertex(idx[2])];
-            if v.iter().any(|x| !x.is_finite()) {
-                return Err(p.error(format!("mesh {} has a non-finite vertex", path.display())));
+            let v = idx.map(|i| at(&m.positions, i));
+            // Checked line by line above; kept as a guard for what tobj makes of them.
+            if v.iter().any(|x| !x.is_finite() || x.abs().max_element() > MAX_COORD) {
+                return Err(p.error(format!("mesh {name} has a vertex that is not finite or beyond ±{MAX_COORD:e}")));
             }
-            let normals = has_normals.then(|| TriangleNormals([normal(idx[0]), normal(idx[1]), normal(idx[2])]));
+            let normals = match has_normals {
+                false => None,
+                true => {
+                    let n = idx.map(|i| at(&m.normals, i).try_normalize());
+                    let [Some(a), Some(b), Some(c)] = n else {
+                        return Err(p.error(format!("mesh {name} has a vertex normal that is zero or not finite")));
+                    };
+                    Some(TriangleNormals([a, b, c]))
+                }
+            };
             let tri = Triangle { v, normals };
-            if tri.area() > 0.0 {
+            if has_normal(&tri) {
                 tris.push(tri);
             }
         }
     }
     if tris.is_empty() {
-        return Err(p.error(format!("mesh {} has no triangles", path.display())));
+        return Err(p.error(format!("mesh {name} has no triangles")));
     }
     Ok(tris)
 }
 
+/// Checks every `v` (position) and `vn` (normal) line of an OBJ file:
+/// coordinates finite and within ±`MAX_COORD`, normals also not zero.
+fn check_obj_lines(text: &str, name: &str, p: &Place) -> Result<(), SceneError> {
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let kind = match words.next() {
+            Some("v") => "vertex",
+            Some("vn") => "vertex normal",
+            _ => continue,
+        };
+        let bad = |why: &str| p.error(format!("mesh {name}:{}: {kind} `{}` {why}", i + 1, line.trim()));
+        // Unparsable numbers are left to the OBJ reader, which reports them.
+        let xyz: Vec<f32> = words.take(3).filter_map(|w| w.parse().ok()).collect();
+        if xyz.iter().any(|x| !x.is_finite()) {
+            return Err(bad("is not finite"));
+        }
+        if xyz.iter().any(|x| x.abs() > MAX_COORD) {
+            return Err(bad(&format!("has a component beyond ±{MAX_COORD:e}")));
+        }
+        if kind == "vertex normal" && xyz.len() == 3 && Vec3::from_slice(&xyz).try_normalize().is_none() {
+            return Err(bad("is zero (or too short to normalise)"));
+        }
+    }
+    Ok(())
+}
+
+/// Rejects a quad whose area is (nearly) zero.
+fn quad_area(p: &Place, kind: &str, u: Vec3, v: Vec3) -> Result<(), SceneError> {
+    if u.cross(v).length() >= limits::MIN_QUAD_AREA {
+        Ok(())
+    } else {
+        Err(p.error(format!(
+            "{kind} has zero area (|edge_u × edge_v| below {:e}: the edges are parallel, zero or tiny)",
+            limits::MIN_QUAD_AREA
+        )))
+    }
+}
+
+/// A light, with its total power checked: finite and not (nearly) zero.
 fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
+    let light = light_from_desc(l, p)?;
+    let power = mean(light.power());
+    if !(power.is_finite() && power >= limits::MIN_LIGHT_POWER) {
+        return Err(p.error(format!(
+            "the light's total power {power:e} W is below {:e}: it would emit nothing",
+            limits::MIN_LIGHT_POWER
+        )));
+    }
+    Ok(light)
+}
+
+fn light_from_desc(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
     let given = [
         ("position", l.position.is_some()),
         ("intensity", l.intensity.is_some()),
@@ -411,8 +553,11 @@ fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
         "point" => {
             p.only("a point light", &given, &["position", "intensity"])?;
             Ok(Light::Point {
-                position: p.vec3("position", p.required("position", l.position)?)?,
-                intensity: nonzero("intensity", p.color("intensity", p.required("intensity", l.intensity)?, None)?)?,
+                position: p.coord("position", p.required("position", l.position)?)?,
+                intensity: nonzero(
+                    "intensity",
+                    p.color("intensity", p.required("intensity", l.intensity)?, MAX_EMISSION)?,
+                )?,
             })
         }
         "spot" => {
@@ -421,22 +566,19 @@ fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
                 &given,
                 &["position", "intensity", "direction", "cutoff_angle", "falloff_start_angle"],
             )?;
-            let axis = p.vec3("direction", p.required("direction", l.direction)?)?.normalize_or_zero();
-            if axis == Vec3::ZERO {
-                return Err(p.error("`direction` is zero"));
-            }
-            let cutoff = l.cutoff_angle.unwrap_or(20.0);
-            if !(cutoff > 0.0 && cutoff <= 90.0) {
-                return Err(p.error(format!("`cutoff_angle` = {cutoff} must be in (0, 90] degrees")));
-            }
+            let axis = p.direction("direction", p.required("direction", l.direction)?)?;
+            let cutoff = p.in_range("cutoff_angle", l.cutoff_angle.unwrap_or(20.0), limits::CUTOFF_ANGLE)?;
             let start = l.falloff_start_angle.unwrap_or(cutoff * 0.75);
             if !(start >= 0.0 && start <= cutoff) {
                 return Err(p.error(format!("`falloff_start_angle` = {start} must be in [0, cutoff_angle = {cutoff}]")));
             }
             Ok(Light::Spot {
-                position: p.vec3("position", p.required("position", l.position)?)?,
+                position: p.coord("position", p.required("position", l.position)?)?,
                 axis,
-                intensity: nonzero("intensity", p.color("intensity", p.required("intensity", l.intensity)?, None)?)?,
+                intensity: nonzero(
+                    "intensity",
+                    p.color("intensity", p.required("intensity", l.intensity)?, MAX_EMISSION)?,
+                )?,
                 cutoff: cutoff.to_radians(),
                 falloff_start: start.to_radians(),
             })
@@ -444,23 +586,21 @@ fn load_light(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
         "sphere" => {
             p.only("a sphere light", &given, &["center", "radius", "radiance"])?;
             Ok(Light::Sphere {
-                center: p.vec3("center", p.required("center", l.center)?)?,
-                radius: p.positive("radius", p.required("radius", l.radius)?)?,
-                radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, None)?)?,
+                center: p.coord("center", p.required("center", l.center)?)?,
+                radius: p.length("radius", p.required("radius", l.radius)?)?,
+                radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, MAX_EMISSION)?)?,
             })
         }
         "quad" => {
             p.only("a quad light", &given, &["corner", "edge_u", "edge_v", "radiance"])?;
-            let edge_u = p.vec3("edge_u", p.required("edge_u", l.edge_u)?)?;
-            let edge_v = p.vec3("edge_v", p.required("edge_v", l.edge_v)?)?;
-            if edge_u.cross(edge_v).length() <= 1e-12 {
-                return Err(p.error("quad light has zero area"));
-            }
+            let edge_u = p.coord("edge_u", p.required("edge_u", l.edge_u)?)?;
+            let edge_v = p.coord("edge_v", p.required("edge_v", l.edge_v)?)?;
+            quad_area(p, "quad light", edge_u, edge_v)?;
             Ok(Light::Quad {
-                corner: p.vec3("corner", p.required("corner", l.corner)?)?,
+                corner: p.coord("corner", p.required("corner", l.corner)?)?,
                 edge_u,
                 edge_v,
-                radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, None)?)?,
+                radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, MAX_EMISSION)?)?,
             })
         }
         other => Err(p.error(format!("unknown light type \"{other}\" (expected point, spot, sphere or quad)"))),
@@ -633,6 +773,176 @@ intensity = [1.0, 1.0, 1.0]
         let hg = |g: f32| format!("\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\nphase = \"hg\"\ng = {g}\n");
         let five: String = (0..5).map(|i| hg(i as f32 * 0.1)).collect();
         assert!(err(&format!("{BASE}{five}")).message.contains("phase functions"));
+    }
+
+    /// `BASE` with `from` replaced by `to`; the error must name the entry, its
+    /// line, and contain every word of `words`.
+    fn rejects(from: &str, to: &str, context: &str, words: &[&str]) {
+        assert!(BASE.contains(from), "{from}");
+        let e = err(&BASE.replace(from, to));
+        assert!(e.position.is_some() && e.context.starts_with(context), "{to}: {e}");
+        for w in words {
+            assert!(e.message.contains(w), "{to}: {e}");
+        }
+    }
+
+    const SPHERE: &str = "center = [0.0, 0.0, 0.0]\nradius = 1.0";
+    const POINT: &str = "position = [0.0, 2.0, 0.0]\nintensity = [1.0, 1.0, 1.0]";
+
+    fn quad(corner: &str, u: &str, v: &str) -> String {
+        format!("shape = \"quad\"\ncorner = {corner}\nedge_u = {u}\nedge_v = {v}\n")
+    }
+
+    #[test]
+    fn coordinates_beyond_a_million_are_rejected() {
+        let obj = "[[object]] #1";
+        rejects("center = [0.0, 0.0, 0.0]", "center = [2e6, 0.0, 0.0]", obj, &["center", "beyond"]);
+        rejects("center = [0.0, 0.0, 0.0]", "center = [0.0, 1e38, 0.0]", obj, &["beyond"]);
+        let sphere = format!("shape = \"sphere\"\n{SPHERE}");
+        let edge = quad("[0.0, 0.0, 0.0]", "[1.0, 0.0, 0.0]", "[1e30, 1e30, 1e30]");
+        rejects(&sphere, &edge, obj, &["edge_v", "beyond"]);
+        let corner = quad("[0.0, 1e38, 0.0]", "[1.0, 0.0, 0.0]", "[0.0, 0.0, 1.0]");
+        rejects(&sphere, &corner, obj, &["corner", "beyond"]);
+        rejects("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 0.0, -1e7]", "[camera]", &["look_at"]);
+        rejects("fov_y = 40.0", "fov_y = 40.0\nup = [0.0, 1e30, 0.0]", "[camera]", &["up"]);
+        rejects("position = [0.0, 2.0, 0.0]", "position = [0.0, 2e6, 0.0]", "[[light]] #1", &["position"]);
+    }
+
+    #[test]
+    fn derived_vertices_beyond_a_million_are_rejected() {
+        let sphere = format!("shape = \"sphere\"\n{SPHERE}");
+        let far = quad("[9e5, 0.0, 0.0]", "[9e5, 0.0, 0.0]", "[0.0, 0.0, 1.0]");
+        rejects(&sphere, &far, "[[object]] #1", &["vertex", "beyond"]);
+        rejects(SPHERE, "center = [999999.5, 0.0, 0.0]\nradius = 1.0", "[[object]] #1", &["sphere", "beyond"]);
+        let boxed = "shape = \"box\"\ncenter = [999999.0, 0.0, 0.0]\nsize = [4.0, 1.0, 1.0]\nrotate_y = 30.0";
+        rejects(&sphere, boxed, "[[object]] #1", &["vertex", "beyond"]);
+        let light = "type = \"sphere\"\ncenter = [0.0, 999999.9, 0.0]\nradius = 1.0\nradiance = [1.0, 1.0, 1.0]";
+        rejects(&format!("type = \"point\"\n{POINT}"), light, "[[light]] #1", &["beyond"]);
+    }
+
+    #[test]
+    fn quads_too_thin_for_their_position_are_rejected() {
+        let sphere = format!("shape = \"sphere\"\n{SPHERE}");
+        // |edge_u × edge_v| = 1e-10 passes the area test, but next to 5e5 the
+        // edges vanish in f32 (spacing 0.03) and the triangles have no normal.
+        let thin = quad("[5e5, 0.0, 0.0]", "[1e-5, 0.0, 0.0]", "[0.0, 1e-5, 0.0]");
+        rejects(&sphere, &thin, "[[object]] #1", &["too thin"]);
+        let tiny = quad("[0.0, 0.0, 0.0]", "[1e-7, 0.0, 0.0]", "[0.0, 1e-7, 0.0]");
+        rejects(&sphere, &tiny, "[[object]] #1", &["zero area"]);
+        let light = format!("type = \"quad\"\nradiance = [1.0, 1.0, 1.0]\n{}", thin.replace("shape = \"quad\"\n", ""));
+        rejects(&format!("type = \"point\"\n{POINT}"), &light, "[[light]] #1", &["too thin"]);
+    }
+
+    #[test]
+    fn lengths_and_factors_are_bounded() {
+        let obj = "[[object]] #1";
+        for bad in ["1e-7", "1e-20", "3e6", "0.0", "-1.0"] {
+            rejects("radius = 1.0", &format!("radius = {bad}"), obj, &["radius"]);
+        }
+        let boxed = |size: &str| format!("shape = \"box\"\ncenter = [0.0, 0.0, 0.0]\nsize = {size}");
+        let sphere = format!("shape = \"sphere\"\n{SPHERE}");
+        rejects(&sphere, &boxed("[1.0, 1e-7, 1.0]"), obj, &["size"]);
+        rejects(&sphere, &boxed("[1.0, 3e6, 1.0]"), obj, &["size"]);
+        let rotated = format!("{}\nrotate_y = 1e7", boxed("[1.0, 1.0, 1.0]"));
+        rejects(&sphere, &rotated, obj, &["rotate_y"]);
+        let glass = |ior: &str| format!("name = \"white\"\ntype = \"glass\"\nior = {ior}");
+        let white = "name = \"white\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]";
+        assert!(parse(&BASE.replace(white, &glass("1.5")), "t.toml", None).is_ok());
+        rejects(white, &glass("0.001"), "[[material]] #1", &["ior"]);
+        rejects(white, &glass("1000.0"), "[[material]] #1", &["ior"]);
+    }
+
+    #[test]
+    fn emission_and_light_power_are_bounded() {
+        let light = "[[light]] #1";
+        rejects("intensity = [1.0, 1.0, 1.0]", "intensity = [2e6, 1.0, 1.0]", light, &["intensity", "above"]);
+        let sphere_light = |radius: &str, radiance: &str| {
+            format!("type = \"sphere\"\ncenter = [0.0, 3.0, 0.0]\nradius = {radius}\nradiance = {radiance}")
+        };
+        let point = format!("type = \"point\"\n{POINT}");
+        rejects(&point, &sphere_light("1.0", "[1e7, 0.0, 0.0]"), light, &["radiance", "above"]);
+        rejects(&point, &sphere_light("1e-6", "[1e-30, 0.0, 0.0]"), light, &["power"]);
+        rejects("intensity = [1.0, 1.0, 1.0]", "intensity = [1e-30, 0.0, 0.0]", light, &["power"]);
+        let spot =
+            "type = \"spot\"\nposition = [0.0, 2.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\ndirection = [0.0, -1.0, 0.0]";
+        rejects(&point, &format!("{spot}\ncutoff_angle = 0.001"), light, &["cutoff_angle"]);
+        rejects(&point, &spot.replace("[0.0, -1.0, 0.0]", "[0.0, 0.0, 0.0]"), light, &["direction", "zero"]);
+        // A ramp thinner than f32 resolves still has a positive power.
+        let thin = format!("{spot}\ncutoff_angle = 20.0\nfalloff_start_angle = 19.999999");
+        let s = parse(&BASE.replace(&point, &thin), "test.toml", None).unwrap();
+        assert!(crate::material::mean(s.lights[0].power()) > 0.0);
+    }
+
+    #[test]
+    fn camera_field_of_view_and_resolution_are_located_errors() {
+        rejects("fov_y = 40.0", "fov_y = 0.001", "[camera]", &["fov_y"]);
+        rejects("fov_y = 40.0", "fov_y = 179.9", "[camera]", &["fov_y"]);
+        rejects("resolution = [16, 16]", "resolution = [100000, 100000]", "[camera]", &["at most 16384"]);
+        rejects("resolution = [16, 16]", "resolution = [16384, 16384]", "[camera]", &["pixels"]);
+        assert!(parse(&BASE.replace("[16, 16]", "[8192, 8192]"), "t.toml", None).is_ok());
+        // Beyond u32: the TOML reader's own located error.
+        let e = err(&BASE.replace("[16, 16]", "[16, 99999999999]"));
+        assert!(e.position.is_some(), "{e}");
+    }
+
+    #[test]
+    fn medium_coefficients_are_bounded() {
+        let fog = |sigma: &str| format!("{BASE}\n[[medium]]\nsigma_s = {sigma}\n");
+        for (sigma, words) in
+            [("[2e6, 0.0, 0.0]", "above"), ("[1e-9, 0.5, 0.5]", "below"), ("[1e-45, 0.0, 0.0]", "below")]
+        {
+            let e = err(&fog(sigma));
+            assert!(e.context == "[[medium]] #1" && e.message.contains(words) && e.position.is_some(), "{e}");
+        }
+        assert!(parse(&fog("[1e6, 0.0, 1e-6]"), "t.toml", None).is_ok());
+    }
+
+    /// Writes `files` into a fresh folder and loads `BASE` with its sphere
+    /// replaced by `object`.
+    fn with_files(tag: &str, files: &[(&str, &str)], object: &str) -> Result<Scene, SceneError> {
+        let dir = std::env::temp_dir().join(format!("hikari-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, text) in files {
+            std::fs::write(dir.join(name), text).unwrap();
+        }
+        let result = parse(&BASE.replace(&format!("shape = \"sphere\"\n{SPHERE}"), object), "test.toml", Some(&dir));
+        let _ = std::fs::remove_dir_all(&dir);
+        result
+    }
+
+    #[test]
+    fn obj_vertices_and_normals_are_checked_by_line() {
+        let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+        for (normals, words) in [
+            ("vn 0 0 1\nvn 0 0 0\nvn 0 0 1\n", ["m.obj:5", "vertex normal", "zero"]),
+            ("vn 0 0 1\nvn 0 0 1\nvn nan 0 1\n", ["m.obj:6", "vertex normal", "not finite"]),
+            ("vn 0 0 1\nvn 1e-30 0 0\nvn 0 0 1\n", ["m.obj:5", "vertex normal", "zero"]),
+        ] {
+            let obj = format!("{tri}{normals}f 1//1 2//2 3//3\n");
+            let e = with_files("vn", &[("m.obj", &obj)], "mesh = \"m.obj\"").err().unwrap();
+            assert!(e.position.is_some() && e.context == "[[object]] #1", "{e}");
+            assert!(words.iter().all(|w| e.message.contains(w)), "{e}");
+        }
+        for (v, words) in [("v 0 1e39 0", ["m.obj:3", "not finite"]), ("v 0 2e6 0", ["m.obj:3", "beyond"])] {
+            let obj = format!("v 0 0 0\nv 1 0 0\n{v}\nf 1 2 3\n");
+            let e = with_files("v", &[("m.obj", &obj)], "mesh = \"m.obj\"").err().unwrap();
+            assert!(words.iter().all(|w| e.message.contains(w)), "{e}");
+        }
+    }
+
+    #[test]
+    fn mesh_transforms_are_bounded() {
+        let obj = [("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")];
+        let e = with_files("scale", &obj, "mesh = \"m.obj\"\nscale = 1e7").err().unwrap();
+        assert!(e.message.contains("scale"), "{e}");
+        let e = with_files("far", &obj, "mesh = \"m.obj\"\nscale = 1e6\ntranslate = [1.0, 0.0, 0.0]").err().unwrap();
+        assert!(e.message.contains("beyond") && e.position.is_some(), "{e}");
+        let e = with_files("tx", &obj, "mesh = \"m.obj\"\ntranslate = [0.0, 0.0, 1e9]").err().unwrap();
+        assert!(e.message.contains("translate"), "{e}");
+        // Scaled so small that f32 gives its triangle no normal.
+        let small = [("m.obj", "v 0 0 0\nv 1e-15 0 0\nv 0 1e-15 0\nf 1 2 3\n")];
+        let e = with_files("small", &small, "mesh = \"m.obj\"\nscale = 1e-6").err().unwrap();
+        assert!(e.message.contains("no triangle"), "{e}");
     }
 
     #[test]

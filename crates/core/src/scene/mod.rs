@@ -4,6 +4,7 @@
 pub mod builtin;
 mod desc;
 mod error;
+pub mod limits;
 mod load;
 
 pub use error::SceneError;
