@@ -25,3 +25,10 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
 fi
 
 cargo test --workspace --locked "$@"
+
+# The GPU tests again on Mesa's OpenGL (llvmpipe through EGL): the storage
+# G-buffer, 16-bit splat sums and the media refusal (see README).
+WGPU_BACKEND=gl cargo test -p hikari-gpu --locked "$@"
+
+# A minute of the structured scene fuzzer (new mutants for every commit).
+bash scripts/fuzz-ci.sh

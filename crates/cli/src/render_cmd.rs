@@ -50,7 +50,8 @@ pub struct RenderArgs {
     /// Samples per pixel, 1 to 65536 [default: 4 for photon-cpu, 64 for path].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: Option<u32>,
-    /// Override the scene's resolution, e.g. 1280x720.
+    /// Override the scene's resolution, e.g. 1280x720 (each side 1 to 16384,
+    /// at most 8192x8192 pixels in all).
     #[arg(long, value_parser = parse_resolution)]
     pub resolution: Option<(u32, u32)>,
     /// Random seed: the same seed gives the same image whatever the thread count.
@@ -100,8 +101,12 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
     let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"));
     let (w, h) = (parse(w)?, parse(h)?);
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!("`{s}`: each side must be between 1 and 16384"));
+    use hikari_core::scene::limits::{MAX_PIXELS, MAX_SIDE};
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        return Err(format!("`{s}`: each side must be between 1 and {MAX_SIDE}"));
+    }
+    if w as u64 * h as u64 > MAX_PIXELS {
+        return Err(format!("`{s}`: at most {MAX_PIXELS} pixels (8192x8192)"));
     }
     Ok((w, h))
 }

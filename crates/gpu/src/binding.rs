@@ -39,15 +39,6 @@ pub fn texture(view_dimension: wgpu::TextureViewDimension) -> wgpu::BindingType 
     }
 }
 
-/// A depth texture array read with `textureLoad` (the shadow maps).
-pub fn depth_texture_array() -> wgpu::BindingType {
-    wgpu::BindingType::Texture {
-        sample_type: wgpu::TextureSampleType::Depth,
-        view_dimension: wgpu::TextureViewDimension::D2Array,
-        multisampled: false,
-    }
-}
-
 /// A write-only `Rgba32Float` storage texture.
 pub fn storage_texture_rgba32f() -> wgpu::BindingType {
     wgpu::BindingType::StorageTexture {
@@ -55,6 +46,16 @@ pub fn storage_texture_rgba32f() -> wgpu::BindingType {
         format: wgpu::TextureFormat::Rgba32Float,
         view_dimension: wgpu::TextureViewDimension::D2,
     }
+}
+
+/// Layers to allocate for a 2D array of `layers` layers of `width × height`.
+/// wgpu's OpenGL backend makes every square texture whose layers are a
+/// multiple of 6 a cube map (its heuristic, wgpu issues #1574 and #1614),
+/// and then renders nothing into its layers as 2D views (measured: the shadow
+/// maps of a point light stayed zero); one spare layer keeps it an array.
+pub fn array_layers(width: u32, height: u32, layers: u32) -> u32 {
+    let layers = layers.max(1);
+    if width == height && layers % 6 == 0 { layers + 1 } else { layers }
 }
 
 /// The layout of a pipeline with one bind group (every pass has one).
@@ -133,4 +134,16 @@ pub fn color_pass<'a>(
         occlusion_query_set: None,
         multiview_mask: None,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn array_textures_are_never_cube_compatible() {
+        assert_eq!(super::array_layers(64, 64, 6), 7);
+        assert_eq!(super::array_layers(64, 64, 12), 13);
+        assert_eq!(super::array_layers(64, 32, 6), 6);
+        assert_eq!(super::array_layers(64, 64, 8), 8);
+        assert_eq!(super::array_layers(64, 64, 0), 1);
+    }
 }

@@ -11,12 +11,10 @@ use wgpu::{DownlevelFlags, TextureFormat, TextureFormatFeatureFlags as F, Textur
 
 /// Formats and what each must support.
 pub const FORMATS: [(TextureFormat, U, &str); 2] = [
-    // G-buffer targets, the specular pass's storage output, read by textureLoad.
-    (
-        TextureFormat::Rgba32Float,
-        U::RENDER_ATTACHMENT.union(U::TEXTURE_BINDING).union(U::STORAGE_BINDING),
-        "G-buffer targets and compute outputs",
-    ),
+    // The G-buffer, the specular and resolve outputs: written as render
+    // targets or storage textures, read by textureLoad. (Rendering to it is
+    // optional: see `Capabilities::gbuffer_storage`.)
+    (TextureFormat::Rgba32Float, U::TEXTURE_BINDING.union(U::STORAGE_BINDING), "G-buffer and compute outputs"),
     // Depth tests, and shadow distances written as depth and loaded later.
     (TextureFormat::Depth32Float, U::RENDER_ATTACHMENT.union(U::TEXTURE_BINDING), "depth and shadow maps"),
 ];
@@ -93,7 +91,16 @@ pub struct Capabilities {
     pub float16_blend: bool,
     /// GPU timestamps can be written between passes.
     pub timestamps: bool,
+    /// Rgba32Float is not renderable (Mesa's OpenGL), so the G-buffer is
+    /// stored from the fragment shader after a depth pre-pass.
+    pub gbuffer_storage: bool,
+    /// R32Float is renderable: shadow maps use it (else R16Float).
+    pub r32_renderable: bool,
 }
+
+/// What the storage G-buffer needs beyond the common requirements.
+const STORAGE_GBUFFER_FEATURES: wgpu::Features =
+    wgpu::Features::CLEAR_TEXTURE.union(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
 
 impl Capabilities {
     /// The adapter's fit, or every missing requirement in one line.
@@ -112,6 +119,29 @@ impl Capabilities {
             }
         }
         missing.extend(limit_shortfalls(&adapter.limits(), &required_limits()));
+        let renders_float32 = adapter
+            .get_texture_format_features(TextureFormat::Rgba32Float)
+            .allowed_usages
+            .contains(U::RENDER_ATTACHMENT);
+        let gbuffer_storage = !renders_float32;
+        let renderable =
+            |format| adapter.get_texture_format_features(format).allowed_usages.contains(U::RENDER_ATTACHMENT);
+        let r32_renderable = renderable(TextureFormat::R32Float);
+        if !r32_renderable && !renderable(TextureFormat::R16Float) {
+            missing.push("a renderable R32Float or R16Float (shadow maps)".into());
+        }
+        if gbuffer_storage {
+            let why = "Rgba32Float render targets, or instead";
+            if !adapter.features().contains(STORAGE_GBUFFER_FEATURES) {
+                missing.push(format!("{why} {:?}", STORAGE_GBUFFER_FEATURES.difference(adapter.features())));
+            }
+            if !downlevel.flags.contains(DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) {
+                missing.push(format!("{why} storage writes in fragment shaders"));
+            }
+            if adapter.limits().max_storage_textures_per_shader_stage < 4 {
+                missing.push(format!("{why} 4 storage textures per stage"));
+            }
+        }
         let blendable = |format| {
             let f = adapter.get_texture_format_features(format);
             f.allowed_usages.contains(U::RENDER_ATTACHMENT) && f.flags.contains(F::BLENDABLE)
@@ -126,7 +156,7 @@ impl Capabilities {
             return Err(format!("lacks {}", missing.join("; ")));
         }
         let timestamps = adapter.features().contains(timestamp_features());
-        Ok(Capabilities { float32_blend, float16_blend, timestamps })
+        Ok(Capabilities { float32_blend, float16_blend, timestamps, gbuffer_storage, r32_renderable })
     }
 
     /// The features to request for a device.
@@ -137,6 +167,9 @@ impl Capabilities {
         }
         if self.timestamps {
             features |= timestamp_features();
+        }
+        if self.gbuffer_storage {
+            features |= STORAGE_GBUFFER_FEATURES;
         }
         features
     }

@@ -24,6 +24,9 @@ pub enum GpuError {
     /// The scene or the settings need more than the adapter offers.
     #[error("{0}")]
     TooLarge(String),
+    /// The adapter lacks what this scene needs (see `GpuRenderer::unsupported`).
+    #[error("{0}")]
+    SceneUnsupported(String),
     /// A shader would run past the adapter's loop budget even split up.
     #[error("{0}")]
     LoopBudget(String),
@@ -32,6 +35,8 @@ pub enum GpuError {
 /// The first error the device reported outside an error scope, or its loss.
 type Fault = Arc<Mutex<Option<String>>>;
 
+/// Clones share the device (and its recorded faults).
+#[derive(Clone)]
 pub struct GpuContext {
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
@@ -43,6 +48,10 @@ pub struct GpuContext {
     pub float32_blend: bool,
     /// GPU timestamps can be written between passes (per-pass timings).
     pub timestamps: bool,
+    /// R32Float can be rendered (else shadow maps are R16Float).
+    pub r32_renderable: bool,
+    /// The G-buffer is stored from fragment shaders (`Capabilities::gbuffer_storage`).
+    pub gbuffer_storage: bool,
     /// Loop iterations one shader invocation may run (`capabilities::loop_budget`).
     pub loop_budget: u32,
     /// Longest wait for submitted work before giving up.
@@ -111,6 +120,8 @@ impl GpuContext {
             radiance_format: caps.radiance_format(),
             float32_blend: caps.float32_blend,
             timestamps: caps.timestamps,
+            gbuffer_storage: caps.gbuffer_storage,
+            r32_renderable: caps.r32_renderable,
             wait_timeout: WAIT_TIMEOUT,
             fault,
         })

@@ -169,6 +169,17 @@ fn depth_range(scene: &Scene) -> (f32, f32) {
 }
 
 impl GpuRenderer {
+    /// Why `ctx` cannot draw `scene` correctly, if so. Media need 32-bit
+    /// float blending: the volume splat adds thousands of small in-scattered
+    /// terms per pixel and the optical-depth pass adds and subtracts region
+    /// crossings, and 16-bit sums lose both (measured on Mesa's GL: slab
+    /// optical depths off by 8e-4 where they are 0, fog frames off by more
+    /// than 2%).
+    pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
+        (!ctx.float32_blend && !scene.media.is_empty())
+            .then(|| format!("participating media need 32-bit float blending, which {} lacks", ctx.describe()))
+    }
+
     /// What a frame of `scene` with `settings` allocates, for `photons`
     /// stored in the global, caustic and volume maps (known, or estimated
     /// before tracing).
@@ -196,6 +207,9 @@ impl GpuRenderer {
         settings: &GpuSettings,
         photons: [u64; 3],
     ) -> Result<(), GpuError> {
+        if let Some(why) = Self::unsupported(ctx, scene) {
+            return Err(GpuError::SceneUnsupported(why));
+        }
         Self::frame_size(scene, settings, photons).check(ctx)?;
         let lights = GpuLights::new(scene, settings.area_light_samples);
         let iterations = crate::direct::loop_iterations(&lights, GpuMedia::region_triangle_count(scene));
@@ -243,11 +257,11 @@ impl GpuRenderer {
                 view_formats: &[],
             })
         };
-        let shadow_pass = ShadowPass::new(device);
+        let shadow_pass = ShadowPass::new(device, crate::shadow::map_format(ctx.r32_renderable));
         let lod_pass = LodPass::new(device);
         let lights = GpuLights::new(scene, settings.area_light_samples);
         let targets = FrameTargets {
-            gbuffer: GBuffer::new(device, w, h),
+            gbuffer: GBuffer::new(device, w, h, ctx.gbuffer_storage),
             direct: radiance_target("direct radiance"),
             indirect: radiance_target("indirect radiance"),
             caustic: radiance_target("caustic radiance"),
@@ -306,7 +320,7 @@ impl GpuRenderer {
         GpuRenderer {
             resolve_pass,
             specular_pass,
-            gbuffer_pass: GBufferPass::new(device),
+            gbuffer_pass: GBufferPass::new(device, ctx.gbuffer_storage),
             splat_pass: SplatPass::new(device, ctx.radiance_format),
             direct_pass: DirectPass::new(device, ctx.radiance_format),
             shadow_pass,
@@ -536,7 +550,9 @@ impl GpuRenderer {
 
     /// The regions' optical-depth slices, layer by layer.
     pub fn read_slices(&self) -> Result<Vec<Vec<Vec4>>, GpuError> {
-        crate::readback::read_rgba_layers(&self.ctx, &self.media.slices)
+        let mut layers = crate::readback::read_rgba_layers(&self.ctx, &self.media.slices)?;
+        layers.truncate(self.media.params.slices.max(1) as usize);
+        Ok(layers)
     }
 
     /// The media parameters the passes see.

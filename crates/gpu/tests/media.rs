@@ -7,7 +7,7 @@ use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
-use hikari_gpu::test_support::test_context;
+use hikari_gpu::test_support::media_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 use std::path::Path;
 
@@ -84,9 +84,9 @@ fn slab_length(eye: Vec3, dir: Vec3, l: f32, z0: f32, z1: f32) -> f32 {
 #[test]
 fn optical_depth_pass_matches_slabs() {
     for (eye_z, label) in [(3.0, "eye outside"), (0.0, "eye inside a region")] {
-        let ctx = test_context("optical depth");
         let dir = std::env::temp_dir().join(format!("hikari-slabs-{}-{}", std::process::id(), label.len()));
         let scene = slab_scene(&dir, eye_z);
+        let Some(ctx) = media_context("optical depth", &scene) else { return };
         let traced = trace_photons(&scene, &TraceSettings { photons: 1000, seed: 1, ..Default::default() }, &Silent);
         let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
         let gpu = GpuRenderer::new(
@@ -134,7 +134,7 @@ struct Twin {
 /// the same photons, radius and transmittance: exact for media filling the
 /// scene, the same slice interpolation for regions.
 fn volume_twin(scene: &Scene, traced: &TracedPhotons, slices: u32) -> Option<Twin> {
-    let ctx = test_context("volume twin");
+    let ctx = media_context("volume twin", scene)?;
     let cpu = PhotonCpuRenderer::new(scene, traced, &PhotonCpuSettings::default());
     let settings = GpuSettings {
         volume_radius: cpu.volume_radius,
@@ -217,7 +217,7 @@ fn volume_splat_equals_cpu_twin_with_regions() {
 fn whole_frame_matches_photon_cpu(name: &str) {
     let mut scene = Scene::load(name).unwrap();
     scene.camera = scene.camera.with_resolution(64, 48).unwrap();
-    let ctx = test_context("media frame");
+    let Some(ctx) = media_context("media frame", &scene) else { return };
     let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, seed: 13, ..Default::default() }, &Silent);
     let cpu_settings = PhotonCpuSettings { spp: 4, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
@@ -295,7 +295,7 @@ fn specular_in_fog_matches_photon_cpu(layered: bool) {
     // (The layered fog's region transmittance loops over its triangles per photon.)
     let photons: u64 = if layered { 250 } else { 800 };
     let scene = fog_with_specular(layered);
-    let ctx = test_context("specular in fog");
+    let Some(ctx) = media_context("specular in fog", &scene) else { return };
     // Few photons: lavapipe runs at most 65,535 loop iterations per shader
     // invocation (then every loop stops after one pass), and a pixel that
     // sees glass gathers along many segments.

@@ -13,8 +13,10 @@ use hikari_gpu::{GpuRenderer, GpuSettings};
 
 struct TwinStats {
     lit: usize,
-    within_1e4: usize,
+    /// Pixels within `tolerance` (relative) of the CPU.
+    within: usize,
     worst: f32,
+    tolerance: f32,
 }
 
 fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
@@ -25,6 +27,11 @@ fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats,
 
 fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
     let ctx = test_context("twin");
+    // Splats add in the radiance format: f32, or f16 where the adapter
+    // cannot blend f32 (Mesa's GL), whose running sums round to 2^-11 at
+    // every add (measured there: worst pixel 1.6% on cornell-box, 3.2% on
+    // cornell-caustic, at 20,000 photons).
+    let tolerance = if ctx.float32_blend { 1e-4 } else { 1e-2 };
     let traced = trace_photons(&scene, &TraceSettings { photons, seed: 11, ..Default::default() }, &Silent);
     let cpu_settings = PhotonCpuSettings { normal_test, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
@@ -39,7 +46,7 @@ fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStat
     let caustic = gpu.read(&t.caustic).unwrap();
 
     let compare = |gpu_image: &[glam::Vec4], map, params: &FixedRadius| {
-        let mut stats = TwinStats { lit: 0, within_1e4: 0, worst: 0.0 };
+        let mut stats = TwinStats { lit: 0, within: 0, worst: 0.0, tolerance };
         for i in 0..position.len() {
             if position[i].w == 0.0 || albedo[i].w != 0.0 {
                 continue; // no surface, or not diffuse
@@ -59,7 +66,7 @@ fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStat
             stats.lit += 1;
             let err = ((got - want).abs() / want.max(Vec3::splat(1e-30))).max_element();
             let err = if want.max_element() == 0.0 { f32::INFINITY } else { err };
-            stats.within_1e4 += (err < 1e-4) as usize;
+            stats.within += (err < tolerance) as usize;
             stats.worst = stats.worst.max(err);
         }
         stats
@@ -72,17 +79,19 @@ fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStat
 
 fn assert_twin(name: &str, stats: &TwinStats, min_lit: usize) {
     eprintln!(
-        "{name}: {} lit pixels, {} within 1e-4, worst relative error {:e}",
-        stats.lit, stats.within_1e4, stats.worst
+        "{name}: {} lit pixels, {} within {:e}, worst relative error {:e}",
+        stats.lit, stats.within, stats.tolerance, stats.worst
     );
     assert!(stats.lit >= min_lit, "{name}: only {} lit pixels", stats.lit);
     assert!(
-        stats.within_1e4 as f64 >= 0.999 * stats.lit as f64,
-        "{name}: {} of {} within 1e-4",
-        stats.within_1e4,
-        stats.lit
+        stats.within as f64 >= if stats.tolerance < 1e-3 { 0.999 } else { 0.95 } * stats.lit as f64,
+        "{name}: {} of {} within {}",
+        stats.within,
+        stats.lit,
+        stats.tolerance
     );
-    assert!(stats.worst < 1e-2, "{name}: worst relative error {}", stats.worst);
+    let worst = if stats.tolerance < 1e-3 { 1e-2 } else { 5e-2 };
+    assert!(stats.worst < worst, "{name}: worst relative error {}", stats.worst);
 }
 
 #[test]

@@ -5,7 +5,7 @@
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var<storage, read> samples: array<LightSample>;
 @group(0) @binding(3) var<storage, read> views: array<ShadowView>;
-@group(0) @binding(4) var shadow_maps: texture_depth_2d_array;
+@group(0) @binding(4) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(5) var gbuffer_position: texture_2d<f32>;
 @group(0) @binding(6) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(7) var gbuffer_albedo: texture_2d<f32>;

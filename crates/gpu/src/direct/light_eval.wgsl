@@ -131,7 +131,7 @@ fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
     let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
     let size = i32(direct_params.shadow_size);
     let texel_index = clamp(vec2<i32>(uv * f32(size)), vec2<i32>(0), vec2<i32>(size - 1));
-    let stored = textureLoad(shadow_maps, texel_index, i32(layer), 0) * views[layer].light_position.w;
+    let stored = textureLoad(shadow_maps, texel_index, i32(layer), 0).r * views[layer].light_position.w;
     return distance(xs, s.position) <= stored * (1.0 + direct_params.bias);
 }
 

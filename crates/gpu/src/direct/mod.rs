@@ -58,7 +58,7 @@ impl DirectPass {
                 entry(1, storage(true)),
                 entry(2, storage(true)),
                 entry(3, storage(true)),
-                entry(4, crate::binding::depth_texture_array()),
+                entry(4, texture(wgpu::TextureViewDimension::D2Array)),
                 entry(5, texture(D2)),
                 entry(6, texture(D2)),
                 entry(7, texture(D2)),

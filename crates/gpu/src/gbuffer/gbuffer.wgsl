@@ -27,7 +27,8 @@ struct VertexIn {
 }
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the storage path's two draws must give the same depths.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
@@ -58,6 +59,11 @@ struct GBufferOut {
 
 @fragment
 fn fs_main(in: VertexOut) -> GBufferOut {
+    return shade(in);
+}
+
+// What a pixel stores (fs_main's outputs; gbuffer_storage.wgsl stores the same).
+fn shade(in: VertexOut) -> GBufferOut {
     let surface = surfaces[in.surface];
     let view = in.world - params.camera_position;
     let front = dot(in.geometric_normal, view) < 0.0;

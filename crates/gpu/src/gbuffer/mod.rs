@@ -18,6 +18,11 @@ pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const SHADER: &str = include_str!("gbuffer.wgsl");
 
+/// gbuffer.wgsl with the storage path's fragment entry point.
+pub fn storage_shader_source() -> String {
+    format!("{SHADER}\n{}", include_str!("gbuffer_storage.wgsl"))
+}
+
 /// `GpuVertex` as vertex attributes, offsets written by hand (a test checks
 /// them against the struct).
 pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 4] = [
@@ -39,7 +44,11 @@ pub struct GBuffer {
 }
 
 impl GBuffer {
-    pub fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+    /// With `storage`, the targets are written as storage textures
+    /// (`GBufferPass` on adapters that cannot render to Rgba32Float).
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, storage: bool) -> Self {
+        let written_as =
+            if storage { wgpu::TextureUsages::STORAGE_BINDING } else { wgpu::TextureUsages::RENDER_ATTACHMENT };
         let target = |label| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -48,9 +57,7 @@ impl GBuffer {
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
                 format: TARGET_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING
-                    | wgpu::TextureUsages::COPY_SRC,
+                usage: written_as | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             })
         };
@@ -77,52 +84,84 @@ impl GBuffer {
 }
 
 pub struct GBufferPass {
-    pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    mode: Mode,
+}
+
+/// How the G-buffer is written.
+enum Mode {
+    /// Four Rgba32Float colour targets.
+    Targets(wgpu::RenderPipeline),
+    /// A depth-only draw, then a draw whose nearest fragments store into
+    /// storage textures (gbuffer_storage.wgsl).
+    Storage { depth: wgpu::RenderPipeline, store: wgpu::RenderPipeline },
 }
 
 impl GBufferPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// With `storage`, the storage path (`GpuContext::gbuffer_storage`).
+    pub fn new(device: &wgpu::Device, storage: bool) -> Self {
+        let source = if storage { storage_shader_source() } else { SHADER.to_string() };
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gbuffer.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("gbuffer"),
-            entries: &[
-                crate::binding::entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, crate::binding::uniform()),
-                crate::binding::entry(1, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
-            ],
-        });
+        let mut entries = vec![
+            crate::binding::entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, crate::binding::uniform()),
+            crate::binding::entry(1, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
+        ];
+        if storage {
+            entries.extend((2..6).map(|b| {
+                crate::binding::entry(b, wgpu::ShaderStages::FRAGMENT, crate::binding::storage_texture_rgba32f())
+            }));
+        }
+        let layout = device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("gbuffer"), entries: &entries });
         let pipeline_layout = crate::binding::pipeline_layout(device, "gbuffer", &layout);
-        let target =
-            Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("gbuffer"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<GpuVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &VERTEX_ATTRIBUTES,
-                })],
-            },
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(crate::binding::nearest_depth(DEPTH_FORMAT)),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[target.clone(), target.clone(), target.clone(), target],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        GBufferPass { pipeline, layout }
+        let pipeline = |label: &str, fragment: Option<(&str, &[Option<wgpu::ColorTargetState>])>, depth| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<GpuVertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &VERTEX_ATTRIBUTES,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: Some(depth),
+                multisample: Default::default(),
+                fragment: fragment.map(|(entry_point, targets)| wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry_point),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let nearest = crate::binding::nearest_depth(DEPTH_FORMAT);
+        let mode = if storage {
+            let equal = wgpu::DepthStencilState {
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::Equal),
+                ..nearest.clone()
+            };
+            Mode::Storage {
+                depth: pipeline("gbuffer depth", None, nearest),
+                store: pipeline("gbuffer store", Some(("fs_storage", &[])), equal),
+            }
+        } else {
+            let target =
+                Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
+            let targets = [target.clone(), target.clone(), target.clone(), target];
+            Mode::Targets(pipeline("gbuffer", Some(("fs_main", &targets)), nearest))
+        };
+        GBufferPass { layout, mode }
     }
 
     pub fn record(
@@ -138,48 +177,72 @@ impl GBufferPass {
             contents: bytemuck::bytes_of(params),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gbuffer"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: scene.surfaces.as_entire_binding() },
-            ],
-        });
         let views: Vec<wgpu::TextureView> = [&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission]
             .iter()
             .map(|t| t.create_view(&Default::default()))
             .collect();
-        let depth_view = gbuffer.depth.create_view(&Default::default());
-        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
-            .iter()
-            .map(|view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            })
-            .collect();
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 1, resource: scene.surfaces.as_entire_binding() },
+        ];
+        if matches!(self.mode, Mode::Storage { .. }) {
+            entries.extend(views.iter().enumerate().map(|(i, view)| wgpu::BindGroupEntry {
+                binding: 2 + i as u32,
+                resource: wgpu::BindingResource::TextureView(view),
+            }));
+        }
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer"),
-            color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
+            layout: &self.layout,
+            entries: &entries,
         });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.set_vertex_buffer(0, scene.vertices.slice(..));
-        pass.draw(0..scene.vertex_count, 0..1);
+        let depth_view = gbuffer.depth.create_view(&Default::default());
+        let draw = |encoder: &mut wgpu::CommandEncoder,
+                    pipeline: &wgpu::RenderPipeline,
+                    color: &[Option<wgpu::RenderPassColorAttachment>],
+                    depth_load: wgpu::LoadOp<f32>| {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gbuffer"),
+                color_attachments: color,
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_vertex_buffer(0, scene.vertices.slice(..));
+            pass.draw(0..scene.vertex_count, 0..1);
+        };
+        match &self.mode {
+            Mode::Targets(pipeline) => {
+                let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
+                    .iter()
+                    .map(|view| {
+                        Some(wgpu::RenderPassColorAttachment {
+                            view,
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })
+                    })
+                    .collect();
+                draw(encoder, pipeline, &attachments, wgpu::LoadOp::Clear(1.0));
+            }
+            Mode::Storage { depth, store } => {
+                for texture in [&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission] {
+                    encoder.clear_texture(texture, &Default::default());
+                }
+                draw(encoder, depth, &[], wgpu::LoadOp::Clear(1.0));
+                draw(encoder, store, &[], wgpu::LoadOp::Load);
+            }
+        }
     }
 }

@@ -157,7 +157,7 @@ impl GpuMedia {
             size: wgpu::Extent3d {
                 width: gbuffer.width,
                 height: gbuffer.height,
-                depth_or_array_layers: params.slices.max(1),
+                depth_or_array_layers: crate::binding::array_layers(gbuffer.width, gbuffer.height, params.slices),
             },
             mip_level_count: 1,
             sample_count: 1,

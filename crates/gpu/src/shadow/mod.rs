@@ -1,12 +1,13 @@
 //! The shadow pass: renders, for every light sample, the distance to the
-//! nearest surface into layers of one depth texture array (a cube of six
+//! nearest surface into layers of one float texture array (a cube of six
 //! layers for point and area samples, one layer for narrow spots).
 //!
-//! The distance is written as the fragment's depth, divided by the view's
-//! `range` (stored in `light_position.w`), so the depth test itself keeps
-//! the nearest surface and no float colour target is needed: OpenGL ES
-//! adapters without `EXT_color_buffer_float` cannot render to `R32Float`,
-//! and every adapter can render and load `Depth32Float`.
+//! The distance is stored divided by the view's `range` (in
+//! `light_position.w`), so it lies in [0, 1]: then `R16Float`, which
+//! adapters that cannot render `R32Float` (Mesa's OpenGL) use instead, keeps
+//! it to 2^-11 relative, well inside the shadow bias (1%). Depth textures
+//! would avoid the colour target, but GLSL can neither `textureLoad` them
+//! nor (on llvmpipe's GL, measured) compare them.
 
 pub mod light_samples;
 
@@ -18,7 +19,10 @@ use light_samples::ShadowView;
 use wgpu::util::DeviceExt;
 
 pub const SHADER: &str = include_str!("shadow.wgsl");
-pub const MAP_FORMAT: wgpu::TextureFormat = DEPTH_FORMAT;
+/// The shadow-map format: `R32Float` where it is renderable, else `R16Float`.
+pub fn map_format(r32_renderable: bool) -> wgpu::TextureFormat {
+    if r32_renderable { wgpu::TextureFormat::R32Float } else { wgpu::TextureFormat::R16Float }
+}
 
 /// Mirrors `ShadowViewParams` in shadow.wgsl and `ShadowView` in direct.wgsl.
 #[repr(C)]
@@ -50,8 +54,9 @@ pub fn shadow_range(from: Vec3, lo: Vec3, hi: Vec3) -> f32 {
 pub struct ShadowMaps {
     pub size: u32,
     pub layers: u32,
-    /// `Depth32Float` layers: distance to the nearest surface / range.
+    /// Distance to the nearest surface / range, one layer per view.
     pub texture: wgpu::Texture,
+    depth: wgpu::Texture,
     view_bind_groups: Vec<wgpu::BindGroup>,
     /// All views, for the direct pass's lookups.
     pub views_buffer: wgpu::Buffer,
@@ -60,10 +65,12 @@ pub struct ShadowMaps {
 pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    format: wgpu::TextureFormat,
 }
 
 impl ShadowPass {
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// Maps in `format` (`map_format`).
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow.wgsl"),
             source: wgpu::ShaderSource::Wgsl(SHADER.into()),
@@ -93,12 +100,12 @@ impl ShadowPass {
                 module: &module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[],
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
             }),
             multiview_mask: None,
             cache: None,
         });
-        ShadowPass { pipeline, layout }
+        ShadowPass { pipeline, layout, format }
     }
 
     /// One layer per view of `views`, each `size²`, for a scene within `bounds`.
@@ -112,12 +119,26 @@ impl ShadowPass {
         let layers = views.len().max(1) as u32;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
-            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+            size: wgpu::Extent3d {
+                width: size,
+                height: size,
+                depth_or_array_layers: crate::binding::array_layers(size, size, layers),
+            },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: MAP_FORMAT,
+            format: self.format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow depth"),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
             view_formats: &[],
         });
         let params: Vec<ShadowViewParams> = views.iter().map(|v| ShadowViewParams::new(v, bounds)).collect();
@@ -142,11 +163,12 @@ impl ShadowPass {
             contents: bytemuck::cast_slice(if params.is_empty() { &zero[..] } else { &params }),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        ShadowMaps { size, layers, texture, view_bind_groups, views_buffer }
+        ShadowMaps { size, layers, texture, depth, view_bind_groups, views_buffer }
     }
 
     /// Renders every shadow view of `maps`.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, scene: &SceneBuffers, maps: &ShadowMaps) {
+        let depth_view = maps.depth.create_view(&Default::default());
         for (layer, bind_group) in maps.view_bind_groups.iter().enumerate() {
             let target = maps.texture.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
@@ -156,11 +178,19 @@ impl ShadowPass {
             });
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow view"),
-                color_attachments: &[],
-                // Texels that see nothing hold the whole range: lit.
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &target,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                    depth_slice: None,
+                    resolve_target: None,
+                    // Texels that see nothing hold the whole range: lit.
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color { r: 1.0, g: 0.0, b: 0.0, a: 0.0 }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Discard }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,

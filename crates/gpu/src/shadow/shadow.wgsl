@@ -1,7 +1,6 @@
 // Shadow views: each layer of the shadow-map array stores, per texel, the
 // distance from the light sample to the nearest surface seen through it,
-// as the depth `distance / range` (range in light_position.w), so the
-// depth test keeps the nearest surface.
+// divided by the view's range (light_position.w) so it fits in [0, 1].
 
 struct ShadowViewParams {
     clip_from_world: mat4x4<f32>,
@@ -24,6 +23,6 @@ fn vs_main(@location(0) position: vec3<f32>) -> VertexOut {
 }
 
 @fragment
-fn fs_main(in: VertexOut) -> @builtin(frag_depth) f32 {
-    return min(distance(in.world, view.light_position.xyz) / view.light_position.w, 1.0);
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(distance(in.world, view.light_position.xyz) / view.light_position.w, 0.0, 0.0, 0.0);
 }

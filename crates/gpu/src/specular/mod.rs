@@ -167,7 +167,7 @@ impl SpecularPass {
                 entry(7, storage(true)),
                 entry(8, storage(true)),
                 entry(9, storage(true)),
-                entry(10, crate::binding::depth_texture_array()),
+                entry(10, texture(D2Array)),
                 entry(11, texture(D2)),
                 entry(12, storage_texture_rgba32f()),
                 entry(13, uniform()),

@@ -84,7 +84,7 @@ struct Surface {
 @group(0) @binding(7) var<storage, read> lights: array<Light>;
 @group(0) @binding(8) var<storage, read> samples: array<LightSample>;
 @group(0) @binding(9) var<storage, read> views: array<ShadowView>;
-@group(0) @binding(10) var shadow_maps: texture_depth_2d_array;
+@group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(13) var<uniform> media: MediaParams;
