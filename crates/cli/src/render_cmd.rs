@@ -63,7 +63,8 @@ pub struct RenderArgs {
     /// Exposure in stops applied before PNG tone mapping (-64 to 64).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
-    /// Shadow-map side in texels for each shadow view (gpu).
+    /// Shadow-map side in texels for each shadow view, 16 to 8192 (gpu; the
+    /// views' total memory is checked against the adapter before tracing).
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=8192))]
     pub shadow_map_size: u32,
     /// Samples per area light, 1 to 256: shadow rays per shaded point
@@ -75,7 +76,7 @@ pub struct RenderArgs {
     /// diagonals [default: 3% of the scene diagonal].
     #[arg(long, allow_negative_numbers = true)]
     pub volume_radius: Option<f32>,
-    /// Optical-depth slices along each view ray through region media (gpu).
+    /// Optical-depth slices along each view ray through region media, 1 to 64 (gpu).
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=64))]
     pub volume_slices: u32,
     /// Count only photons that arrived from the side the surface faces the
@@ -89,7 +90,7 @@ pub struct RenderArgs {
     /// LOD (gpu): the other end of the detail ramp (scene units).
     #[arg(long, requires = "lod_near", allow_negative_numbers = true)]
     pub lod_far: Option<f32>,
-    /// LOD (gpu): number of photon groups A.
+    /// LOD (gpu): number of photon groups A, 1 to 1000.
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub lod_groups: u32,
     /// No progress bars.
