@@ -148,12 +148,20 @@ pub struct GpuRenderer {
     pub targets: FrameTargets,
     clip_from_world: glam::Mat4,
     camera_position: Vec3,
+    camera: hikari_core::camera::Camera,
+    /// The scene's bounds (for the depth range of a moved camera).
+    bounds: (Vec3, Vec3),
+    volume_radius: f32,
 }
 
-/// Near and far planes enclosing the scene's bounding box.
-fn depth_range(scene: &Scene) -> (f32, f32) {
-    let (lo, hi) = scene.accel.bounds();
-    let eye = scene.camera.position;
+/// The rasterizing passes' projection for `camera` in a scene within `bounds`.
+fn clip_from_world(camera: &hikari_core::camera::Camera, bounds: (Vec3, Vec3)) -> glam::Mat4 {
+    let (near, far) = depth_range(bounds, camera.position);
+    camera.clip_from_view(near, far) * camera.view_from_world()
+}
+
+/// Near and far planes enclosing the scene bounds `(lo, hi)` seen from `eye`.
+fn depth_range((lo, hi): (Vec3, Vec3), eye: Vec3) -> (f32, f32) {
     let far = (0..8)
         .map(|i| {
             let corner = Vec3::new(
@@ -177,7 +185,7 @@ impl GpuRenderer {
     /// than 2%).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
         (!ctx.float32_blend && !scene.media.is_empty())
-            .then(|| format!("participating media need 32-bit float blending, which {} lacks", ctx.describe()))
+            .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string())
     }
 
     /// What a frame of `scene` with `settings` allocates, for `photons`
@@ -268,10 +276,11 @@ impl GpuRenderer {
             volume: radiance_target("volume radiance"),
             shadow_maps: shadow_pass.create_maps(device, &lights.views, settings.shadow_map_size, scene.accel.bounds()),
         };
-        let (near, far) = depth_range(scene);
         let scene_buffers = SceneBuffers::upload(device, scene);
         let global_photons = traced.indirect();
-        let clip_from_world = scene.camera.clip_from_view(near, far) * scene.camera.view_from_world();
+        let bounds = scene.accel.bounds();
+        let volume_radius = settings.volume_radius;
+        let clip_from_world = clip_from_world(&scene.camera, bounds);
         let media = GpuMedia::new(
             device,
             scene,
@@ -340,8 +349,45 @@ impl GpuRenderer {
             targets,
             clip_from_world,
             camera_position: scene.camera.position,
+            camera: scene.camera.clone(),
+            bounds,
+            volume_radius,
             ctx,
         }
+    }
+
+    /// The camera the frames are drawn from.
+    pub fn camera(&self) -> &hikari_core::camera::Camera {
+        &self.camera
+    }
+
+    /// Draws the next frames from `camera`, which must keep the resolution
+    /// (the targets are sized for it). The photon maps stay: they do not
+    /// depend on the eye.
+    pub fn set_camera(&mut self, camera: &hikari_core::camera::Camera) -> Result<(), GpuError> {
+        if (camera.width, camera.height) != (self.camera.width, self.camera.height) {
+            return Err(GpuError::Failed(format!(
+                "a camera of {}x{} for targets of {}x{}",
+                camera.width, camera.height, self.camera.width, self.camera.height
+            )));
+        }
+        let queue = &self.ctx.queue;
+        self.clip_from_world = clip_from_world(camera, self.bounds);
+        self.camera_position = camera.position;
+        self.camera = camera.clone();
+        self.media.set_camera(queue, camera, self.clip_from_world);
+        self.specular_pass.set_camera(queue, camera);
+        self.volume_pass.set_params(
+            queue,
+            &VolumeParams {
+                clip_from_world: self.clip_from_world.to_cols_array_2d(),
+                radius: self.volume_radius,
+                power_unit: self.power_unit,
+                _pad0: 0,
+                _pad1: 0,
+            },
+        );
+        Ok(())
     }
 
     fn splat_params(&self, estimate: &FixedRadius) -> SplatParams {

@@ -56,6 +56,20 @@ pub fn max_view_distance(scene: &Scene) -> f32 {
 }
 
 impl MediaParams {
+    /// These parameters seen from `camera` (same resolution).
+    pub fn with_camera(&self, camera: &hikari_core::camera::Camera) -> Self {
+        let (forward, right, up, tan_half_fov) = camera.basis();
+        MediaParams {
+            camera_position: camera.position.to_array(),
+            forward: forward.to_array(),
+            tan_half_fov,
+            right: right.to_array(),
+            aspect: camera.width as f32 / camera.height as f32,
+            up: up.to_array(),
+            ..*self
+        }
+    }
+
     pub fn new(scene: &Scene, slices: u32) -> Self {
         let media = &scene.media;
         let camera = &scene.camera;
@@ -126,9 +140,22 @@ pub struct GpuMedia {
     pub slices: wgpu::Texture,
     pipeline: wgpu::RenderPipeline,
     bind_group: wgpu::BindGroup,
+    clip_buffer: wgpu::Buffer,
 }
 
 impl GpuMedia {
+    /// Sees the media from `camera` from the next frame on.
+    pub fn set_camera(
+        &mut self,
+        queue: &wgpu::Queue,
+        camera: &hikari_core::camera::Camera,
+        clip_from_world: glam::Mat4,
+    ) {
+        self.params = self.params.with_camera(camera);
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        queue.write_buffer(&self.clip_buffer, 0, bytemuck::bytes_of(&clip_from_world.to_cols_array_2d()));
+    }
+
     pub fn new(
         device: &wgpu::Device,
         scene: &Scene,
@@ -141,7 +168,7 @@ impl GpuMedia {
         let params_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("media params"),
             contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let mut triangles = region_triangles(&scene.media);
         if triangles.is_empty() {
@@ -171,7 +198,7 @@ impl GpuMedia {
         let clip_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("optical-depth clip_from_world"),
             contents: bytemuck::bytes_of(&clip_from_world.to_cols_array_2d()),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         use crate::binding::{entry, storage, texture, uniform};
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
@@ -201,7 +228,7 @@ impl GpuMedia {
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "optical depth", &layout);
         let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &[], "optical depth");
-        GpuMedia { params, params_buffer, regions, slices: slices_texture, pipeline, bind_group }
+        GpuMedia { params, params_buffer, regions, slices: slices_texture, pipeline, bind_group, clip_buffer }
     }
 
     /// Rasterizes the region meshes once per slice (nothing without regions).

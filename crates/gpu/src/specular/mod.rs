@@ -127,6 +127,8 @@ pub struct SpecularPass {
     pub output: wgpu::Texture,
     slice_params: wgpu::Buffer,
     status: wgpu::Buffer,
+    params: SpecularParams,
+    params_buffer: wgpu::Buffer,
     iteration_budget: u32,
     /// Dispatches the gathers are split into; grows when a frame ran over
     /// budget and is kept for the next frames.
@@ -240,7 +242,11 @@ impl SpecularPass {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: padded, usage })
         };
         let storage_usage = wgpu::BufferUsages::STORAGE;
-        let params_buffer = buffer("specular params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let params_buffer = buffer(
+            "specular params",
+            bytemuck::bytes_of(&params),
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        );
         let nodes = buffer("bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage_usage);
         let prims = buffer("bvh prims", bytemuck::cast_slice(&bvh.prims), storage_usage);
         let grid = buffer("photon grids", bytemuck::cast_slice(&words), storage_usage);
@@ -317,9 +323,26 @@ impl SpecularPass {
             output,
             slice_params,
             status,
+            params,
+            params_buffer,
             iteration_budget,
             slices: std::cell::Cell::new(0),
         }
+    }
+
+    /// Casts its primary rays from `camera` (same resolution) from the next frame on.
+    pub fn set_camera(&mut self, queue: &wgpu::Queue, camera: &hikari_core::camera::Camera) {
+        let (forward, right, up, tan_half_fov) = camera.basis();
+        self.params = SpecularParams {
+            camera_position: camera.position.to_array(),
+            tan_half_fov,
+            camera_right: right.to_array(),
+            aspect: camera.aspect(),
+            camera_up: up.to_array(),
+            camera_forward: forward.to_array(),
+            ..self.params
+        };
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
     }
 
     /// Whether the pass runs at all (the scene has specular surfaces).

@@ -36,6 +36,7 @@ pub fn shader_source() -> String {
 pub struct VolumePass {
     pipeline: wgpu::RenderPipeline,
     bind_group: wgpu::BindGroup,
+    uniforms: wgpu::Buffer,
 }
 
 impl VolumePass {
@@ -62,7 +63,7 @@ impl VolumePass {
         let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("volume params"),
             contents: bytemuck::bytes_of(params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let slices =
             media.slices.create_view(&wgpu::TextureViewDescriptor { dimension: Some(D2Array), ..Default::default() });
@@ -85,7 +86,12 @@ impl VolumePass {
         let pipeline_layout = crate::binding::pipeline_layout(device, "volume splat", &layout);
         let instances = [Some(crate::splat::photon_instances())];
         let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &instances, "volume");
-        VolumePass { pipeline, bind_group }
+        VolumePass { pipeline, bind_group, uniforms }
+    }
+
+    /// New parameters (a moved camera) from the next frame on.
+    pub fn set_params(&self, queue: &wgpu::Queue, params: &VolumeParams) {
+        queue.write_buffer(&self.uniforms, 0, bytemuck::bytes_of(params));
     }
 
     /// Clears `target` and adds the surviving volume photons' in-scattering

@@ -1,0 +1,67 @@
+//! A moved camera (`GpuRenderer::set_camera`, what the viewer does every
+//! frame) draws what a renderer built for that camera draws.
+
+use glam::Vec3;
+use hikari_core::camera::Camera;
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::render::photon_cpu::PhotonCpuSettings;
+use hikari_core::scene::Scene;
+use hikari_gpu::test_support::media_context;
+use hikari_gpu::{GpuRenderer, GpuSettings};
+
+fn moved(camera: &Camera) -> Camera {
+    let position = camera.position + Vec3::new(0.4, -0.2, -0.6);
+    Camera::new(
+        position,
+        camera.look_at + Vec3::new(0.1, 0.1, 0.0),
+        camera.up,
+        camera.fov_y * 0.9,
+        camera.width,
+        camera.height,
+    )
+    .unwrap()
+}
+
+fn assert_moved_camera_draws_as_built(name: &str) {
+    let mut scene = Scene::load(name).unwrap();
+    scene.camera = scene.camera.with_resolution(48, 40).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 5_000, seed: 2, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let settings = GpuSettings::new(global, caustic);
+    let Some(ctx) = media_context(name, &scene) else { return };
+
+    let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &traced, settings.clone()).expect("GPU renderer");
+    gpu.render().expect("first frame");
+    let target = moved(&scene.camera);
+    gpu.set_camera(&target).unwrap();
+    gpu.render().expect("moved frame");
+    let (moved_image, _) = gpu.read_image().unwrap();
+
+    let mut built_scene = scene;
+    built_scene.camera = target;
+    let built = GpuRenderer::new(ctx, &built_scene, &traced, settings).expect("GPU renderer");
+    built.render().expect("frame");
+    let (built_image, _) = built.read_image().unwrap();
+
+    let mut differing = 0;
+    for (a, b) in moved_image.pixels.iter().zip(&built_image.pixels) {
+        if (*a - *b).abs().max_element() > 1e-5 * a.max_element().max(1e-3) {
+            differing += 1;
+        }
+    }
+    let lit = built_image.pixels.iter().filter(|p| p.max_element() > 0.0).count();
+    eprintln!("{name}: {differing} of {} pixels differ ({lit} lit)", built_image.pixels.len());
+    assert!(lit > built_image.pixels.len() / 2);
+    assert_eq!(differing, 0);
+}
+
+#[test]
+fn moved_camera_draws_as_built_in_cornell_caustic() {
+    assert_moved_camera_draws_as_built("cornell-caustic");
+}
+
+#[test]
+fn moved_camera_draws_as_built_in_layered_fog() {
+    assert_moved_camera_draws_as_built("fog-stage-layered");
+}
