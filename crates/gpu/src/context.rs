@@ -69,6 +69,16 @@ impl GpuContext {
     /// that has everything the renderer needs.
     pub fn new() -> Result<Self, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::choose(&instance, None)
+    }
+
+    /// As `new`, among the adapters of `instance` that can present to
+    /// `surface` (the viewer's window).
+    pub fn for_surface(instance: &wgpu::Instance, surface: &wgpu::Surface) -> Result<Self, GpuError> {
+        Self::choose(instance, Some(surface))
+    }
+
+    fn choose(instance: &wgpu::Instance, surface: Option<&wgpu::Surface>) -> Result<Self, GpuError> {
         let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         if adapters.is_empty() {
             return Err(GpuError::NoAdapter("wgpu enumerated none; WGPU_BACKEND may exclude them".into()));
@@ -77,6 +87,10 @@ impl GpuContext {
         let mut refusals = Vec::new();
         for adapter in adapters {
             let info = adapter.get_info();
+            if surface.is_some_and(|s| !adapter.is_surface_supported(s)) {
+                refusals.push(format!("{} ({:?}) cannot present to the window", info.name, info.backend));
+                continue;
+            }
             match Capabilities::check(&adapter) {
                 Ok(caps) => return Self::open(adapter, caps),
                 Err(why) => refusals.push(format!("{} ({:?}) {why}", info.name, info.backend)),

@@ -36,5 +36,6 @@ pub const UNCOUNTED_LOOPS_WGSL: &str = "fn loop_iteration() -> bool { return tru
 /// The WGSL mirror of `hikari_core::estimate`, prepended to the shaders that use it.
 pub const ESTIMATE_WGSL: &str = include_str!("estimate.wgsl");
 pub mod photon_grid;
+pub mod present;
 #[doc(hidden)]
 pub mod test_support;

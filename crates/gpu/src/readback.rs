@@ -14,14 +14,32 @@ pub fn read_rgba_layers(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec
     (0..texture.depth_or_array_layers()).map(|layer| read_rgba_layer(ctx, texture, layer)).collect()
 }
 
+/// A 2D `Rgba8Unorm` texture's bytes, row-major, row 0 at the top.
+pub fn read_rgba8(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>, GpuError> {
+    if texture.format() != wgpu::TextureFormat::Rgba8Unorm {
+        return Err(GpuError::Readback(format!("not Rgba8Unorm: {:?}", texture.format())));
+    }
+    read_rows(ctx, texture, 0, 4)
+}
+
 /// One layer of a 2D (array) texture.
 pub fn read_rgba_layer(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -> Result<Vec<Vec4>, GpuError> {
-    let (width, height) = (texture.width(), texture.height());
     let texel_bytes = match texture.format() {
         wgpu::TextureFormat::Rgba32Float => 16,
         wgpu::TextureFormat::Rgba16Float => 8,
         other => return Err(GpuError::Readback(format!("cannot read back {other:?}"))),
     };
+    let bytes = read_rows(ctx, texture, layer, texel_bytes)?;
+    if texel_bytes == 16 {
+        Ok(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes).iter().map(|&v| Vec4::from(v)).collect())
+    } else {
+        Ok(bytemuck::cast_slice::<u8, [u16; 4]>(&bytes).iter().map(|v| Vec4::from(v.map(f16_to_f32))).collect())
+    }
+}
+
+/// The texels of one layer, rows unpadded, `texel_bytes` each.
+fn read_rows(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32, texel_bytes: u32) -> Result<Vec<u8>, GpuError> {
+    let (width, height) = (texture.width(), texture.height());
     let unpadded = width * texel_bytes;
     let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
@@ -50,14 +68,9 @@ pub fn read_rgba_layer(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) ->
     );
     ctx.queue.submit([encoder.finish()]);
     let data = map_read(ctx, &buffer)?;
-    let mut out = Vec::with_capacity((width * height) as usize);
+    let mut out = Vec::with_capacity((unpadded * height) as usize);
     for row in 0..height {
-        let bytes = &data[(row * padded) as usize..(row * padded + unpadded) as usize];
-        if texel_bytes == 16 {
-            out.extend(bytemuck::cast_slice::<u8, [f32; 4]>(bytes).iter().map(|&v| Vec4::from(v)));
-        } else {
-            out.extend(bytemuck::cast_slice::<u8, [u16; 4]>(bytes).iter().map(|v| Vec4::from(v.map(f16_to_f32))));
-        }
+        out.extend_from_slice(&data[(row * padded) as usize..(row * padded + unpadded) as usize]);
     }
     Ok(out)
 }

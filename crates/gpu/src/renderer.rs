@@ -356,6 +356,11 @@ impl GpuRenderer {
         }
     }
 
+    /// The resolved frame (linear radiance, `Rgba32Float`), as `read_image` reads it.
+    pub fn resolved(&self) -> &wgpu::Texture {
+        &self.resolve_pass.output
+    }
+
     /// The camera the frames are drawn from.
     pub fn camera(&self) -> &hikari_core::camera::Camera {
         &self.camera

@@ -14,6 +14,8 @@ use std::mem::{offset_of, size_of};
 fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("gbuffer.wgsl", hikari_gpu::gbuffer::SHADER.to_string()),
+        ("gbuffer.wgsl + gbuffer_storage.wgsl", hikari_gpu::gbuffer::storage_shader_source()),
+        ("present.wgsl", hikari_gpu::present::SHADER.to_string()),
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
         ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
         ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
@@ -139,6 +141,9 @@ fn shared_structs_match_wgsl_layouts() {
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
     assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
+    assert_layout!(specular, "SliceParams", hikari_gpu::specular::SliceParams, [index, count, iteration_budget, _pad]);
+    let present = hikari_gpu::present::SHADER;
+    assert_layout!(present, "PresentParams", hikari_gpu::present::PresentParams, [scale, encode_srgb, _pad0, _pad1]);
     let volume = hikari_gpu::volume::shader_source();
     assert_layout!(
         volume,

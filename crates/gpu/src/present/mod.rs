@@ -1,0 +1,97 @@
+//! The present pass: the resolved frame to a window's surface texture (or
+//! any colour target), tone-mapped as `hikari_core::output::tone_map` does
+//! for PNG files, so the window shows what `--screenshot` writes.
+
+use bytemuck::{Pod, Zeroable};
+use wgpu::util::DeviceExt;
+
+pub const SHADER: &str = include_str!("present.wgsl");
+
+/// Mirrors `PresentParams` in present.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct PresentParams {
+    pub scale: f32,
+    pub encode_srgb: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+}
+
+pub struct PresentPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    /// The target is an sRGB format (its stores encode).
+    srgb_target: bool,
+}
+
+impl PresentPass {
+    /// A pass drawing into targets of `format`.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("present.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        use crate::binding::{entry, texture, uniform};
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("present"),
+            entries: &[
+                entry(0, wgpu::ShaderStages::FRAGMENT, uniform()),
+                entry(1, wgpu::ShaderStages::FRAGMENT, texture(wgpu::TextureViewDimension::D2)),
+            ],
+        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "present", &layout);
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("present"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_fullscreen"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        PresentPass { pipeline, layout, srgb_target: format.is_srgb() }
+    }
+
+    /// Draws `frame` (linear radiance) into `target` with `exposure` stops.
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &wgpu::Texture,
+        target: &wgpu::TextureView,
+        exposure: f32,
+    ) {
+        let params =
+            PresentParams { scale: 2f32.powf(exposure), encode_srgb: (!self.srgb_target) as u32, _pad0: 0, _pad1: 0 };
+        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("present params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let frame_view = frame.create_view(&Default::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("present"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&frame_view) },
+            ],
+        });
+        let mut pass = crate::binding::color_pass(encoder, "present", target, true);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+}
