@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Runs the whole hikari test suite on a fresh Debian 12 machine: installs what
-# the machine lacks (Mesa's software Vulkan driver for the GPU tests), then
+# the machine lacks (Mesa's software Vulkan driver for the GPU tests, Xvfb
+# for the viewer's window tests), then
 # runs every test of the workspace. GPU tests fail, not skip, without an
 # adapter; the CLI tests also run the renderer on Mesa's OpenGL.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need=()
-for pkg in mesa-vulkan-drivers libvulkan1; do
+for pkg in mesa-vulkan-drivers libvulkan1 xvfb xauth; do
     dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then

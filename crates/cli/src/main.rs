@@ -3,6 +3,7 @@
 mod bench_cmd;
 mod progress_bar;
 mod render_cmd;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -22,6 +23,8 @@ struct Cli {
 enum Command {
     /// Render a scene to an image.
     Render(render_cmd::RenderArgs),
+    /// Look around a scene in a window (the GPU renderer, live).
+    View(view::ViewArgs),
     /// List the built-in scenes.
     Scenes,
     /// Measure the GPU renderer: the seed's chapter-6 table for surfaces.
@@ -33,6 +36,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
+        Command::View(args) => view::run(args),
         Command::Scenes => {
             for name in hikari_core::scene::builtin::NAMES {
                 let default = if *name == hikari_core::scene::builtin::DEFAULT { "  (default)" } else { "" };

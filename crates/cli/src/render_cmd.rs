@@ -98,7 +98,7 @@ pub struct RenderArgs {
     pub quiet: bool,
 }
 
-fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
+pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
     let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"));
     let (w, h) = (parse(w)?, parse(h)?);

@@ -257,3 +257,45 @@ fn the_gl_backend_renders_or_falls_back_with_the_reason() {
     );
     assert!(dir.join("out.png").is_file());
 }
+
+/// `hikari view` in a real window under a virtual X server (Debian's Xvfb,
+/// which scripts/test.sh installs): a few frames unattended, the last one
+/// written, one summary line.
+#[test]
+fn view_runs_unattended_under_xvfb() {
+    let dir = scratch_dir("view");
+    let out = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_hikari")])
+        .args(["view", "cornell-caustic", "--frames", "4", "--size", "64x48", "--photons", "3000", "-q"])
+        .args(["--screenshot", "shot.png"])
+        .current_dir(&dir)
+        .output()
+        .expect("xvfb-run runs (scripts/test.sh installs Debian's xvfb)");
+    let (err, text) = (stderr(&out), String::from_utf8_lossy(&out.stdout).into_owned());
+    assert!(out.status.success(), "{err}");
+    assert!(text.contains("view: 4 frames") && text.contains("fps, 1% low"), "{text}");
+    let shot = image::open(dir.join("shot.png")).unwrap();
+    assert_eq!((shot.width(), shot.height()), (64, 48));
+    // The frame is lit (the ball's scene, not a cleared target).
+    let lit = shot.to_rgb8().pixels().filter(|p| p.0.iter().any(|&c| c > 40)).count();
+    assert!(lit > 64 * 48 / 2, "only {lit} lit pixels");
+}
+
+/// Without a display the viewer says so in one line and exits non-zero.
+#[test]
+fn view_without_a_display_says_so() {
+    let dir = scratch_dir("nodisplay");
+    let out = Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(["view", "--frames", "1", "-q"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("WAYLAND_SOCKET")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("hikari render"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}

@@ -38,6 +38,8 @@ type Fault = Arc<Mutex<Option<String>>>;
 /// Clones share the device (and its recorded faults).
 #[derive(Clone)]
 pub struct GpuContext {
+    /// The adapter the device was opened on (a window's surface asks it).
+    pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub adapter_info: wgpu::AdapterInfo,
@@ -126,6 +128,7 @@ impl GpuContext {
         }));
         let info = adapter.get_info();
         Ok(GpuContext {
+            adapter,
             device,
             queue,
             loop_budget: loop_budget(&info),

@@ -1,0 +1,398 @@
+//! `hikari view`: the GPU renderer in a window, drawn straight to the
+//! swapchain, with an orbiting camera. The photon maps are traced once; a
+//! moved camera only updates the passes' uniforms (`GpuRenderer::set_camera`).
+//!
+//! Controls: left drag orbits, middle or shift + left drag pans, the wheel
+//! zooms, Home resets the camera, C prints it as a `[camera]` table, F12
+//! writes a PNG and an EXR of the frame, Escape quits.
+
+mod frame_stats;
+mod orbit;
+
+use crate::progress_bar::TerminalProgress;
+use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution};
+use anyhow::{Result, anyhow};
+use clap::Args;
+use frame_stats::FrameStats;
+use hikari_core::output::write_image;
+use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
+use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
+use hikari_core::scene::{Scene, builtin};
+use hikari_gpu::present::PresentPass;
+use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
+use orbit::Orbit;
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+use winit::application::ApplicationHandler;
+use winit::dpi::{PhysicalPosition, PhysicalSize};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::keyboard::{Key, NamedKey};
+use winit::window::{Window, WindowId};
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    /// A built-in scene name (see `hikari scenes`) or a path to a .toml scene file.
+    #[arg(default_value = builtin::DEFAULT)]
+    pub scene: String,
+    /// Photon paths emitted from the lights (1 to 100,000,000).
+    #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=MAX_PHOTONS))]
+    pub photons: u64,
+    /// Random seed of the photon set.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Exposure in stops (-64 to 64).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Window size in pixels, e.g. 1280x720 [default: the scene's resolution].
+    #[arg(long, value_parser = parse_resolution)]
+    pub size: Option<(u32, u32)>,
+    /// Quit after this many frames (for tests and benchmarks).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    pub frames: Option<u64>,
+    /// Write the last frame to this .png or .exr on exit.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// No progress bars.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+pub fn run(args: ViewArgs) -> Result<()> {
+    if !(args.exposure.abs() <= 64.0) {
+        return Err(UsageError(format!("--exposure {}: must be between -64 and 64 stops", args.exposure)).into());
+    }
+    if let Some(path) = &args.screenshot {
+        let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+        if !matches!(ext.as_deref(), Some("png" | "exr")) {
+            return Err(UsageError(format!("{}: unsupported image type (use .png or .exr)", path.display())).into());
+        }
+    }
+    let scene = Scene::load(&args.scene).map_err(|e| UsageError(e.to_string()))?;
+    let event_loop = EventLoop::new()
+        .map_err(|e| anyhow!("cannot open a window ({e}); `hikari render` writes an image without one"))?;
+    let mut viewer = Viewer::new(args, scene);
+    event_loop.run_app(&mut viewer).map_err(|e| anyhow!("the window's event loop failed: {e}"))?;
+    if let Some(error) = viewer.error.take() {
+        return Err(error);
+    }
+    viewer.summary();
+    Ok(())
+}
+
+/// What exists once the window does.
+struct Session {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    renderer: GpuRenderer,
+    present: PresentPass,
+}
+
+struct Viewer {
+    args: ViewArgs,
+    scene: Scene,
+    orbit: Orbit,
+    traced: Option<TracedPhotons>,
+    trace_seconds: f64,
+    session: Option<Session>,
+    error: Option<anyhow::Error>,
+    stats: FrameStats,
+    last_frame: Option<Instant>,
+    started: Option<Instant>,
+    /// When the camera was last moved and the move is not on screen yet.
+    pending_edit: Option<Instant>,
+    edit_latencies: Vec<f64>,
+    cursor: PhysicalPosition<f64>,
+    dragging: Option<MouseButton>,
+    shift: bool,
+    screenshots: u32,
+    title_updated: Option<Instant>,
+}
+
+impl Viewer {
+    fn new(args: ViewArgs, scene: Scene) -> Self {
+        Viewer {
+            orbit: Orbit::new(&scene.camera),
+            args,
+            scene,
+            traced: None,
+            trace_seconds: 0.0,
+            session: None,
+            error: None,
+            stats: FrameStats::default(),
+            last_frame: None,
+            started: None,
+            pending_edit: None,
+            edit_latencies: Vec::new(),
+            cursor: PhysicalPosition::new(0.0, 0.0),
+            dragging: None,
+            shift: false,
+            screenshots: 0,
+            title_updated: None,
+        }
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        self.error.get_or_insert(error);
+        event_loop.exit();
+    }
+
+    /// Opens the window, finds an adapter that can present to it, traces
+    /// the photons (once) and builds the renderer.
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<Session> {
+        let (width, height) = self.args.size.unwrap_or((self.scene.camera.width, self.scene.camera.height));
+        let attributes = Window::default_attributes()
+            .with_title(format!("hikari view — {}", self.args.scene))
+            .with_inner_size(PhysicalSize::new(width, height));
+        let window = Arc::new(event_loop.create_window(attributes).map_err(|e| anyhow!("cannot open a window: {e}"))?);
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+            event_loop.owned_display_handle(),
+        )));
+        let surface = instance.create_surface(window.clone()).map_err(|e| anyhow!("cannot draw in the window: {e}"))?;
+        let ctx = GpuContext::for_surface(&instance, &surface)
+            .map_err(|e| anyhow!("{e}; `hikari render` renders without a usable GPU"))?;
+        let size = window.inner_size();
+        let (width, height) = (size.width.max(1), size.height.max(1));
+        let format = surface.get_capabilities(&ctx.adapter).formats.first().copied().ok_or_else(|| {
+            anyhow!("the window offers no surface format on {}; `hikari render` writes an image", ctx.describe())
+        })?;
+        let config = wgpu::SurfaceConfiguration {
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            format,
+            width,
+            height,
+            present_mode: wgpu::PresentMode::Fifo,
+            desired_maximum_frame_latency: 2,
+            alpha_mode: wgpu::CompositeAlphaMode::Auto,
+            view_formats: vec![],
+            color_space: wgpu::SurfaceColorSpace::Auto,
+        };
+        ctx.scoped(|| surface.configure(&ctx.device, &config))?;
+        if self.traced.is_none() {
+            let progress = TerminalProgress::new(self.args.quiet);
+            let start = Instant::now();
+            let settings = TraceSettings { photons: self.args.photons, seed: self.args.seed, ..Default::default() };
+            self.traced = Some(trace_photons(&self.scene, &settings, &progress));
+            self.trace_seconds = start.elapsed().as_secs_f64();
+        }
+        eprintln!("view: {} on {}", self.args.scene, ctx.describe());
+        let present = PresentPass::new(&ctx.device, format);
+        let renderer = self.renderer(ctx, width, height)?;
+        Ok(Session { window, surface, config, renderer, present })
+    }
+
+    /// A renderer for frames of `width × height` from the orbit's camera.
+    fn renderer(&mut self, ctx: GpuContext, width: u32, height: u32) -> Result<GpuRenderer> {
+        self.scene.camera = self.orbit.camera(width, height);
+        let scene = &self.scene;
+        let traced = self.traced.as_ref().expect("photons are traced before the renderer is built");
+        let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
+        let settings = GpuSettings { volume_radius: default_radius(scene), ..GpuSettings::new(global, caustic) };
+        Ok(GpuRenderer::new(ctx, scene, traced, settings)?)
+    }
+
+    /// Renders and presents one frame.
+    fn frame(&mut self) -> Result<()> {
+        let Some(session) = &mut self.session else { return Ok(()) };
+        let (width, height) = (session.config.width, session.config.height);
+        let camera = self.orbit.camera(width, height);
+        if camera.position != session.renderer.camera().position || camera.look_at != session.renderer.camera().look_at
+        {
+            session.renderer.set_camera(&camera)?;
+        }
+        session.renderer.render()?;
+        let ctx = &session.renderer.ctx;
+        let texture = match session.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => return Ok(()),
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                session.surface.configure(&ctx.device, &session.config);
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err(GpuError::Failed("the window's surface refused a frame".into()).into());
+            }
+        };
+        let scopes = ctx.error_scopes();
+        let view = texture.texture.create_view(&Default::default());
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        session.present.record(&ctx.device, &mut encoder, session.renderer.resolved(), &view, self.args.exposure);
+        ctx.queue.submit([encoder.finish()]);
+        session.window.pre_present_notify();
+        ctx.queue.present(texture);
+        scopes.finish()?;
+
+        let now = Instant::now();
+        if let Some(last) = self.last_frame {
+            self.stats.push((now - last).as_secs_f64());
+        }
+        self.started.get_or_insert(now);
+        self.last_frame = Some(now);
+        if let Some(edit) = self.pending_edit.take() {
+            self.edit_latencies.push((now - edit).as_secs_f64());
+        }
+        if self.title_updated.is_none_or(|t| (now - t).as_secs_f64() > 0.5) && self.stats.frames() > 0 {
+            let fps = self.stats.mean_fps();
+            session.window.set_title(&format!("hikari view — {} — {fps:.1} fps", self.args.scene));
+            self.title_updated = Some(now);
+        }
+        Ok(())
+    }
+
+    /// Writes the current frame to `path` (PNG tone-mapped, EXR linear).
+    fn screenshot(&self, path: &std::path::Path) -> Result<()> {
+        let Some(session) = &self.session else { return Ok(()) };
+        let (image, _) = session.renderer.read_image()?;
+        write_image(path, &image, self.args.exposure)?;
+        eprintln!("view: wrote {}", path.display());
+        Ok(())
+    }
+
+    fn resize(&mut self, size: PhysicalSize<u32>) -> Result<()> {
+        if size.width == 0 || size.height == 0 {
+            return Ok(());
+        }
+        let Some(session) = self.session.take() else { return Ok(()) };
+        if (size.width, size.height) == (session.config.width, session.config.height) {
+            self.session = Some(session);
+            return Ok(());
+        }
+        let Session { window, surface, mut config, renderer, present } = session;
+        config.width = size.width;
+        config.height = size.height;
+        let ctx = renderer.ctx.clone();
+        drop(renderer);
+        surface.configure(&ctx.device, &config);
+        let renderer = self.renderer(ctx, size.width, size.height)?;
+        self.session = Some(Session { window, surface, config, renderer, present });
+        Ok(())
+    }
+
+    fn summary(&self) {
+        let seconds = match (self.started, self.last_frame) {
+            (Some(a), Some(b)) => (b - a).as_secs_f64(),
+            _ => 0.0,
+        };
+        let latency = if self.edit_latencies.is_empty() {
+            "no camera moves".to_string()
+        } else {
+            let mean = self.edit_latencies.iter().sum::<f64>() / self.edit_latencies.len() as f64;
+            format!("camera move to screen {:.1} ms mean over {} moves", mean * 1e3, self.edit_latencies.len())
+        };
+        println!(
+            "view: {} frames in {seconds:.2} s: mean {:.2} fps, 1% low {:.2} fps; 1 photon set traced ({:.2} s); {latency}",
+            self.stats.frames() + self.last_frame.is_some() as usize,
+            self.stats.mean_fps(),
+            self.stats.one_percent_low_fps(),
+            self.trace_seconds,
+        );
+    }
+
+    /// The camera moved: the next presented frame shows it.
+    fn edited(&mut self) {
+        self.pending_edit.get_or_insert_with(Instant::now);
+    }
+
+    fn key(&mut self, event_loop: &ActiveEventLoop, key: &Key) -> Result<()> {
+        match key {
+            Key::Named(NamedKey::Escape) => event_loop.exit(),
+            Key::Named(NamedKey::Home) => {
+                self.orbit.reset();
+                self.edited();
+            }
+            Key::Named(NamedKey::F12) => {
+                self.screenshots += 1;
+                for ext in ["png", "exr"] {
+                    self.screenshot(&PathBuf::from(format!("hikari-view-{}.{ext}", self.screenshots)))?;
+                }
+            }
+            Key::Character(c) if c.eq_ignore_ascii_case("c") => {
+                if let Some(s) = &self.session {
+                    println!("{}", self.orbit.toml(s.config.width, s.config.height));
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for Viewer {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.session.is_some() {
+            return;
+        }
+        match self.open(event_loop) {
+            Ok(session) => {
+                session.window.request_redraw();
+                self.session = Some(session);
+            }
+            Err(e) => self.fail(event_loop, e),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let result = match event {
+            WindowEvent::CloseRequested => {
+                event_loop.exit();
+                Ok(())
+            }
+            WindowEvent::Resized(size) => self.resize(size),
+            WindowEvent::RedrawRequested => self.frame().and_then(|()| {
+                let done = self.args.frames.is_some_and(|n| self.stats.frames() as u64 + 1 >= n);
+                if done {
+                    if let Some(path) = self.args.screenshot.clone() {
+                        self.screenshot(&path)?;
+                    }
+                    event_loop.exit();
+                }
+                Ok(())
+            }),
+            WindowEvent::ModifiersChanged(m) => {
+                self.shift = m.state().shift_key();
+                Ok(())
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                self.dragging = (state == ElementState::Pressed).then_some(button);
+                Ok(())
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                let (dx, dy) = ((position.x - self.cursor.x) as f32, (position.y - self.cursor.y) as f32);
+                self.cursor = position;
+                let height = self.session.as_ref().map_or(1, |s| s.config.height);
+                match self.dragging {
+                    Some(MouseButton::Left) if self.shift => self.orbit.pan(dx, dy, height),
+                    Some(MouseButton::Middle) => self.orbit.pan(dx, dy, height),
+                    Some(MouseButton::Left) => self.orbit.rotate(dx, dy),
+                    _ => return,
+                }
+                self.edited();
+                Ok(())
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                self.orbit.zoom(lines);
+                self.edited();
+                Ok(())
+            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
+                self.key(event_loop, &event.logical_key)
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = result {
+            self.fail(event_loop, e);
+        }
+    }
+
+    fn about_to_wait(&mut self, _: &ActiveEventLoop) {
+        if let Some(session) = &self.session {
+            session.window.request_redraw();
+        }
+    }
+}

@@ -1,0 +1,154 @@
+//! The viewer's camera: orbit around a target (left drag), pan (middle or
+//! shift drag), zoom (wheel), reset (Home), and the current view as a
+//! `[camera]` block for a scene file.
+
+use glam::Vec3;
+use hikari_core::camera::Camera;
+
+/// Radians per pixel dragged.
+const ORBIT_SPEED: f32 = 0.005;
+/// Distance factor per wheel line.
+const ZOOM_STEP: f32 = 0.9;
+/// Keeps the view off the poles, where `up` and the view would be parallel.
+const MAX_PITCH: f32 = 1.55;
+
+#[derive(Clone, Debug)]
+pub struct Orbit {
+    pub target: Vec3,
+    pub distance: f32,
+    /// Around `up`, from +z toward +x.
+    pub yaw: f32,
+    /// Above the plane normal to `up`.
+    pub pitch: f32,
+    up: Vec3,
+    fov_y: f32,
+    /// The scene's camera, for `reset`.
+    home: Camera,
+}
+
+impl Orbit {
+    /// The orbit that sees what `camera` sees.
+    pub fn new(camera: &Camera) -> Self {
+        let up = camera.up.normalize();
+        let offset = camera.position - camera.look_at;
+        let distance = offset.length();
+        let (side, forward) = frame(up);
+        let d = offset / distance;
+        let pitch = d.dot(up).clamp(-1.0, 1.0).asin().clamp(-MAX_PITCH, MAX_PITCH);
+        let yaw = d.dot(side).atan2(d.dot(forward));
+        Orbit { target: camera.look_at, distance, yaw, pitch, up, fov_y: camera.fov_y, home: camera.clone() }
+    }
+
+    pub fn reset(&mut self) {
+        *self = Orbit::new(&self.home);
+    }
+
+    /// The eye position.
+    pub fn position(&self) -> Vec3 {
+        let (side, forward) = frame(self.up);
+        let (sp, cp) = self.pitch.sin_cos();
+        let (sy, cy) = self.yaw.sin_cos();
+        self.target + self.distance * (self.up * sp + cp * (forward * cy + side * sy))
+    }
+
+    /// The camera for an image of `width × height`.
+    pub fn camera(&self, width: u32, height: u32) -> Camera {
+        Camera::new(self.position(), self.target, self.up, self.fov_y, width, height)
+            .expect("an orbit keeps the eye off the target and off the up axis")
+    }
+
+    /// A drag of (dx, dy) pixels turns the eye around the target.
+    pub fn rotate(&mut self, dx: f32, dy: f32) {
+        self.yaw -= dx * ORBIT_SPEED;
+        self.pitch = (self.pitch + dy * ORBIT_SPEED).clamp(-MAX_PITCH, MAX_PITCH);
+    }
+
+    /// A drag of (dx, dy) pixels moves target and eye across the view, by
+    /// about the distance a point at the target moves on screen.
+    pub fn pan(&mut self, dx: f32, dy: f32, height: u32) {
+        let camera = self.camera(height.max(1), height.max(1));
+        let (_, right, up, tan_half_fov) = camera.basis();
+        let per_pixel = 2.0 * self.distance * tan_half_fov / height.max(1) as f32;
+        self.target += (-dx * right + dy * up) * per_pixel;
+    }
+
+    /// `lines` wheel lines toward the target (negative: away).
+    pub fn zoom(&mut self, lines: f32) {
+        self.distance = (self.distance * ZOOM_STEP.powf(lines)).clamp(1e-4, 1e7);
+    }
+
+    /// The view as a scene file's `[camera]` table.
+    pub fn toml(&self, width: u32, height: u32) -> String {
+        let v = |p: Vec3| format!("[{}, {}, {}]", p.x, p.y, p.z);
+        format!(
+            "[camera]\nposition = {}\nlook_at = {}\nup = {}\nfov_y = {}\nresolution = [{width}, {height}]\n",
+            v(self.position()),
+            v(self.target),
+            v(self.up),
+            self.fov_y
+        )
+    }
+}
+
+/// Two unit vectors perpendicular to `up` and to each other.
+fn frame(up: Vec3) -> (Vec3, Vec3) {
+    let forward = up.any_orthonormal_vector();
+    (up.cross(forward), forward)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera::new(Vec3::new(0.3, 0.4, 3.5), Vec3::new(0.0, 0.1, 0.0), Vec3::Y, 40.0, 64, 48).unwrap()
+    }
+
+    #[test]
+    fn the_orbit_starts_at_the_scene_camera() {
+        let orbit = Orbit::new(&camera());
+        assert!((orbit.position() - camera().position).length() < 1e-5, "{}", orbit.position());
+        let c = orbit.camera(64, 48);
+        assert!((c.look_at - camera().look_at).length() < 1e-6);
+    }
+
+    #[test]
+    fn rotating_keeps_the_distance_and_reset_returns() {
+        let mut orbit = Orbit::new(&camera());
+        let d = orbit.distance;
+        orbit.rotate(120.0, -40.0);
+        assert!(((orbit.position() - orbit.target).length() - d).abs() < 1e-4);
+        assert!((orbit.position() - camera().position).length() > 0.1);
+        orbit.rotate(0.0, 1e6);
+        assert!(orbit.pitch <= MAX_PITCH);
+        orbit.camera(64, 48); // still a valid camera at the pole limit
+        orbit.reset();
+        assert!((orbit.position() - camera().position).length() < 1e-5);
+    }
+
+    #[test]
+    fn zoom_and_pan_move_as_asked() {
+        let mut orbit = Orbit::new(&camera());
+        let d = orbit.distance;
+        orbit.zoom(2.0);
+        assert!((orbit.distance - d * 0.81).abs() < 1e-5);
+        let target = orbit.target;
+        orbit.pan(10.0, 0.0, 48);
+        let right = orbit.camera(64, 48).basis().1;
+        // Dragging right moves the scene right: the target moves left.
+        assert!((orbit.target - target).dot(right) < 0.0);
+    }
+
+    #[test]
+    fn the_printed_camera_loads_back() {
+        let mut orbit = Orbit::new(&camera());
+        orbit.rotate(33.0, 12.0);
+        let text = format!(
+            "{}\n[[material]]\nname = \"w\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]\n\n[[object]]\nshape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nmaterial = \"w\"\n\n[[light]]\ntype = \"point\"\nposition = [0.0, 2.0, 2.0]\nintensity = [1.0, 1.0, 1.0]\n",
+            orbit.toml(64, 48)
+        );
+        let scene = hikari_core::scene::Scene::from_toml(&text, "printed", None).unwrap();
+        assert!((scene.camera.position - orbit.position()).length() < 1e-5);
+        assert_eq!((scene.camera.width, scene.camera.height), (64, 48));
+    }
+}
