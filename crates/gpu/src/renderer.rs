@@ -154,6 +154,27 @@ pub struct GpuRenderer {
     volume_radius: f32,
 }
 
+/// What the specular pass gathers from.
+fn specular_inputs<'a>(
+    settings: &GpuSettings,
+    traced: &'a TracedPhotons,
+    global_photons: &'a [hikari_core::photon::Photon],
+    iteration_budget: u32,
+) -> SpecularInputs<'a> {
+    SpecularInputs {
+        global_photons,
+        caustic_photons: &traced.caustic,
+        volume_photons: &traced.volume,
+        volume_radius: settings.volume_radius,
+        global: settings.global,
+        caustic: settings.caustic,
+        power_unit: traced.power_unit,
+        max_depth: settings.max_specular_depth,
+        shadow_bias: settings.shadow_bias,
+        iteration_budget,
+    }
+}
+
 /// The rasterizing passes' projection for `camera` in a scene within `bounds`.
 fn clip_from_world(camera: &hikari_core::camera::Camera, bounds: (Vec3, Vec3)) -> glam::Mat4 {
     let (near, far) = depth_range(bounds, camera.position);
@@ -297,18 +318,7 @@ impl GpuRenderer {
             &targets.shadow_maps,
             &targets.gbuffer,
             &media,
-            &SpecularInputs {
-                global_photons: &global_photons,
-                caustic_photons: &traced.caustic,
-                volume_photons: &traced.volume,
-                volume_radius: settings.volume_radius,
-                global: settings.global,
-                caustic: settings.caustic,
-                power_unit: traced.power_unit,
-                max_depth: settings.max_specular_depth,
-                shadow_bias: settings.shadow_bias,
-                iteration_budget: ctx.loop_budget,
-            },
+            &specular_inputs(&settings, traced, &global_photons, ctx.loop_budget),
         );
         let volume_params = VolumeParams {
             clip_from_world: clip_from_world.to_cols_array_2d(),
@@ -382,17 +392,42 @@ impl GpuRenderer {
         self.camera = camera.clone();
         self.media.set_camera(queue, camera, self.clip_from_world);
         self.specular_pass.set_camera(queue, camera);
-        self.volume_pass.set_params(
-            queue,
-            &VolumeParams {
-                clip_from_world: self.clip_from_world.to_cols_array_2d(),
-                radius: self.volume_radius,
-                power_unit: self.power_unit,
-                _pad0: 0,
-                _pad1: 0,
-            },
-        );
+        self.volume_pass.set_params(queue, &self.volume_params());
         Ok(())
+    }
+
+    /// Draws the next frames from `traced`, a new photon set of the same
+    /// scene (the viewer's progressive frames): new photon buffers, LOD
+    /// outputs and specular grids; the pipelines and every other resource
+    /// stay. Checked against the adapter's limits first.
+    pub fn set_photons(&mut self, scene: &Scene, traced: &TracedPhotons) -> Result<(), GpuError> {
+        let global_photons = traced.indirect();
+        let counts = [global_photons.len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
+        Self::check_fits(&self.ctx, scene, &self.settings, counts)?;
+        let scopes = self.ctx.error_scopes();
+        let device = &self.ctx.device;
+        let upload = |photons: &[hikari_core::photon::Photon], label| {
+            self.lod_pass.create_output(device, &PhotonBuffer::upload(device, photons, label))
+        };
+        self.global_lod = upload(&global_photons, "global photons");
+        self.caustic_lod = upload(&traced.caustic, "caustic photons");
+        self.volume_lod = upload(&traced.volume, "volume photons");
+        self.power_unit = traced.power_unit;
+        let inputs = specular_inputs(&self.settings, traced, &global_photons, self.ctx.loop_budget);
+        self.specular_pass.set_photons(device, &self.ctx.queue, &inputs);
+        self.volume_pass.set_params(&self.ctx.queue, &self.volume_params());
+        scopes.finish()?;
+        self.ctx.check()
+    }
+
+    fn volume_params(&self) -> VolumeParams {
+        VolumeParams {
+            clip_from_world: self.clip_from_world.to_cols_array_2d(),
+            radius: self.volume_radius,
+            power_unit: self.power_unit,
+            _pad0: 0,
+            _pad1: 0,
+        }
     }
 
     fn splat_params(&self, estimate: &FixedRadius) -> SplatParams {

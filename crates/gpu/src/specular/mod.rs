@@ -133,6 +133,120 @@ pub struct SpecularPass {
     /// Dispatches the gathers are split into; grows when a frame ran over
     /// budget and is kept for the next frames.
     slices: std::cell::Cell<u32>,
+    bindings: Bindings,
+}
+
+/// Everything the pass binds but the photon grids, kept to rebind new ones.
+struct Bindings {
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    prims: wgpu::Buffer,
+    surfaces: wgpu::Buffer,
+    regions: wgpu::Buffer,
+    direct: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    samples: wgpu::Buffer,
+    views: wgpu::Buffer,
+    maps: wgpu::TextureView,
+    normal: wgpu::TextureView,
+    output: wgpu::TextureView,
+    media: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    status: wgpu::Buffer,
+    slices: wgpu::Buffer,
+}
+
+impl Bindings {
+    fn bind_group(&self, device: &wgpu::Device, grid: &wgpu::Buffer) -> wgpu::BindGroup {
+        fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
+        }
+        fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
+            wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
+        }
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("specular"),
+            layout: &self.layout,
+            entries: &[
+                buffer(0, &self.params),
+                buffer(1, &self.nodes),
+                buffer(2, &self.prims),
+                buffer(3, &self.surfaces),
+                buffer(4, grid),
+                buffer(5, &self.regions),
+                buffer(6, &self.direct),
+                buffer(7, &self.lights),
+                buffer(8, &self.samples),
+                buffer(9, &self.views),
+                view(10, &self.maps),
+                view(11, &self.normal),
+                view(12, &self.output),
+                buffer(13, &self.media),
+                buffer(14, &self.accum),
+                buffer(15, &self.status),
+                wgpu::BindGroupEntry {
+                    binding: 16,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &self.slices,
+                        offset: 0,
+                        size: std::num::NonZeroU64::new(std::mem::size_of::<SliceParams>() as u64),
+                    }),
+                },
+            ],
+        })
+    }
+}
+
+/// The three photon grids (global, caustic, volume) in one buffer of words:
+/// all bucket starts, then all photons; and the parameters that locate them.
+struct PackedGrids;
+
+impl PackedGrids {
+    /// The words and a `SpecularParams` whose grid fields (buckets, offsets,
+    /// volume bounds, power unit) are set, the rest zero.
+    fn new(inputs: &SpecularInputs) -> (Vec<u32>, SpecularParams) {
+        let global = PhotonGrid::new(inputs.global_photons, inputs.global.radius);
+        let caustic = PhotonGrid::new(inputs.caustic_photons, inputs.caustic.radius);
+        let volume = PhotonGrid::new(inputs.volume_photons, inputs.volume_radius);
+        let grids = [&global, &caustic, &volume];
+        let mut words: Vec<u32> = Vec::new();
+        let mut start_offsets = [0u32; 3];
+        for (offset, grid) in start_offsets.iter_mut().zip(grids) {
+            *offset = words.len() as u32;
+            words.extend(&grid.starts);
+        }
+        let mut photon_offsets = [0u32; 3];
+        for (offset, grid) in photon_offsets.iter_mut().zip(grids) {
+            *offset = words.len() as u32;
+            words.extend_from_slice(bytemuck::cast_slice(&grid.photons));
+        }
+        let (lo, hi) = inputs
+            .volume_photons
+            .iter()
+            .fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
+                (lo.min(p.position()), hi.max(p.position()))
+            });
+        let params = SpecularParams {
+            power_unit: inputs.power_unit,
+            global_radius: inputs.global.radius,
+            global_buckets: global.buckets,
+            global_start_offset: start_offsets[0],
+            global_photon_offset: photon_offsets[0],
+            caustic_radius: inputs.caustic.radius,
+            caustic_buckets: caustic.buckets,
+            caustic_start_offset: start_offsets[1],
+            caustic_photon_offset: photon_offsets[1],
+            volume_radius: inputs.volume_radius,
+            volume_buckets: if inputs.volume_photons.is_empty() { 0 } else { volume.buckets },
+            volume_start_offset: start_offsets[2],
+            volume_photon_offset: photon_offsets[2],
+            volume_min: lo.to_array(),
+            volume_max: hi.to_array(),
+            ..SpecularParams::zeroed()
+        };
+        (words, params)
+    }
 }
 
 impl SpecularPass {
@@ -181,30 +295,9 @@ impl SpecularPass {
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
         let pipeline = crate::binding::compute_pipeline(device, "specular", &pipeline_layout, &module, "main");
 
-        // Static scene data: the flat BVH and the three photon grids in one
-        // buffer of words (all bucket starts, then all photons).
+        // Static scene data: the flat BVH; the photon grids (`PackedGrids`).
         let bvh = FlatBvh::new(&scene.accel);
-        let global = PhotonGrid::new(inputs.global_photons, inputs.global.radius);
-        let caustic = PhotonGrid::new(inputs.caustic_photons, inputs.caustic.radius);
-        let volume = PhotonGrid::new(inputs.volume_photons, inputs.volume_radius);
-        let grids = [&global, &caustic, &volume];
-        let mut words: Vec<u32> = Vec::new();
-        let mut start_offsets = [0u32; 3];
-        for (offset, grid) in start_offsets.iter_mut().zip(grids) {
-            *offset = words.len() as u32;
-            words.extend(&grid.starts);
-        }
-        let mut photon_offsets = [0u32; 3];
-        for (offset, grid) in photon_offsets.iter_mut().zip(grids) {
-            *offset = words.len() as u32;
-            words.extend_from_slice(bytemuck::cast_slice(&grid.photons));
-        }
-        let volume_bounds = inputs
-            .volume_photons
-            .iter()
-            .fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| {
-                (lo.min(p.position()), hi.max(p.position()))
-            });
+        let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();
         let params = SpecularParams {
             camera_position: scene.camera.position.to_array(),
@@ -218,23 +311,7 @@ impl SpecularPass {
             width,
             height,
             normal_test: inputs.global.normal_test as u32,
-            power_unit: inputs.power_unit,
-            global_radius: inputs.global.radius,
-            global_buckets: global.buckets,
-            global_start_offset: start_offsets[0],
-            global_photon_offset: photon_offsets[0],
-            caustic_radius: inputs.caustic.radius,
-            caustic_buckets: caustic.buckets,
-            caustic_start_offset: start_offsets[1],
-            caustic_photon_offset: photon_offsets[1],
-            volume_radius: inputs.volume_radius,
-            volume_buckets: if inputs.volume_photons.is_empty() { 0 } else { volume.buckets },
-            volume_start_offset: start_offsets[2],
-            volume_photon_offset: photon_offsets[2],
-            volume_min: volume_bounds.0.to_array(),
-            _pad0: 0,
-            volume_max: volume_bounds.1.to_array(),
-            _pad1: 0,
+            ..grid_params
         };
         let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
             // wgpu refuses empty bindings: pad to one zero word.
@@ -250,6 +327,7 @@ impl SpecularPass {
         let nodes = buffer("bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage_usage);
         let prims = buffer("bvh prims", bytemuck::cast_slice(&bvh.prims), storage_usage);
         let grid = buffer("photon grids", bytemuck::cast_slice(&words), storage_usage);
+        let keep = |b: &wgpu::Buffer| b.clone();
         let direct_params = DirectParams {
             light_count: lights.lights.len() as u32,
             shadow_size: maps.size,
@@ -281,38 +359,26 @@ impl SpecularPass {
         });
         let maps_view =
             maps.texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(D2Array), ..Default::default() });
-        let normal_view = gbuffer.normal.create_view(&Default::default());
-        let output_view = output.create_view(&Default::default());
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("specular"),
-            layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: nodes.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: prims.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: surfaces.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: grid.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: media.regions.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: direct_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: lights_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 8, resource: samples_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 9, resource: maps.views_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&maps_view) },
-                wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&normal_view) },
-                wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&output_view) },
-                wgpu::BindGroupEntry { binding: 13, resource: media.params_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 14, resource: accum.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 15, resource: status.as_entire_binding() },
-                wgpu::BindGroupEntry {
-                    binding: 16,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &slice_params,
-                        offset: 0,
-                        size: std::num::NonZeroU64::new(std::mem::size_of::<SliceParams>() as u64),
-                    }),
-                },
-            ],
-        });
+        let bindings = Bindings {
+            layout,
+            params: keep(&params_buffer),
+            nodes,
+            prims,
+            surfaces: keep(surfaces),
+            regions: keep(&media.regions),
+            direct: direct_buffer,
+            lights: lights_buffer,
+            samples: samples_buffer,
+            views: keep(&maps.views_buffer),
+            maps: maps_view,
+            normal: gbuffer.normal.create_view(&Default::default()),
+            output: output.create_view(&Default::default()),
+            media: keep(&media.params_buffer),
+            accum,
+            status: keep(&status),
+            slices: keep(&slice_params),
+        };
+        let bind_group = bindings.bind_group(device, &grid);
         let enabled = has_specular_surfaces(scene);
         SpecularPass {
             pipeline,
@@ -327,7 +393,37 @@ impl SpecularPass {
             params_buffer,
             iteration_budget,
             slices: std::cell::Cell::new(0),
+            bindings,
         }
+    }
+
+    /// Gathers from new photon maps from the next frame on (the same radii):
+    /// a new grid buffer and bind group, nothing else rebuilt.
+    pub fn set_photons(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, inputs: &SpecularInputs) {
+        let (words, grid_params) = PackedGrids::new(inputs);
+        let padded: &[u32] = if words.is_empty() { &[0; 12] } else { &words };
+        let grid = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("photon grids"),
+            contents: bytemuck::cast_slice(padded),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        self.params = SpecularParams {
+            power_unit: grid_params.power_unit,
+            global_buckets: grid_params.global_buckets,
+            global_start_offset: grid_params.global_start_offset,
+            global_photon_offset: grid_params.global_photon_offset,
+            caustic_buckets: grid_params.caustic_buckets,
+            caustic_start_offset: grid_params.caustic_start_offset,
+            caustic_photon_offset: grid_params.caustic_photon_offset,
+            volume_buckets: grid_params.volume_buckets,
+            volume_start_offset: grid_params.volume_start_offset,
+            volume_photon_offset: grid_params.volume_photon_offset,
+            volume_min: grid_params.volume_min,
+            volume_max: grid_params.volume_max,
+            ..self.params
+        };
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        self.bind_group = self.bindings.bind_group(device, &grid);
     }
 
     /// Casts its primary rays from `camera` (same resolution) from the next frame on.

@@ -1,5 +1,6 @@
-//! A moved camera (`GpuRenderer::set_camera`, what the viewer does every
-//! frame) draws what a renderer built for that camera draws.
+//! What the viewer changes between frames: a moved camera
+//! (`GpuRenderer::set_camera`) or a new photon set (`set_photons`) draws
+//! what a renderer built for it draws.
 
 use glam::Vec3;
 use hikari_core::camera::Camera;
@@ -64,4 +65,40 @@ fn moved_camera_draws_as_built_in_cornell_caustic() {
 #[test]
 fn moved_camera_draws_as_built_in_layered_fog() {
     assert_moved_camera_draws_as_built("fog-stage-layered");
+}
+
+/// Frames from a new photon set equal a renderer's built with that set:
+/// the specular grids, LOD outputs and power unit all follow.
+fn assert_new_photons_draw_as_built(name: &str) {
+    let mut scene = Scene::load(name).unwrap();
+    scene.camera = scene.camera.with_resolution(48, 40).unwrap();
+    let trace = |seed| trace_photons(&scene, &TraceSettings { photons: 5_000, seed, ..Default::default() }, &Silent);
+    let (first, second) = (trace(2), trace(3));
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let settings = GpuSettings::new(global, caustic);
+    let Some(ctx) = media_context(name, &scene) else { return };
+    let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &first, settings.clone()).expect("GPU renderer");
+    gpu.render().expect("first frame");
+    let (first_image, _) = gpu.read_image().unwrap();
+    gpu.set_photons(&scene, &second).unwrap();
+    gpu.render().expect("frame of the second set");
+    let (updated, _) = gpu.read_image().unwrap();
+    let built = GpuRenderer::new(ctx, &scene, &second, settings).expect("GPU renderer");
+    built.render().expect("frame");
+    let (built_image, _) = built.read_image().unwrap();
+    let differing = updated.pixels.iter().zip(&built_image.pixels).filter(|(a, b)| **a != **b).count();
+    let changed = updated.pixels.iter().zip(&first_image.pixels).filter(|(a, b)| **a != **b).count();
+    eprintln!("{name}: {differing} pixels differ from the built renderer, {changed} changed from the first set");
+    assert_eq!(differing, 0);
+    assert!(changed > updated.pixels.len() / 2, "the second set changed only {changed} pixels");
+}
+
+#[test]
+fn new_photons_draw_as_built_in_cornell_caustic() {
+    assert_new_photons_draw_as_built("cornell-caustic");
+}
+
+#[test]
+fn new_photons_draw_as_built_in_layered_fog() {
+    assert_new_photons_draw_as_built("fog-stage-layered");
 }
