@@ -299,3 +299,39 @@ fn view_without_a_display_says_so() {
     assert!(err.contains("hikari render"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
+
+/// Still means converging: with the camera still, each frame draws a fresh
+/// photon set and the window shows their mean, so two runs from different
+/// seeds come closer with more frames (noise ∝ 1/√frames: 8 frames should
+/// differ about 0.35 times as much as 1 frame).
+#[test]
+fn view_converges_while_the_camera_stands_still() {
+    let dir = scratch_dir("converge");
+    let run = |frames: &str, seed: &str, file: &str| {
+        let out = Command::new("xvfb-run")
+            .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_hikari")])
+            .args(["view", "cornell-box", "--size", "48x36", "--photons", "3000", "-q", "--seed", seed])
+            .args(["--frames", frames, "--screenshot", file])
+            .current_dir(&dir)
+            .output()
+            .expect("xvfb-run runs (scripts/test.sh installs Debian's xvfb)");
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(text.contains(&format!("{frames} photon sets drawn")), "{text}");
+        image::open(dir.join(file)).unwrap().to_rgb32f()
+    };
+    let rms = |a: &image::Rgb32FImage, b: &image::Rgb32FImage| {
+        let sum: f64 = a
+            .pixels()
+            .zip(b.pixels())
+            .flat_map(|(p, q)| (0..3).map(move |c| (p.0[c] - q.0[c]) as f64))
+            .map(|d| d * d)
+            .sum();
+        (sum / (a.len() as f64)).sqrt()
+    };
+    let one = rms(&run("1", "0", "a1.exr"), &run("1", "100", "b1.exr"));
+    let eight = rms(&run("8", "0", "a8.exr"), &run("8", "100", "b8.exr"));
+    eprintln!("RMS difference between seeds: 1 frame {one:.5}, 8 frames {eight:.5} (ratio {:.3})", eight / one);
+    assert!(one > 0.0);
+    assert!(eight < 0.55 * one, "8 frames {eight} vs 1 frame {one}");
+}

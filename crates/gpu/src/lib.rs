@@ -9,6 +9,7 @@
 //!
 //! Each pass is a small struct with its pipeline, its shader beside it.
 
+pub mod accumulate;
 pub mod binding;
 pub mod capabilities;
 pub mod context;

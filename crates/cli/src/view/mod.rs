@@ -1,6 +1,11 @@
 //! `hikari view`: the GPU renderer in a window, drawn straight to the
-//! swapchain, with an orbiting camera. The photon maps are traced once; a
-//! moved camera only updates the passes' uniforms (`GpuRenderer::set_camera`).
+//! swapchain, with an orbiting camera. A moved camera only updates the
+//! passes' uniforms (`GpuRenderer::set_camera`). While the camera stands
+//! still, a background thread traces fresh photon sets (seeds seed + 1,
+//! seed + 2, …, all cores) and the window shows the running mean of their
+//! frames (`AccumulatePass`), so the noise falls as you look; a move
+//! starts the mean over. With `--frames N` every frame waits for its own
+//! photon set, so the last frame is the mean of N sets, reproducibly.
 //!
 //! Controls: left drag orbits, middle or shift + left drag pans, the wheel
 //! zooms, Home resets the camera, C prints it as a `[camera]` table, F12
@@ -18,11 +23,13 @@ use hikari_core::output::write_image;
 use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::scene::{Scene, builtin};
+use hikari_gpu::accumulate::AccumulatePass;
 use hikari_gpu::present::PresentPass;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use orbit::Orbit;
 use std::path::PathBuf;
 use std::sync::Arc;
+use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 use std::time::Instant;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
@@ -88,6 +95,8 @@ struct Session {
     config: wgpu::SurfaceConfiguration,
     renderer: GpuRenderer,
     present: PresentPass,
+    /// The mean of the frames since the camera last moved.
+    mean: AccumulatePass,
 }
 
 struct Viewer {
@@ -96,6 +105,10 @@ struct Viewer {
     orbit: Orbit,
     traced: Option<TracedPhotons>,
     trace_seconds: f64,
+    /// Fresh photon sets from the tracing thread.
+    photon_sets: Option<Receiver<TracedPhotons>>,
+    /// Photon sets drawn so far.
+    sets_used: u64,
     session: Option<Session>,
     error: Option<anyhow::Error>,
     stats: FrameStats,
@@ -119,6 +132,8 @@ impl Viewer {
             scene,
             traced: None,
             trace_seconds: 0.0,
+            photon_sets: None,
+            sets_used: 0,
             session: None,
             error: None,
             stats: FrameStats::default(),
@@ -177,10 +192,36 @@ impl Viewer {
             self.traced = Some(trace_photons(&self.scene, &settings, &progress));
             self.trace_seconds = start.elapsed().as_secs_f64();
         }
+        if self.photon_sets.is_none() {
+            self.photon_sets = Some(self.start_tracing()?);
+            self.sets_used = 1;
+        }
         eprintln!("view: {} on {}", self.args.scene, ctx.describe());
         let present = PresentPass::new(&ctx.device, format);
         let renderer = self.renderer(ctx, width, height)?;
-        Ok(Session { window, surface, config, renderer, present })
+        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
+        Ok(Session { window, surface, config, renderer, present, mean })
+    }
+
+    /// A thread tracing photon sets of the scene with seeds seed + 1, seed + 2,
+    /// … (one set ahead of the window at most), until the window closes.
+    fn start_tracing(&self) -> Result<Receiver<TracedPhotons>> {
+        let scene = Scene::load(&self.args.scene).map_err(|e| UsageError(e.to_string()))?;
+        let (photons, seed) = (self.args.photons, self.args.seed);
+        let (sender, receiver) = sync_channel(1);
+        std::thread::Builder::new()
+            .name("photon sets".into())
+            .spawn(move || {
+                for k in 1.. {
+                    let settings = TraceSettings { photons, seed: seed.wrapping_add(k), ..Default::default() };
+                    let traced = trace_photons(&scene, &settings, &hikari_core::progress::Silent);
+                    if sender.send(traced).is_err() {
+                        return; // the window closed
+                    }
+                }
+            })
+            .map_err(|e| anyhow!("cannot start the photon-tracing thread: {e}"))?;
+        Ok(receiver)
     }
 
     /// A renderer for frames of `width × height` from the orbit's camera.
@@ -193,16 +234,48 @@ impl Viewer {
         Ok(GpuRenderer::new(ctx, scene, traced, settings)?)
     }
 
-    /// Renders and presents one frame.
+    /// The next photon set: waited for in unattended runs (after the first
+    /// frame), taken if ready otherwise.
+    fn next_photon_set(&mut self) -> Result<Option<TracedPhotons>> {
+        // The first frame draws the set the renderer was built with.
+        let (Some(sets), Some(_)) = (&self.photon_sets, self.last_frame) else { return Ok(None) };
+        let wait = self.args.frames.is_some();
+        let next = if wait {
+            Some(sets.recv().map_err(|_| anyhow!("the photon-tracing thread stopped"))?)
+        } else {
+            match sets.try_recv() {
+                Ok(traced) => Some(traced),
+                Err(TryRecvError::Empty) => None,
+                Err(TryRecvError::Disconnected) => return Err(anyhow!("the photon-tracing thread stopped")),
+            }
+        };
+        Ok(next)
+    }
+
+    /// Renders (when the camera moved or a new photon set came), adds the
+    /// frame to the mean, and presents the mean.
     fn frame(&mut self) -> Result<()> {
+        let new_set = self.next_photon_set()?;
         let Some(session) = &mut self.session else { return Ok(()) };
         let (width, height) = (session.config.width, session.config.height);
         let camera = self.orbit.camera(width, height);
-        if camera.position != session.renderer.camera().position || camera.look_at != session.renderer.camera().look_at
-        {
+        let moved = camera.position != session.renderer.camera().position
+            || camera.look_at != session.renderer.camera().look_at;
+        if moved {
             session.renderer.set_camera(&camera)?;
+            session.mean.reset();
         }
-        session.renderer.render()?;
+        if let Some(traced) = &new_set {
+            session.renderer.set_photons(&self.scene, traced)?;
+            self.sets_used += 1;
+        }
+        if moved || new_set.is_some() || session.mean.count() == 0 {
+            session.renderer.render()?;
+            let ctx = &session.renderer.ctx;
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            session.mean.record(&ctx.queue, &mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+        }
         let ctx = &session.renderer.ctx;
         let texture = match session.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -218,7 +291,7 @@ impl Viewer {
         let scopes = ctx.error_scopes();
         let view = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        session.present.record(&ctx.device, &mut encoder, session.renderer.resolved(), &view, self.args.exposure);
+        session.present.record(&ctx.device, &mut encoder, &session.mean.mean, &view, self.args.exposure);
         ctx.queue.submit([encoder.finish()]);
         session.window.pre_present_notify();
         ctx.queue.present(texture);
@@ -235,16 +308,21 @@ impl Viewer {
         }
         if self.title_updated.is_none_or(|t| (now - t).as_secs_f64() > 0.5) && self.stats.frames() > 0 {
             let fps = self.stats.mean_fps();
-            session.window.set_title(&format!("hikari view — {} — {fps:.1} fps", self.args.scene));
+            let frames = session.mean.count();
+            session.window.set_title(&format!("hikari view — {} — {fps:.1} fps — mean of {frames}", self.args.scene));
             self.title_updated = Some(now);
         }
         Ok(())
     }
 
-    /// Writes the current frame to `path` (PNG tone-mapped, EXR linear).
+    /// Writes the frame on screen (the mean) to `path` (PNG tone-mapped, EXR linear).
     fn screenshot(&self, path: &std::path::Path) -> Result<()> {
         let Some(session) = &self.session else { return Ok(()) };
-        let (image, _) = session.renderer.read_image()?;
+        let mut image = hikari_core::render::Image::new(session.config.width, session.config.height);
+        for (pixel, value) in image.pixels.iter_mut().zip(session.renderer.read(&session.mean.mean)?) {
+            let v = value.truncate();
+            *pixel = if v.is_finite() { v } else { glam::Vec3::ZERO };
+        }
         write_image(path, &image, self.args.exposure)?;
         eprintln!("view: wrote {}", path.display());
         Ok(())
@@ -259,14 +337,15 @@ impl Viewer {
             self.session = Some(session);
             return Ok(());
         }
-        let Session { window, surface, mut config, renderer, present } = session;
+        let Session { window, surface, mut config, renderer, present, .. } = session;
         config.width = size.width;
         config.height = size.height;
         let ctx = renderer.ctx.clone();
         drop(renderer);
         surface.configure(&ctx.device, &config);
         let renderer = self.renderer(ctx, size.width, size.height)?;
-        self.session = Some(Session { window, surface, config, renderer, present });
+        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
+        self.session = Some(Session { window, surface, config, renderer, present, mean });
         Ok(())
     }
 
@@ -282,10 +361,11 @@ impl Viewer {
             format!("camera move to screen {:.1} ms mean over {} moves", mean * 1e3, self.edit_latencies.len())
         };
         println!(
-            "view: {} frames in {seconds:.2} s: mean {:.2} fps, 1% low {:.2} fps; 1 photon set traced ({:.2} s); {latency}",
+            "view: {} frames in {seconds:.2} s: mean {:.2} fps, 1% low {:.2} fps; {} photon sets drawn (the first traced in {:.2} s); {latency}",
             self.stats.frames() + self.last_frame.is_some() as usize,
             self.stats.mean_fps(),
             self.stats.one_percent_low_fps(),
+            self.sets_used,
             self.trace_seconds,
         );
     }

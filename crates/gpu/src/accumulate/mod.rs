@@ -1,0 +1,103 @@
+//! The running mean of frames from independent photon sets: what the
+//! viewer shows while the camera stands still, so the noise of the photon
+//! maps falls as it looks (`count` frames: variance / count).
+
+use bytemuck::{Pod, Zeroable};
+
+const WORKGROUP: u32 = 8;
+pub const SHADER: &str = include_str!("accumulate.wgsl");
+
+/// Mirrors `AccumulateParams` in accumulate.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct AccumulateParams {
+    pub width: u32,
+    pub height: u32,
+    pub count: u32,
+    pub _pad: u32,
+}
+
+pub struct AccumulatePass {
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    width: u32,
+    height: u32,
+    /// Frames in the mean.
+    count: u32,
+    /// The mean so far (`Rgba32Float`).
+    pub mean: wgpu::Texture,
+}
+
+impl AccumulatePass {
+    /// Averages the frames `frame` will hold (an `Rgba32Float` texture,
+    /// e.g. `GpuRenderer::resolved`).
+    pub fn new(device: &wgpu::Device, frame: &wgpu::Texture) -> Self {
+        let (width, height) = (frame.width(), frame.height());
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("accumulate.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        use crate::binding::{entry, storage, storage_texture_rgba32f, texture, uniform};
+        let stage = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("accumulate"),
+            entries: &[
+                entry(0, stage, uniform()),
+                entry(1, stage, texture(wgpu::TextureViewDimension::D2)),
+                entry(2, stage, storage(false)),
+                entry(3, stage, storage_texture_rgba32f()),
+            ],
+        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "accumulate", &layout);
+        let pipeline = crate::binding::compute_pipeline(device, "accumulate", &pipeline_layout, &module, "main");
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accumulate params"),
+            size: std::mem::size_of::<AccumulateParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let sum = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accumulated sum"),
+            size: width as u64 * height as u64 * 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let mean = crate::binding::storage_output_texture(device, "accumulated mean", width, height);
+        let frame_view = frame.create_view(&Default::default());
+        let mean_view = mean.create_view(&Default::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("accumulate"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&frame_view) },
+                wgpu::BindGroupEntry { binding: 2, resource: sum.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&mean_view) },
+            ],
+        });
+        AccumulatePass { pipeline, bind_group, params, width, height, count: 0, mean }
+    }
+
+    /// Frames in the mean.
+    pub fn count(&self) -> u32 {
+        self.count
+    }
+
+    /// Starts a new mean with the next frame (the camera or scene changed).
+    pub fn reset(&mut self) {
+        self.count = 0;
+    }
+
+    /// Adds the current frame to the mean.
+    pub fn record(&mut self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder) {
+        self.count += 1;
+        let params = AccumulateParams { width: self.width, height: self.height, count: self.count, _pad: 0 };
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("accumulate"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+    }
+}

@@ -1,0 +1,49 @@
+//! The viewer's running mean: frames of independent photon sets averaged on
+//! the GPU equal the mean of the same frames read back, and a reset starts
+//! over.
+
+use glam::Vec3;
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::render::photon_cpu::PhotonCpuSettings;
+use hikari_core::scene::Scene;
+use hikari_gpu::accumulate::AccumulatePass;
+use hikari_gpu::test_support::test_context;
+use hikari_gpu::{GpuRenderer, GpuSettings};
+
+#[test]
+fn the_running_mean_is_the_mean_of_the_frames() {
+    let ctx = test_context("accumulate");
+    let mut scene = Scene::load("cornell-caustic").unwrap();
+    scene.camera = scene.camera.with_resolution(40, 32).unwrap();
+    let trace = |seed| trace_photons(&scene, &TraceSettings { photons: 3_000, seed, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &trace(1), GpuSettings::new(global, caustic)).unwrap();
+    let mut mean = AccumulatePass::new(&ctx.device, gpu.resolved());
+    let mut frames = Vec::new();
+    for seed in 1..=4 {
+        if seed > 1 {
+            gpu.set_photons(&scene, &trace(seed)).unwrap();
+        }
+        gpu.render().unwrap();
+        frames.push(gpu.read_image().unwrap().0);
+        if seed == 3 {
+            // What came before the reset is forgotten.
+            mean.reset();
+            frames.drain(..2);
+        }
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        mean.record(&ctx.queue, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+    }
+    assert_eq!(mean.count(), 2);
+    let got = gpu.read(&mean.mean).unwrap();
+    let mut worst = 0.0f32;
+    for (i, g) in got.iter().enumerate() {
+        let want = frames.iter().map(|f| f.pixels[i]).sum::<Vec3>() / frames.len() as f32;
+        worst = worst.max((g.truncate() - want).abs().max_element() / want.max_element().max(1e-3));
+    }
+    let differ = frames[0].pixels.iter().zip(&frames[1].pixels).filter(|(a, b)| a != b).count();
+    assert!(differ > 500, "the two photon sets gave nearly the same frame ({differ} pixels differ)");
+    assert!(worst < 1e-6, "worst relative difference {worst}");
+}
