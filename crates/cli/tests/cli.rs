@@ -335,3 +335,48 @@ fn view_converges_while_the_camera_stands_still() {
     assert!(one > 0.0);
     assert!(eight < 0.55 * one, "8 frames {eight} vs 1 frame {one}");
 }
+
+/// The controls, driven like a user under Xvfb with xdotool (installed by
+/// scripts/test.sh): fly forward (W), print the camera (C), orbit (left
+/// drag), quit (Escape). The printed camera is a moved one and the summary
+/// counts the moves.
+#[test]
+fn view_follows_keys_and_mouse() {
+    let dir = scratch_dir("drive");
+    let script = r#"
+"$1" view cornell-box --size 64x48 --photons 2000 --frames 100000 -q > out.txt 2> err.txt &
+pid=$!
+win=$(xdotool search --sync --name "hikari view")
+xdotool windowfocus --sync "$win"
+sleep 0.5
+xdotool keydown w; sleep 0.8; xdotool keyup w
+sleep 0.3
+xdotool mousemove --window "$win" 30 20 mousedown 1 mousemove --window "$win" 50 25 mouseup 1
+sleep 0.3
+xdotool key c
+sleep 0.5
+xdotool key Escape
+wait $pid
+"#;
+    let out = Command::new("timeout")
+        .args(["120", "xvfb-run", "-a", "-s", "-screen 0 640x480x24", "sh", "-c", script, "sh"])
+        .arg(env!("CARGO_BIN_EXE_hikari"))
+        .current_dir(&dir)
+        .output()
+        .expect("xvfb-run and xdotool run (scripts/test.sh installs them)");
+    let text = std::fs::read_to_string(dir.join("out.txt")).unwrap_or_default();
+    let err = std::fs::read_to_string(dir.join("err.txt")).unwrap_or_default();
+    assert!(out.status.success(), "{err}{}", stderr(&out));
+    let printed = text.split("[camera]").nth(1).expect("C printed the camera");
+    let z: f32 = printed
+        .lines()
+        .find_map(|l| l.strip_prefix("position = ["))
+        .and_then(|v| v.trim_end_matches(']').split(',').nth(2))
+        .and_then(|z| z.trim().parse().ok())
+        .expect("a position line");
+    // cornell-box's eye is at z = 3.9, looking toward -z: flying forward lowers z.
+    assert!(z < 3.85, "the eye did not fly forward: z = {z}\n{text}");
+    let moves: usize =
+        text.split("over ").nth(1).and_then(|t| t.split(' ').next()).and_then(|n| n.parse().ok()).unwrap_or(0);
+    assert!(moves >= 2, "{text}");
+}

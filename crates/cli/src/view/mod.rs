@@ -8,7 +8,9 @@
 //! photon set, so the last frame is the mean of N sets, reproducibly.
 //!
 //! Controls: left drag orbits, middle or shift + left drag pans, the wheel
-//! zooms, Home resets the camera, C prints it as a `[camera]` table, F12
+//! zooms; right drag turns in place and WASD/QE fly (the wheel sets the
+//! flying speed while the right button is held); Home resets the camera, C
+//! prints it as a `[camera]` table, T prints the passes' GPU times, F12
 //! writes a PNG and an EXR of the frame, Escape quits.
 
 mod frame_stats;
@@ -120,12 +122,18 @@ struct Viewer {
     cursor: PhysicalPosition<f64>,
     dragging: Option<MouseButton>,
     shift: bool,
+    /// Fly keys held (W, S, D, A, E, Q) and the flying speed (scene units/s).
+    flying: [bool; 6],
+    fly_speed: f32,
+    /// When the fly keys were last applied.
+    last_fly: Option<Instant>,
     screenshots: u32,
     title_updated: Option<Instant>,
 }
 
 impl Viewer {
     fn new(args: ViewArgs, scene: Scene) -> Self {
+        let fly_speed = 0.25 * scene.diagonal();
         Viewer {
             orbit: Orbit::new(&scene.camera),
             args,
@@ -144,6 +152,9 @@ impl Viewer {
             cursor: PhysicalPosition::new(0.0, 0.0),
             dragging: None,
             shift: false,
+            flying: [false; 6],
+            fly_speed,
+            last_fly: None,
             screenshots: 0,
             title_updated: None,
         }
@@ -252,9 +263,24 @@ impl Viewer {
         Ok(next)
     }
 
+    /// Moves the eye for the fly keys held since the last frame.
+    fn fly(&mut self) {
+        let now = Instant::now();
+        let dt = self.last_fly.map_or(0.0, |t| (now - t).as_secs_f32().min(0.25));
+        self.last_fly = Some(now);
+        let [w, s, d, a, e, q] = self.flying.map(|held| held as i32 as f32);
+        if w + s + d + a + e + q == 0.0 {
+            return;
+        }
+        let step = self.fly_speed * dt;
+        self.orbit.fly((w - s) * step, (d - a) * step, (e - q) * step);
+        self.edited();
+    }
+
     /// Renders (when the camera moved or a new photon set came), adds the
     /// frame to the mean, and presents the mean.
     fn frame(&mut self) -> Result<()> {
+        self.fly();
         let new_set = self.next_photon_set()?;
         let Some(session) = &mut self.session else { return Ok(()) };
         let (width, height) = (session.config.width, session.config.height);
@@ -388,6 +414,15 @@ impl Viewer {
                     self.screenshot(&PathBuf::from(format!("hikari-view-{}.{ext}", self.screenshots)))?;
                 }
             }
+            Key::Character(c) if c.eq_ignore_ascii_case("t") => {
+                if let Some(s) = &self.session {
+                    let (times, timestamps) = s.renderer.render_timed()?;
+                    let parts: Vec<String> =
+                        times.iter().map(|(stage, t)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
+                    let how = if timestamps { "GPU timestamps" } else { "wall clock" };
+                    println!("view: per pass ({how}): {}", parts.join(", "));
+                }
+            }
             Key::Character(c) if c.eq_ignore_ascii_case("c") => {
                 if let Some(s) = &self.session {
                     println!("{}", self.orbit.toml(s.config.width, s.config.height));
@@ -446,6 +481,7 @@ impl ApplicationHandler for Viewer {
                     Some(MouseButton::Left) if self.shift => self.orbit.pan(dx, dy, height),
                     Some(MouseButton::Middle) => self.orbit.pan(dx, dy, height),
                     Some(MouseButton::Left) => self.orbit.rotate(dx, dy),
+                    Some(MouseButton::Right) => self.orbit.look(dx, dy),
                     _ => return,
                 }
                 self.edited();
@@ -456,12 +492,22 @@ impl ApplicationHandler for Viewer {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
                 };
-                self.orbit.zoom(lines);
-                self.edited();
+                if self.dragging == Some(MouseButton::Right) {
+                    self.fly_speed = (self.fly_speed * 1.25f32.powf(lines)).clamp(1e-6, 1e7);
+                } else {
+                    self.orbit.zoom(lines);
+                    self.edited();
+                }
                 Ok(())
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                self.key(event_loop, &event.logical_key)
+            WindowEvent::KeyboardInput { event, .. } => {
+                let pressed = event.state == ElementState::Pressed;
+                if let Key::Character(c) = &event.logical_key {
+                    if let Some(i) = "wsdaeq".find(c.to_ascii_lowercase().as_str()).filter(|_| c.len() == 1) {
+                        self.flying[i] = pressed;
+                    }
+                }
+                if pressed { self.key(event_loop, &event.logical_key) } else { Ok(()) }
             }
             _ => Ok(()),
         };

@@ -1,6 +1,7 @@
 //! The viewer's camera: orbit around a target (left drag), pan (middle or
-//! shift drag), zoom (wheel), reset (Home), and the current view as a
-//! `[camera]` block for a scene file.
+//! shift drag), zoom (wheel), fly (turn in place with right drag, move with
+//! WASD/QE), reset (Home), and the current view as a `[camera]` block for
+//! a scene file.
 
 use glam::Vec3;
 use hikari_core::camera::Camera;
@@ -61,6 +62,21 @@ impl Orbit {
     pub fn rotate(&mut self, dx: f32, dy: f32) {
         self.yaw -= dx * ORBIT_SPEED;
         self.pitch = (self.pitch + dy * ORBIT_SPEED).clamp(-MAX_PITCH, MAX_PITCH);
+    }
+
+    /// A right drag of (dx, dy) pixels turns the view with the eye fixed.
+    pub fn look(&mut self, dx: f32, dy: f32) {
+        let eye = self.position();
+        self.rotate(dx, dy);
+        self.target += eye - self.position();
+    }
+
+    /// Moves eye and target by `forward`, `right` and `up` scene units
+    /// along the view's axes.
+    pub fn fly(&mut self, forward: f32, right: f32, up: f32) {
+        let camera = self.camera(1, 1);
+        let (f, r, u, _) = camera.basis();
+        self.target += f * forward + r * right + u * up;
     }
 
     /// A drag of (dx, dy) pixels moves target and eye across the view, by
@@ -124,6 +140,19 @@ mod tests {
         orbit.camera(64, 48); // still a valid camera at the pole limit
         orbit.reset();
         assert!((orbit.position() - camera().position).length() < 1e-5);
+    }
+
+    #[test]
+    fn looking_keeps_the_eye_and_flying_keeps_the_view() {
+        let mut orbit = Orbit::new(&camera());
+        let eye = orbit.position();
+        orbit.look(50.0, 20.0);
+        assert!((orbit.position() - eye).length() < 1e-4);
+        assert!((orbit.target - camera().look_at).length() > 0.1);
+        let forward = orbit.camera(64, 48).basis().0;
+        orbit.fly(0.5, 0.0, 0.0);
+        assert!((orbit.position() - (eye + forward * 0.5)).length() < 1e-4);
+        assert!((orbit.camera(64, 48).basis().0 - forward).length() < 1e-5);
     }
 
     #[test]
