@@ -380,3 +380,43 @@ wait $pid
         text.split("over ").nth(1).and_then(|t| t.split(' ').next()).and_then(|n| n.parse().ok()).unwrap_or(0);
     assert!(moves >= 2, "{text}");
 }
+
+/// Hot reload: saving the scene file reloads it; a broken save prints the
+/// error with its place and keeps the last good scene on screen.
+#[test]
+fn view_reloads_the_scene_file() {
+    let dir = scratch_dir("reload");
+    std::fs::write(dir.join("scene.toml"), SCENE).unwrap();
+    std::fs::write(dir.join("broken.toml"), SCENE.replace("radius = 1.0", "radius = = 1.0")).unwrap();
+    std::fs::write(
+        dir.join("brighter.toml"),
+        SCENE.replace("intensity = [5.0, 5.0, 5.0]", "intensity = [9.0, 9.0, 9.0]"),
+    )
+    .unwrap();
+    let script = r#"
+"$1" view scene.toml --size 48x36 --photons 2000 --frames 100000 -q > out.txt 2> err.txt &
+pid=$!
+win=$(xdotool search --sync --name "hikari view")
+xdotool windowfocus --sync "$win"
+sleep 0.6
+cp broken.toml scene.toml
+sleep 1.0
+cp brighter.toml scene.toml
+sleep 1.5
+xdotool key Escape
+wait $pid
+"#;
+    let out = Command::new("timeout")
+        .args(["120", "xvfb-run", "-a", "-s", "-screen 0 640x480x24", "sh", "-c", script, "sh"])
+        .arg(env!("CARGO_BIN_EXE_hikari"))
+        .current_dir(&dir)
+        .output()
+        .expect("xvfb-run and xdotool run (scripts/test.sh installs them)");
+    let err = std::fs::read_to_string(dir.join("err.txt")).unwrap_or_default();
+    assert!(out.status.success(), "{err}{}", stderr(&out));
+    assert!(!err.contains("panicked"), "{err}");
+    let broken = err.find("scene.toml:15:10").expect("the broken save's error, located");
+    assert!(err[broken..].contains("the last good scene stays"), "{err}");
+    let reloaded = err.find("view: reloaded scene.toml").expect("the fixed save reloaded");
+    assert!(reloaded > broken, "{err}");
+}

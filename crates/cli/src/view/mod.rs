@@ -12,6 +12,10 @@
 //! flying speed while the right button is held); Home resets the camera, C
 //! prints it as a `[camera]` table, T prints the passes' GPU times, F12
 //! writes a PNG and an EXR of the frame, Escape quits.
+//!
+//! A scene file is watched: saving it reloads the scene (the camera kept);
+//! a file with an error prints it (`FILE:LINE:COLUMN`, also in the title)
+//! and the last good scene stays on screen.
 
 mod frame_stats;
 mod orbit;
@@ -127,6 +131,11 @@ struct Viewer {
     fly_speed: f32,
     /// When the fly keys were last applied.
     last_fly: Option<Instant>,
+    /// The scene file's modification time (None for built-in scenes).
+    watched: Option<std::time::SystemTime>,
+    last_watch: Option<Instant>,
+    /// The error of the last reload that failed, shown in the title.
+    reload_error: Option<String>,
     screenshots: u32,
     title_updated: Option<Instant>,
 }
@@ -134,7 +143,9 @@ struct Viewer {
 impl Viewer {
     fn new(args: ViewArgs, scene: Scene) -> Self {
         let fly_speed = 0.25 * scene.diagonal();
+        let watched = modified(&args.scene);
         Viewer {
+            watched,
             orbit: Orbit::new(&scene.camera),
             args,
             scene,
@@ -155,6 +166,8 @@ impl Viewer {
             flying: [false; 6],
             fly_speed,
             last_fly: None,
+            last_watch: None,
+            reload_error: None,
             screenshots: 0,
             title_updated: None,
         }
@@ -263,6 +276,48 @@ impl Viewer {
         Ok(next)
     }
 
+    /// Reloads the scene file when it changed (checked four times a second).
+    fn watch(&mut self) -> Result<()> {
+        let now = Instant::now();
+        if self.watched.is_none() || self.last_watch.is_some_and(|t| (now - t).as_secs_f32() < 0.25) {
+            return Ok(());
+        }
+        self.last_watch = Some(now);
+        let stamp = modified(&self.args.scene);
+        if stamp == self.watched || stamp.is_none() {
+            return Ok(());
+        }
+        self.watched = stamp;
+        let scene = match Scene::load(&self.args.scene) {
+            Ok(scene) => scene,
+            Err(e) => {
+                eprintln!("view: {e} (the last good scene stays)");
+                self.reload_error = Some(e.to_string());
+                return Ok(());
+            }
+        };
+        self.reload_error = None;
+        let Some(session) = self.session.take() else { return Ok(()) };
+        let Session { window, surface, config, renderer, present, .. } = session;
+        let ctx = renderer.ctx.clone();
+        drop(renderer);
+        // The new scene with the current camera, its first photon set now,
+        // the next ones from a new tracing thread (the old one ends when
+        // its channel closes).
+        self.scene = scene;
+        let settings = TraceSettings { photons: self.args.photons, seed: self.args.seed, ..Default::default() };
+        self.traced = Some(trace_photons(&self.scene, &settings, &hikari_core::progress::Silent));
+        self.photon_sets = Some(self.start_tracing()?);
+        self.sets_used = 1;
+        let renderer = self.renderer(ctx, config.width, config.height)?;
+        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
+        self.session = Some(Session { window, surface, config, renderer, present, mean });
+        self.last_frame = None;
+        self.edited();
+        eprintln!("view: reloaded {}", self.args.scene);
+        Ok(())
+    }
+
     /// Moves the eye for the fly keys held since the last frame.
     fn fly(&mut self) {
         let now = Instant::now();
@@ -280,6 +335,7 @@ impl Viewer {
     /// Renders (when the camera moved or a new photon set came), adds the
     /// frame to the mean, and presents the mean.
     fn frame(&mut self) -> Result<()> {
+        self.watch()?;
         self.fly();
         let new_set = self.next_photon_set()?;
         let Some(session) = &mut self.session else { return Ok(()) };
@@ -335,7 +391,10 @@ impl Viewer {
         if self.title_updated.is_none_or(|t| (now - t).as_secs_f64() > 0.5) && self.stats.frames() > 0 {
             let fps = self.stats.mean_fps();
             let frames = session.mean.count();
-            session.window.set_title(&format!("hikari view — {} — {fps:.1} fps — mean of {frames}", self.args.scene));
+            let error = self.reload_error.as_ref().map_or(String::new(), |e| format!(" — error: {e}"));
+            session
+                .window
+                .set_title(&format!("hikari view — {} — {fps:.1} fps — mean of {frames}{error}", self.args.scene));
             self.title_updated = Some(now);
         }
         Ok(())
@@ -521,4 +580,12 @@ impl ApplicationHandler for Viewer {
             session.window.request_redraw();
         }
     }
+}
+
+/// The modification time of the scene file `spec` (None for built-ins).
+fn modified(spec: &str) -> Option<std::time::SystemTime> {
+    if builtin::source(spec).is_some() {
+        return None;
+    }
+    std::fs::metadata(spec).and_then(|m| m.modified()).ok()
 }
