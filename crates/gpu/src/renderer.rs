@@ -4,7 +4,7 @@
 
 use crate::context::{GpuContext, GpuError};
 use crate::direct::DirectPass;
-use crate::gbuffer::{GBuffer, GBufferParams, GBufferPass};
+use crate::gbuffer::{GBuffer, GBufferBinding, GBufferParams, GBufferPass};
 use crate::lod::{LodOutput, LodPass};
 use crate::media::GpuMedia;
 use crate::memory::FrameSize;
@@ -14,7 +14,7 @@ use crate::scene_upload::SceneBuffers;
 use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
-use crate::splat::{PhotonBuffer, SplatParams, SplatPass};
+use crate::splat::{PhotonBuffer, SplatBinding, SplatParams, SplatPass};
 use crate::volume::{VolumeParams, VolumePass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
@@ -129,16 +129,19 @@ impl Stage {
 pub struct GpuRenderer {
     pub ctx: GpuContext,
     gbuffer_pass: GBufferPass,
+    gbuffer_binding: GBufferBinding,
     splat_pass: SplatPass,
+    global_splat: SplatBinding,
+    caustic_splat: SplatBinding,
     shadow_pass: ShadowPass,
     direct_pass: DirectPass,
+    direct_binding: wgpu::BindGroup,
     specular_pass: SpecularPass,
     resolve_pass: ResolvePass,
     media: GpuMedia,
     volume_pass: VolumePass,
     volume_lod: LodOutput,
     has_media: bool,
-    lights: GpuLights,
     scene: SceneBuffers,
     lod_pass: LodPass,
     global_lod: LodOutput,
@@ -327,6 +330,9 @@ impl GpuRenderer {
             _pad0: 0,
             _pad1: 0,
         };
+        let gbuffer_pass = GBufferPass::new(device, ctx.gbuffer_storage);
+        let splat_pass = SplatPass::new(device, ctx.radiance_format);
+        let direct_pass = DirectPass::new(device, ctx.radiance_format);
         let volume_pass = VolumePass::new(device, ctx.radiance_format, &volume_params, &media, &targets.gbuffer);
         let t = &targets;
         let resolve_pass = ResolvePass::new(
@@ -339,11 +345,21 @@ impl GpuRenderer {
         GpuRenderer {
             resolve_pass,
             specular_pass,
-            gbuffer_pass: GBufferPass::new(device, ctx.gbuffer_storage),
-            splat_pass: SplatPass::new(device, ctx.radiance_format),
-            direct_pass: DirectPass::new(device, ctx.radiance_format),
+            gbuffer_binding: gbuffer_pass.bind(device, &scene_buffers, &targets.gbuffer),
+            gbuffer_pass,
+            global_splat: splat_pass.bind(device, &targets.gbuffer),
+            caustic_splat: splat_pass.bind(device, &targets.gbuffer),
+            splat_pass,
+            direct_binding: direct_pass.bind(
+                device,
+                &targets.gbuffer,
+                &lights,
+                &targets.shadow_maps,
+                settings.shadow_bias,
+                &media,
+            ),
+            direct_pass,
             shadow_pass,
-            lights,
             scene: scene_buffers,
             global_lod: lod_pass
                 .create_output(device, &PhotonBuffer::upload(device, &traced.indirect(), "global photons")),
@@ -560,15 +576,18 @@ impl GpuRenderer {
     }
 
     fn record_stage(&self, stage: Stage, encoder: &mut wgpu::CommandEncoder) {
-        let device = &self.ctx.device;
+        let queue = &self.ctx.queue;
         let lod = self.settings.lod.as_ref();
-        let splat =
-            |encoder: &mut wgpu::CommandEncoder, output: &LodOutput, estimate: &FixedRadius, target: &wgpu::Texture| {
-                self.lod_pass.record(&self.ctx.queue, encoder, output, self.camera_position, lod);
-                let view = target.create_view(&Default::default());
-                let params = self.splat_params(estimate);
-                self.splat_pass.record(device, encoder, &self.targets.gbuffer, output, &params, &view, true);
-            };
+        let splat = |encoder: &mut wgpu::CommandEncoder,
+                     binding: &SplatBinding,
+                     output: &LodOutput,
+                     estimate: &FixedRadius,
+                     target: &wgpu::Texture| {
+            self.lod_pass.record(queue, encoder, output, self.camera_position, lod);
+            let view = target.create_view(&Default::default());
+            let params = self.splat_params(estimate);
+            self.splat_pass.record(queue, encoder, binding, output, &params, &view, true);
+        };
         match stage {
             Stage::GBuffer => {
                 let params = GBufferParams {
@@ -576,27 +595,21 @@ impl GpuRenderer {
                     camera_position: self.camera_position.to_array(),
                     _pad: 0.0,
                 };
-                self.gbuffer_pass.record(device, encoder, &self.scene, &params, &self.targets.gbuffer);
+                let t = &self.targets;
+                self.gbuffer_pass.record(queue, encoder, &self.scene, &self.gbuffer_binding, &params, &t.gbuffer);
             }
             Stage::Shadows => self.shadow_pass.record(encoder, &self.scene, &self.targets.shadow_maps),
             Stage::OpticalDepth => self.media.record(encoder),
             Stage::Direct => {
                 let view = self.targets.direct.create_view(&Default::default());
-                let bias = self.settings.shadow_bias;
-                let t = &self.targets;
-                self.direct_pass.record(
-                    device,
-                    encoder,
-                    &t.gbuffer,
-                    &self.lights,
-                    &t.shadow_maps,
-                    bias,
-                    &self.media,
-                    &view,
-                );
+                self.direct_pass.record(encoder, &self.direct_binding, &view);
             }
-            Stage::GlobalSplat => splat(encoder, &self.global_lod, &self.settings.global, &self.targets.indirect),
-            Stage::CausticSplat => splat(encoder, &self.caustic_lod, &self.settings.caustic, &self.targets.caustic),
+            Stage::GlobalSplat => {
+                splat(encoder, &self.global_splat, &self.global_lod, &self.settings.global, &self.targets.indirect)
+            }
+            Stage::CausticSplat => {
+                splat(encoder, &self.caustic_splat, &self.caustic_lod, &self.settings.caustic, &self.targets.caustic)
+            }
             Stage::VolumeSplat => {
                 // Without media the target is only cleared: the resolve reads it.
                 if self.has_media {

@@ -14,12 +14,13 @@ pub fn test_context(test: &str) -> GpuContext {
     })
 }
 
-/// The context for a test of a scene with media, or None where the adapter
-/// cannot blend 32-bit floats (Mesa's GL): there the renderer must refuse
-/// the scene (the CLI then renders it with photon-cpu), which this asserts.
+/// The context for a test of `scene`, or None when it has media and the
+/// adapter cannot blend 32-bit floats (Mesa's GL): there the renderer must
+/// refuse the scene (the CLI then renders it with photon-cpu), which this
+/// asserts.
 pub fn media_context(test: &str, scene: &Scene) -> Option<GpuContext> {
     let ctx = test_context(test);
-    if ctx.float32_blend {
+    if ctx.float32_blend || scene.media.is_empty() {
         return Some(ctx);
     }
     let why = GpuRenderer::unsupported(&ctx, scene).expect("media refused without f32 blending");

@@ -95,18 +95,17 @@ impl DirectPass {
         DirectPass { pipeline, layout }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
+    /// The bind group of frames over `gbuffer` with these lights, shadow
+    /// maps and media, made once (all of it is static between frames).
+    pub fn bind(
         &self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         gbuffer: &GBuffer,
         lights: &GpuLights,
         maps: &ShadowMaps,
         bias: f32,
         media: &crate::media::GpuMedia,
-        target: &wgpu::TextureView,
-    ) {
+    ) -> wgpu::BindGroup {
         let params = DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, _pad: 0 };
         let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("direct params"),
@@ -129,7 +128,7 @@ impl DirectPass {
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("direct"),
             layout: &self.layout,
             entries: &[
@@ -144,10 +143,14 @@ impl DirectPass {
                 wgpu::BindGroupEntry { binding: 8, resource: media.params_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() },
             ],
-        });
+        })
+    }
+
+    /// Shades every pixel of `target` with the bind group of `bind`.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, bind_group: &wgpu::BindGroup, target: &wgpu::TextureView) {
         let mut pass = crate::binding::color_pass(encoder, "direct light", target, true);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(0, bind_group, &[]);
         pass.draw(0..3, 0..1);
     }
 }

@@ -3,7 +3,6 @@
 
 use crate::scene_upload::{GpuVertex, SceneBuffers};
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 /// Mirrors `GBufferParams` in gbuffer.wgsl.
 #[repr(C)]
@@ -81,6 +80,13 @@ impl GBuffer {
             depth,
         }
     }
+}
+
+/// A `GBufferPass`'s per-target state, kept between frames.
+pub struct GBufferBinding {
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    views: Vec<wgpu::TextureView>,
 }
 
 pub struct GBufferPass {
@@ -164,18 +170,13 @@ impl GBufferPass {
         GBufferPass { layout, mode }
     }
 
-    pub fn record(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &SceneBuffers,
-        params: &GBufferParams,
-        gbuffer: &GBuffer,
-    ) {
-        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    /// The uniforms and bind group of frames into `gbuffer`, made once.
+    pub fn bind(&self, device: &wgpu::Device, scene: &SceneBuffers, gbuffer: &GBuffer) -> GBufferBinding {
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("gbuffer params"),
-            contents: bytemuck::bytes_of(params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            size: std::mem::size_of::<GBufferParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
         let views: Vec<wgpu::TextureView> = [&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission]
             .iter()
@@ -196,6 +197,21 @@ impl GBufferPass {
             layout: &self.layout,
             entries: &entries,
         });
+        GBufferBinding { uniforms, bind_group, views }
+    }
+
+    /// Draws the scene into `gbuffer` as seen with `params` (written now).
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &SceneBuffers,
+        binding: &GBufferBinding,
+        params: &GBufferParams,
+        gbuffer: &GBuffer,
+    ) {
+        queue.write_buffer(&binding.uniforms, 0, bytemuck::bytes_of(params));
+        let (bind_group, views) = (&binding.bind_group, &binding.views);
         let depth_view = gbuffer.depth.create_view(&Default::default());
         let draw = |encoder: &mut wgpu::CommandEncoder,
                     pipeline: &wgpu::RenderPipeline,
@@ -214,7 +230,7 @@ impl GBufferPass {
                 multiview_mask: None,
             });
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(0, bind_group, &[]);
             pass.set_vertex_buffer(0, scene.vertices.slice(..));
             pass.draw(0..scene.vertex_count, 0..1);
         };

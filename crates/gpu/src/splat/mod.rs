@@ -110,6 +110,12 @@ impl PhotonBuffer {
     }
 }
 
+/// One map's splat state (its uniforms and bind group), kept between frames.
+pub struct SplatBinding {
+    uniforms: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
 pub struct SplatPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
@@ -138,23 +144,13 @@ impl SplatPass {
         SplatPass { pipeline, layout }
     }
 
-    /// Adds the surviving photons' radiance (counted by the LOD pass) into `target` (loaded, not cleared, when
-    /// `clear` is false, so several maps can accumulate).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        gbuffer: &GBuffer,
-        photons: &crate::lod::LodOutput,
-        params: &SplatParams,
-        target: &wgpu::TextureView,
-        clear: bool,
-    ) {
-        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    /// The uniforms and bind group of one map's splat over `gbuffer`, made once.
+    pub fn bind(&self, device: &wgpu::Device, gbuffer: &GBuffer) -> SplatBinding {
+        let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("splat params"),
-            contents: bytemuck::bytes_of(params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            size: std::mem::size_of::<SplatParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
@@ -168,9 +164,28 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&albedo) },
             ],
         });
+        SplatBinding { uniforms, bind_group }
+    }
+
+    /// Adds the surviving photons' radiance (counted by the LOD pass) into
+    /// `target` (loaded, not cleared, when `clear` is false, so several maps
+    /// can accumulate), with `params` (written now into `binding`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        binding: &SplatBinding,
+        photons: &crate::lod::LodOutput,
+        params: &SplatParams,
+        target: &wgpu::TextureView,
+        clear: bool,
+    ) {
+        queue.write_buffer(&binding.uniforms, 0, bytemuck::bytes_of(params));
+        let bind_group = &binding.bind_group;
         let mut pass = crate::binding::color_pass(encoder, "photon splat", target, clear);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, photons.survivors.slice(..));
         pass.draw_indirect(&photons.draw_args, 0);
     }
