@@ -337,9 +337,9 @@ fn view_converges_while_the_camera_stands_still() {
 }
 
 /// The controls, driven like a user under Xvfb with xdotool (installed by
-/// scripts/test.sh): fly forward (W), print the camera (C), orbit (left
-/// drag), quit (Escape). The printed camera is a moved one and the summary
-/// counts the moves.
+/// scripts/test.sh): hide the panel (F1), fly forward (W), orbit (left
+/// drag), print the camera (C), quit (Escape). The printed camera has
+/// flown and turned, and the summary counts the moves.
 #[test]
 fn view_follows_keys_and_mouse() {
     let dir = scratch_dir("drive");
@@ -349,6 +349,8 @@ pid=$!
 win=$(xdotool search --sync --name "hikari view")
 xdotool windowfocus --sync "$win"
 sleep 0.5
+xdotool key F1
+sleep 0.2
 xdotool keydown w; sleep 0.8; xdotool keyup w
 sleep 0.3
 xdotool mousemove --window "$win" 30 20 mousedown 1 mousemove --window "$win" 50 25 mouseup 1
@@ -376,6 +378,14 @@ wait $pid
         .expect("a position line");
     // cornell-box's eye is at z = 3.9, looking toward -z: flying forward lowers z.
     assert!(z < 3.85, "the eye did not fly forward: z = {z}\n{text}");
+    let x: f32 = printed
+        .lines()
+        .find_map(|l| l.strip_prefix("position = ["))
+        .and_then(|v| v.split(',').next())
+        .and_then(|x| x.trim().parse().ok())
+        .expect("a position line");
+    // The drag to the right orbits the eye to -x.
+    assert!(x < -0.05, "the eye did not orbit: x = {x}\n{text}");
     let moves: usize =
         text.split("over ").nth(1).and_then(|t| t.split(' ').next()).and_then(|n| n.parse().ok()).unwrap_or(0);
     assert!(moves >= 2, "{text}");

@@ -43,6 +43,8 @@ pub struct GpuSettings {
     pub volume_radius: f32,
     /// Optical-depth slices along each view ray through region media.
     pub volume_slices: u32,
+    /// The terms the frame holds (all by default; the viewer toggles them).
+    pub terms: crate::resolve::Terms,
 }
 
 impl GpuSettings {
@@ -57,6 +59,7 @@ impl GpuSettings {
             max_specular_depth: 8,
             volume_radius: global.radius,
             volume_slices: 8,
+            terms: crate::resolve::Terms::ALL,
         }
     }
 }
@@ -620,7 +623,7 @@ impl GpuRenderer {
                 self.volume_pass.record(encoder, photons, &view, self.has_media);
             }
             Stage::Specular => self.specular_pass.record(&self.ctx.queue, encoder),
-            Stage::Resolve => self.resolve_pass.record(encoder),
+            Stage::Resolve => self.resolve_pass.record(queue, encoder, &self.settings.terms),
         }
     }
 

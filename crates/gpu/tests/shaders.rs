@@ -142,8 +142,12 @@ fn shared_structs_match_wgsl_layouts() {
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
     assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
     assert_layout!(specular, "SliceParams", hikari_gpu::specular::SliceParams, [index, count, iteration_budget, _pad]);
+    let resolve = hikari_gpu::resolve::shader_source();
+    let (size, members) = wgsl_layout(&resolve, "Terms");
+    assert_eq!(size as usize, size_of::<hikari_gpu::resolve::Terms>());
+    assert_eq!(members[4], ("volume".to_string(), offset_of!(hikari_gpu::resolve::Terms, volume) as u32));
     let present = hikari_gpu::present::SHADER;
-    assert_layout!(present, "PresentParams", hikari_gpu::present::PresentParams, [scale, encode_srgb, _pad0, _pad1]);
+    assert_layout!(present, "PresentParams", hikari_gpu::present::PresentParams, [scale, encode_srgb, mode, _pad1]);
     let volume = hikari_gpu::volume::shader_source();
     assert_layout!(
         volume,

@@ -102,3 +102,31 @@ fn new_photons_draw_as_built_in_cornell_caustic() {
 fn new_photons_draw_as_built_in_layered_fog() {
     assert_new_photons_draw_as_built("fog-stage-layered");
 }
+
+/// The viewer's term toggles: a frame without a term is the full frame less
+/// that term's target (no media here, so no attenuation in between).
+#[test]
+fn terms_leave_out_what_is_toggled_off() {
+    let mut scene = Scene::load("cornell-caustic").unwrap();
+    scene.camera = scene.camera.with_resolution(40, 32).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 5_000, seed: 4, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let ctx = hikari_gpu::test_support::test_context("terms");
+    let mut gpu = GpuRenderer::new(ctx, &scene, &traced, GpuSettings::new(global, caustic)).expect("GPU renderer");
+    gpu.render().unwrap();
+    let all = gpu.read(gpu.resolved()).unwrap();
+    let direct = gpu.read(&gpu.targets.direct).unwrap();
+    let indirect = gpu.read(&gpu.targets.indirect).unwrap();
+    gpu.settings.terms.direct = 0.0;
+    gpu.settings.terms.indirect = 0.0;
+    gpu.render().unwrap();
+    let rest = gpu.read(gpu.resolved()).unwrap();
+    let mut worst = 0.0f32;
+    for i in 0..all.len() {
+        let want = all[i].truncate() - direct[i].truncate() - indirect[i].truncate();
+        worst = worst.max((rest[i].truncate() - want).abs().max_element() / all[i].max_element().max(1e-3));
+    }
+    let darker = all.iter().zip(&rest).filter(|(a, r)| a.x > r.x * 1.5).count();
+    assert!(darker > all.len() / 2, "only {darker} pixels lost light");
+    assert!(worst < 1e-5, "worst {worst}");
+}

@@ -11,7 +11,13 @@
 //! zooms; right drag turns in place and WASD/QE fly (the wheel sets the
 //! flying speed while the right button is held); Home resets the camera, C
 //! prints it as a `[camera]` table, T prints the passes' GPU times, F12
-//! writes a PNG and an EXR of the frame, Escape quits.
+//! writes a PNG and an EXR of the frame, F1 hides the panel, Escape quits.
+//!
+//! The panel (egui) shows the frame rate, per-pass GPU times and photon
+//! counts, and edits the image's terms, the radii, LOD, exposure and debug
+//! views (G-buffer normals, albedo). Exposure and views take effect on the
+//! next frame; terms, radii and LOD restart the mean (radii rebuild the
+//! specular pass's photon grids; no photons are re-traced).
 //!
 //! A scene file is watched: saving it reloads the scene (the camera kept);
 //! a file with an error prints it (`FILE:LINE:COLUMN`, also in the title)
@@ -19,6 +25,7 @@
 
 mod frame_stats;
 mod orbit;
+mod panel;
 
 use crate::progress_bar::TerminalProgress;
 use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution};
@@ -30,9 +37,10 @@ use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::scene::{Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
-use hikari_gpu::present::PresentPass;
+use hikari_gpu::present::{PresentMode, PresentPass};
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use orbit::Orbit;
+use panel::{Controls, Panel, Readouts};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
@@ -103,6 +111,7 @@ struct Session {
     present: PresentPass,
     /// The mean of the frames since the camera last moved.
     mean: AccumulatePass,
+    panel: Panel,
 }
 
 struct Viewer {
@@ -136,6 +145,11 @@ struct Viewer {
     last_watch: Option<Instant>,
     /// The error of the last reload that failed, shown in the title.
     reload_error: Option<String>,
+    /// What the panel edits, and what the renderer was last given.
+    controls: Controls,
+    applied: Controls,
+    readouts: Readouts,
+    last_timing: Option<Instant>,
     screenshots: u32,
     title_updated: Option<Instant>,
 }
@@ -143,6 +157,15 @@ struct Viewer {
 impl Viewer {
     fn new(args: ViewArgs, scene: Scene) -> Self {
         let fly_speed = 0.25 * scene.diagonal();
+        let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+        let controls = Controls {
+            exposure: args.exposure,
+            global_radius: global.radius,
+            caustic_radius: caustic.radius,
+            terms: hikari_gpu::resolve::Terms::ALL,
+            lod: None,
+            mode: hikari_gpu::present::PresentMode::Radiance,
+        };
         let watched = modified(&args.scene);
         Viewer {
             watched,
@@ -168,6 +191,10 @@ impl Viewer {
             last_fly: None,
             last_watch: None,
             reload_error: None,
+            applied: controls.clone(),
+            controls,
+            readouts: Readouts::default(),
+            last_timing: None,
             screenshots: 0,
             title_updated: None,
         }
@@ -222,9 +249,11 @@ impl Viewer {
         }
         eprintln!("view: {} on {}", self.args.scene, ctx.describe());
         let present = PresentPass::new(&ctx.device, format);
+        let panel = Panel::new(&window, &ctx.device, format);
+        self.readouts.adapter = ctx.describe();
         let renderer = self.renderer(ctx, width, height)?;
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        Ok(Session { window, surface, config, renderer, present, mean })
+        Ok(Session { window, surface, config, renderer, present, mean, panel })
     }
 
     /// A thread tracing photon sets of the scene with seeds seed + 1, seed + 2,
@@ -253,8 +282,18 @@ impl Viewer {
         self.scene.camera = self.orbit.camera(width, height);
         let scene = &self.scene;
         let traced = self.traced.as_ref().expect("photons are traced before the renderer is built");
-        let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
-        let settings = GpuSettings { volume_radius: default_radius(scene), ..GpuSettings::new(global, caustic) };
+        self.readouts.photons_per_set = self.args.photons;
+        self.readouts.stored = [traced.indirect().len(), traced.caustic.len(), traced.volume.len()];
+        self.readouts.diagonal = scene.diagonal();
+        let (mut global, mut caustic) = PhotonCpuSettings::default().estimate_params(scene);
+        global.radius = self.applied.global_radius;
+        caustic.radius = self.applied.caustic_radius;
+        let settings = GpuSettings {
+            volume_radius: default_radius(scene),
+            terms: self.applied.terms,
+            lod: self.applied.lod,
+            ..GpuSettings::new(global, caustic)
+        };
         Ok(GpuRenderer::new(ctx, scene, traced, settings)?)
     }
 
@@ -298,7 +337,7 @@ impl Viewer {
         };
         self.reload_error = None;
         let Some(session) = self.session.take() else { return Ok(()) };
-        let Session { window, surface, config, renderer, present, .. } = session;
+        let Session { window, surface, config, renderer, present, panel, .. } = session;
         let ctx = renderer.ctx.clone();
         drop(renderer);
         // The new scene with the current camera, its first photon set now,
@@ -311,7 +350,7 @@ impl Viewer {
         self.sets_used = 1;
         let renderer = self.renderer(ctx, config.width, config.height)?;
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        self.session = Some(Session { window, surface, config, renderer, present, mean });
+        self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
         self.last_frame = None;
         self.edited();
         eprintln!("view: reloaded {}", self.args.scene);
@@ -347,11 +386,36 @@ impl Viewer {
             session.renderer.set_camera(&camera)?;
             session.mean.reset();
         }
-        if let Some(traced) = &new_set {
-            session.renderer.set_photons(&self.scene, traced)?;
+        let edited = self.controls != self.applied;
+        let restart = self.controls.terms != self.applied.terms
+            || self.controls.lod != self.applied.lod
+            || self.controls.global_radius != self.applied.global_radius
+            || self.controls.caustic_radius != self.applied.caustic_radius;
+        if restart {
+            let settings = &mut session.renderer.settings;
+            settings.terms = self.controls.terms;
+            settings.lod = self.controls.lod;
+            let radii_changed = settings.global.radius != self.controls.global_radius
+                || settings.caustic.radius != self.controls.caustic_radius;
+            settings.global.radius = self.controls.global_radius;
+            settings.caustic.radius = self.controls.caustic_radius;
+            if radii_changed && new_set.is_none() {
+                // The specular pass's grids are cells of the radius.
+                let traced = self.traced.as_ref().expect("a photon set is drawn");
+                session.renderer.set_photons(&self.scene, traced)?;
+            }
+            session.mean.reset();
+        }
+        if edited {
+            self.applied = self.controls.clone();
+        }
+        let fresh = new_set.is_some();
+        if let Some(traced) = new_set {
+            session.renderer.set_photons(&self.scene, &traced)?;
+            self.traced = Some(traced);
             self.sets_used += 1;
         }
-        if moved || new_set.is_some() || session.mean.count() == 0 {
+        if moved || fresh || restart || session.mean.count() == 0 {
             session.renderer.render()?;
             let ctx = &session.renderer.ctx;
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -373,7 +437,26 @@ impl Viewer {
         let scopes = ctx.error_scopes();
         let view = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        session.present.record(&ctx.device, &mut encoder, &session.mean.mean, &view, self.args.exposure);
+        let shown = match self.controls.mode {
+            PresentMode::Radiance => &session.mean.mean,
+            PresentMode::Normals => &session.renderer.targets.gbuffer.normal,
+            PresentMode::Albedo => &session.renderer.targets.gbuffer.albedo,
+        };
+        session.present.record(&ctx.device, &mut encoder, shown, &view, self.controls.exposure, self.controls.mode);
+        self.readouts.frames_in_mean = session.mean.count();
+        self.readouts.photon_sets = self.sets_used;
+        let size = [session.config.width, session.config.height];
+        let panel = &mut session.panel;
+        panel.draw(
+            &session.window,
+            &ctx.device,
+            &ctx.queue,
+            &mut encoder,
+            &view,
+            size,
+            &mut self.controls,
+            &self.readouts,
+        );
         ctx.queue.submit([encoder.finish()]);
         session.window.pre_present_notify();
         ctx.queue.present(texture);
@@ -388,8 +471,15 @@ impl Viewer {
         if let Some(edit) = self.pending_edit.take() {
             self.edit_latencies.push((now - edit).as_secs_f64());
         }
+        if self.last_timing.is_none_or(|t| (now - t).as_secs_f64() > 2.0) && session.panel.visible {
+            self.last_timing = Some(now);
+            let (times, timestamps) = session.renderer.render_timed()?;
+            self.readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
+            self.readouts.timestamps = timestamps;
+        }
         if self.title_updated.is_none_or(|t| (now - t).as_secs_f64() > 0.5) && self.stats.frames() > 0 {
             let fps = self.stats.mean_fps();
+            self.readouts.fps = fps;
             let frames = session.mean.count();
             let error = self.reload_error.as_ref().map_or(String::new(), |e| format!(" — error: {e}"));
             session
@@ -408,7 +498,7 @@ impl Viewer {
             let v = value.truncate();
             *pixel = if v.is_finite() { v } else { glam::Vec3::ZERO };
         }
-        write_image(path, &image, self.args.exposure)?;
+        write_image(path, &image, self.controls.exposure)?;
         eprintln!("view: wrote {}", path.display());
         Ok(())
     }
@@ -422,7 +512,7 @@ impl Viewer {
             self.session = Some(session);
             return Ok(());
         }
-        let Session { window, surface, mut config, renderer, present, .. } = session;
+        let Session { window, surface, mut config, renderer, present, panel, .. } = session;
         config.width = size.width;
         config.height = size.height;
         let ctx = renderer.ctx.clone();
@@ -430,7 +520,7 @@ impl Viewer {
         surface.configure(&ctx.device, &config);
         let renderer = self.renderer(ctx, size.width, size.height)?;
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        self.session = Some(Session { window, surface, config, renderer, present, mean });
+        self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
         Ok(())
     }
 
@@ -463,6 +553,11 @@ impl Viewer {
     fn key(&mut self, event_loop: &ActiveEventLoop, key: &Key) -> Result<()> {
         match key {
             Key::Named(NamedKey::Escape) => event_loop.exit(),
+            Key::Named(NamedKey::F1) => {
+                if let Some(s) = &mut self.session {
+                    s.panel.visible = !s.panel.visible;
+                }
+            }
             Key::Named(NamedKey::Home) => {
                 self.orbit.reset();
                 self.edited();
@@ -508,6 +603,22 @@ impl ApplicationHandler for Viewer {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let input = matches!(
+            event,
+            WindowEvent::MouseInput { .. }
+                | WindowEvent::CursorMoved { .. }
+                | WindowEvent::MouseWheel { .. }
+                | WindowEvent::KeyboardInput { .. }
+        );
+        if let Some(session) = &mut self.session {
+            let used = session.panel.on_event(&session.window, &event);
+            if used && input {
+                if let WindowEvent::CursorMoved { position, .. } = event {
+                    self.cursor = position;
+                }
+                return;
+            }
+        }
         let result = match event {
             WindowEvent::CloseRequested => {
                 event_loop.exit();

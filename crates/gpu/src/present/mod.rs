@@ -13,8 +13,20 @@ pub const SHADER: &str = include_str!("present.wgsl");
 pub struct PresentParams {
     pub scale: f32,
     pub encode_srgb: u32,
-    pub _pad0: u32,
+    pub mode: u32,
     pub _pad1: u32,
+}
+
+/// What the window shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum PresentMode {
+    /// Linear radiance, tone-mapped as PNG output.
+    #[default]
+    Radiance,
+    /// A G-buffer's normals, xyz · 0.5 + 0.5.
+    Normals,
+    /// A G-buffer's albedo.
+    Albedo,
 }
 
 pub struct PresentPass {
@@ -64,7 +76,9 @@ impl PresentPass {
         PresentPass { pipeline, layout, srgb_target: format.is_srgb() }
     }
 
-    /// Draws `frame` (linear radiance) into `target` with `exposure` stops.
+    /// Draws `frame` (linear radiance, tone-mapped with `exposure` stops;
+    /// or a G-buffer texture, per `mode`) into `target`.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         device: &wgpu::Device,
@@ -72,9 +86,14 @@ impl PresentPass {
         frame: &wgpu::Texture,
         target: &wgpu::TextureView,
         exposure: f32,
+        mode: PresentMode,
     ) {
-        let params =
-            PresentParams { scale: 2f32.powf(exposure), encode_srgb: (!self.srgb_target) as u32, _pad0: 0, _pad1: 0 };
+        let params = PresentParams {
+            scale: 2f32.powf(exposure),
+            encode_srgb: (!self.srgb_target) as u32,
+            mode: mode as u32,
+            _pad1: 0,
+        };
         let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("present params"),
             contents: bytemuck::bytes_of(&params),

@@ -7,7 +7,9 @@ struct PresentParams {
     scale: f32,
     // 1: write sRGB-encoded values (a linear target); 0: linear (an sRGB target).
     encode_srgb: u32,
-    _pad0: u32,
+    // 0: radiance, tone-mapped; 1: a G-buffer normal (xyz · 0.5 + 0.5); 2: a
+    // G-buffer albedo (rgb) — debug views, shown as stored.
+    mode: u32,
     _pad1: u32,
 }
 
@@ -32,7 +34,13 @@ fn vs_fullscreen(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> 
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     let size = vec2<i32>(textureDimensions(frame));
     let pixel = min(vec2<i32>(position.xy), size - vec2<i32>(1));
-    let c = textureLoad(frame, pixel, 0).rgb * params.scale;
+    let texel = textureLoad(frame, pixel, 0).rgb;
+    var c = texel * params.scale;
+    if (params.mode == 1u) {
+        c = texel * 0.5 + vec3<f32>(0.5) * f32(dot(texel, texel) > 0.0);
+    } else if (params.mode == 2u) {
+        c = texel;
+    }
     // Non-finite values show black, as in files.
     let finite = (c == c) & (abs(c) <= vec3<f32>(3.0e38));
     var v = select(vec3<f32>(0.0), clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)), finite);

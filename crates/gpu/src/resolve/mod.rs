@@ -12,9 +12,34 @@ pub fn shader_source() -> String {
 }
 const WORKGROUP: u32 = 8;
 
+/// Which radiance terms the frame holds. Mirrors `Terms` in resolve.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Terms {
+    pub direct: f32,
+    pub indirect: f32,
+    pub caustic: f32,
+    pub specular: f32,
+    pub volume: f32,
+    pub _pad: [f32; 3],
+}
+
+impl Terms {
+    /// Every term: the whole image.
+    pub const ALL: Terms =
+        Terms { direct: 1.0, indirect: 1.0, caustic: 1.0, specular: 1.0, volume: 1.0, _pad: [0.0; 3] };
+}
+
+impl Default for Terms {
+    fn default() -> Self {
+        Terms::ALL
+    }
+}
+
 pub struct ResolvePass {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
+    terms: wgpu::Buffer,
     pub output: wgpu::Texture,
 }
 
@@ -43,6 +68,7 @@ impl ResolvePass {
         entries.push(entry(8, stage, uniform()));
         entries.push(entry(9, stage, storage(true)));
         entries.push(entry(10, stage, texture(wgpu::TextureViewDimension::D2Array)));
+        entries.push(entry(11, stage, uniform()));
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = crate::binding::pipeline_layout(device, "resolve", &layout);
@@ -64,15 +90,24 @@ impl ResolvePass {
         bind_entries.push(wgpu::BindGroupEntry { binding: 8, resource: media.params_buffer.as_entire_binding() });
         bind_entries.push(wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() });
         bind_entries.push(wgpu::BindGroupEntry { binding: 10, resource: wgpu::BindingResource::TextureView(&slices) });
+        let terms = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("resolve terms"),
+            size: std::mem::size_of::<Terms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        bind_entries.push(wgpu::BindGroupEntry { binding: 11, resource: terms.as_entire_binding() });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &layout,
             entries: &bind_entries,
         });
-        ResolvePass { pipeline, bind_group, output }
+        ResolvePass { pipeline, bind_group, terms, output }
     }
 
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+    /// Sums the terms `terms` selects (written now) into `output`.
+    pub fn record(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, terms: &Terms) {
+        queue.write_buffer(&self.terms, 0, bytemuck::bytes_of(terms));
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("resolve"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);

@@ -16,6 +16,19 @@
 @group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(10) var slices_tex: texture_2d_array<f32>;
 
+// Which terms the image holds (1 or 0 each; the viewer's toggles).
+struct Terms {
+    direct: f32,
+    indirect: f32,
+    caustic: f32,
+    specular: f32,
+    volume: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+@group(0) @binding(11) var<uniform> terms: Terms;
+
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(output);
@@ -23,10 +36,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let p = vec2<i32>(id.xy);
-    let surface = textureLoad(emission, p, 0).rgb + textureLoad(direct, p, 0).rgb + textureLoad(indirect, p, 0).rgb
-        + textureLoad(caustic, p, 0).rgb + textureLoad(specular, p, 0).rgb;
+    let surface = textureLoad(emission, p, 0).rgb + terms.direct * textureLoad(direct, p, 0).rgb
+        + terms.indirect * textureLoad(indirect, p, 0).rgb + terms.caustic * textureLoad(caustic, p, 0).rgb
+        + terms.specular * textureLoad(specular, p, 0).rgb;
     let ray = view_ray(textureLoad(gbuffer_position, p, 0), vec2<f32>(p) + 0.5);
     let transmittance = exp(-view_optical_depth(p, ray.w, ray.w));
-    let sum = transmittance * surface + textureLoad(volume, p, 0).rgb;
+    let sum = transmittance * surface + terms.volume * textureLoad(volume, p, 0).rgb;
     textureStore(output, p, vec4<f32>(sum, 1.0));
 }

@@ -1,0 +1,166 @@
+//! The viewer's panel (egui, drawn over the frame): frame rate and per-pass
+//! GPU times, photon counts, the terms of the image, radii, LOD, exposure
+//! and debug views. F1 hides it.
+
+use hikari_core::lod::LodSettings;
+use hikari_gpu::present::PresentMode;
+use hikari_gpu::resolve::Terms;
+use winit::window::Window;
+
+/// What the panel shows and edits; the viewer applies the edits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Controls {
+    pub exposure: f32,
+    pub global_radius: f32,
+    pub caustic_radius: f32,
+    pub terms: Terms,
+    pub lod: Option<LodSettings>,
+    pub mode: PresentMode,
+}
+
+/// Read-outs, refreshed by the viewer.
+#[derive(Clone, Debug, Default)]
+pub struct Readouts {
+    pub adapter: String,
+    pub fps: f64,
+    pub frames_in_mean: u32,
+    pub photon_sets: u64,
+    pub photons_per_set: u64,
+    pub stored: [usize; 3],
+    /// (pass, milliseconds) of the last timed frame, and whether from GPU timestamps.
+    pub passes: Vec<(&'static str, f64)>,
+    pub timestamps: bool,
+    pub reload_error: Option<String>,
+    /// The scene diagonal, for the radius sliders' range.
+    pub diagonal: f32,
+}
+
+pub struct Panel {
+    ctx: egui::Context,
+    state: egui_winit::State,
+    renderer: egui_wgpu::Renderer,
+    pub visible: bool,
+}
+
+impl Panel {
+    pub fn new(window: &Window, device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+        let ctx = egui::Context::default();
+        let state = egui_winit::State::new(ctx.clone(), egui::ViewportId::ROOT, window, None, None, None);
+        let renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
+        Panel { ctx, state, renderer, visible: true }
+    }
+
+    /// Passes a window event to egui; true when egui used it (a click on
+    /// the panel is not a camera drag).
+    pub fn on_event(&mut self, window: &Window, event: &winit::event::WindowEvent) -> bool {
+        self.visible && self.state.on_window_event(window, event).consumed
+    }
+
+    /// Lays out the panel, letting it edit `controls`, and draws it into `target`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw(
+        &mut self,
+        window: &Window,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: [u32; 2],
+        controls: &mut Controls,
+        readouts: &Readouts,
+    ) {
+        if !self.visible {
+            return;
+        }
+        let input = self.state.take_egui_input(window);
+        let output = self.ctx.run_pass(input, |ctx| {
+            egui::Window::new("hikari").default_width(260.0).show(ctx, |ui| layout(ui, controls, readouts));
+        });
+        let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
+        self.state.handle_platform_output(window, platform_output);
+        let jobs = self.ctx.tessellate(shapes, pixels_per_point);
+        for (id, deltas) in &textures_delta.set {
+            for delta in deltas {
+                self.renderer.update_texture(device, queue, *id, delta);
+            }
+        }
+        let screen = egui_wgpu::ScreenDescriptor { size_in_pixels: size, pixels_per_point };
+        let extra = self.renderer.update_buffers(device, queue, encoder, &jobs, &screen);
+        if !extra.is_empty() {
+            queue.submit(extra);
+        }
+        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("panel"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.renderer.render(&mut pass.forget_lifetime(), &jobs, &screen);
+        for id in &textures_delta.free {
+            self.renderer.free_texture(id);
+        }
+        // Applied: egui checks that no texture update is dropped unseen.
+        textures_delta.clear();
+    }
+}
+
+fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
+    ui.label(&r.adapter);
+    ui.label(format!("{:.1} fps; mean of {} frames ({} photon sets)", r.fps, r.frames_in_mean, r.photon_sets));
+    ui.label(format!(
+        "photons: {} per set; stored {} global, {} caustic, {} volume",
+        r.photons_per_set, r.stored[0], r.stored[1], r.stored[2]
+    ));
+    if let Some(error) = &r.reload_error {
+        ui.colored_label(egui::Color32::LIGHT_RED, error);
+    }
+    egui::CollapsingHeader::new("GPU passes").default_open(false).show(ui, |ui| {
+        let how = if r.timestamps { "GPU timestamps" } else { "wall clock" };
+        ui.label(format!("per pass ({how}), every 2 s:"));
+        for (name, ms) in &r.passes {
+            ui.label(format!("{name}: {ms:.2} ms"));
+        }
+    });
+    ui.separator();
+    ui.label("terms");
+    ui.horizontal_wrapped(|ui| {
+        let toggle = |ui: &mut egui::Ui, value: &mut f32, name: &str| {
+            let mut on = *value > 0.0;
+            if ui.checkbox(&mut on, name).changed() {
+                *value = on as u32 as f32;
+            }
+        };
+        toggle(ui, &mut c.terms.direct, "direct");
+        toggle(ui, &mut c.terms.indirect, "indirect");
+        toggle(ui, &mut c.terms.caustic, "caustic");
+        toggle(ui, &mut c.terms.volume, "volume");
+        toggle(ui, &mut c.terms.specular, "specular");
+    });
+    let range = (r.diagonal * 1e-3)..=(r.diagonal * 0.2);
+    ui.add(egui::Slider::new(&mut c.global_radius, range.clone()).logarithmic(true).text("global radius"));
+    ui.add(egui::Slider::new(&mut c.caustic_radius, range).logarithmic(true).text("caustic radius"));
+    ui.add(egui::Slider::new(&mut c.exposure, -8.0..=8.0).text("exposure (stops)"));
+    let mut lod_on = c.lod.is_some();
+    ui.checkbox(&mut lod_on, "level of detail");
+    if lod_on {
+        let lod = c.lod.get_or_insert(LodSettings { near: r.diagonal * 1.5, far: r.diagonal * 0.5, groups: 20 });
+        ui.add(egui::Slider::new(&mut lod.near, 0.0..=r.diagonal * 4.0).text("near"));
+        ui.add(egui::Slider::new(&mut lod.far, 0.0..=r.diagonal * 4.0).text("far"));
+        ui.add(egui::Slider::new(&mut lod.groups, 1..=100).text("groups"));
+    } else {
+        c.lod = None;
+    }
+    ui.horizontal(|ui| {
+        ui.label("show");
+        ui.radio_value(&mut c.mode, PresentMode::Radiance, "image");
+        ui.radio_value(&mut c.mode, PresentMode::Normals, "normals");
+        ui.radio_value(&mut c.mode, PresentMode::Albedo, "albedo");
+    });
+}
