@@ -1,6 +1,8 @@
 //! `hikari bench`: the seed's chapter-6 tables for surfaces and media, on
 //! this machine's GPU: frames per second and a per-pass breakdown (GPU
-//! timestamps where the adapter has them). Photon tracing is not timed.
+//! timestamps where the adapter has them). Photon tracing is not timed in
+//! the static rows; the dynamic rows (what the viewer does) time a camera
+//! that moves every frame, and photons re-traced on the CPU every frame.
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
@@ -32,6 +34,17 @@ struct Row {
     photons: u64,
     volume: bool,
     lod: Option<LodSettings>,
+    motion: Motion,
+}
+
+/// What changes between the timed frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Motion {
+    Still,
+    /// The camera turns a little around its target every frame.
+    Orbit,
+    /// A new photon set is traced (all cores) and uploaded every frame.
+    Retrace,
 }
 
 /// The seed's fog-scene LOD settings, in scene units as given (its scene's
@@ -53,6 +66,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 10_000,
             volume: false,
             lod: None,
+            motion: Motion::Still,
         },
         Row {
             label: "cornell-box, 10,000 photons, LOD n=20 f=7 (scaled)",
@@ -61,6 +75,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 10_000,
             volume: false,
             lod: Some(SEED_CORNELL_LOD),
+            motion: Motion::Still,
         },
         Row {
             label: "cornell-box, 2,000 photons, LOD off",
@@ -69,6 +84,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 2_000,
             volume: false,
             lod: None,
+            motion: Motion::Still,
         },
         Row {
             label: "fog-stage, 50,000 volume photons, LOD off",
@@ -77,6 +93,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 50_000,
             volume: true,
             lod: None,
+            motion: Motion::Still,
         },
         Row {
             label: "fog-stage, 50,000 volume photons, LOD n=25 f=3",
@@ -85,6 +102,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 50_000,
             volume: true,
             lod: Some(SEED_FOG_LOD),
+            motion: Motion::Still,
         },
         Row {
             label: "fog-stage, 25,000 volume photons, LOD n=0 f=20",
@@ -93,6 +111,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 25_000,
             volume: true,
             lod: Some(SEED_FOG_LOD_FAR),
+            motion: Motion::Still,
+        },
+        Row {
+            label: "cornell-box, 10,000 photons, camera moving every frame",
+            scene: "cornell-box",
+            size: (512, 512),
+            photons: 10_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Orbit,
+        },
+        Row {
+            label: "cornell-box, 10,000 photons re-traced every frame",
+            scene: "cornell-box",
+            size: (512, 512),
+            photons: 10_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Retrace,
         },
     ];
     if args.large {
@@ -103,6 +140,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 1_000_000,
             volume: false,
             lod: None,
+            motion: Motion::Still,
         });
         rows.push(Row {
             label: "fog-stage 1920x1080, 1,000,000 volume photons, LOD off",
@@ -111,6 +149,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             photons: 1_000_000,
             volume: true,
             lod: None,
+            motion: Motion::Still,
         });
     }
     let mut ctx = Some(ctx);
@@ -141,19 +180,43 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         volume_radius: hikari_core::render::photon_cpu::default_radius(&scene),
         ..GpuSettings::new(global, caustic)
     };
-    let renderer = GpuRenderer::new(ctx, &scene, &traced, settings)?;
+    let mut renderer = GpuRenderer::new(ctx, &scene, &traced, settings)?;
     renderer.render()?;
+    let mut tracing = 0.0;
+    let mut global_count = traced.indirect().len();
     let start = Instant::now();
-    for _ in 0..frames {
+    for k in 0..frames {
+        match row.motion {
+            Motion::Still => {}
+            Motion::Orbit => {
+                let c = &scene.camera;
+                let turn = glam::Quat::from_axis_angle(c.up.normalize(), 0.01 * (k + 1) as f32);
+                let position = c.look_at + turn * (c.position - c.look_at);
+                let moved = hikari_core::camera::Camera::new(position, c.look_at, c.up, c.fov_y, c.width, c.height)
+                    .map_err(anyhow::Error::msg)?;
+                renderer.set_camera(&moved)?;
+            }
+            Motion::Retrace => {
+                let trace_start = Instant::now();
+                let settings = TraceSettings { photons: row.photons, seed: 2 + k as u64, ..Default::default() };
+                let fresh = trace_photons(&scene, &settings, &Silent);
+                tracing += trace_start.elapsed().as_secs_f64();
+                renderer.set_photons(&scene, &fresh)?;
+                global_count = fresh.indirect().len();
+            }
+        }
         renderer.render()?;
     }
     renderer.wait()?;
     let frame = start.elapsed().as_secs_f64() / frames as f64;
+    if row.motion == Motion::Retrace {
+        println!("    tracing {:.2} ms of each frame (CPU, all cores)", tracing / frames as f64 * 1e3);
+    }
     let (global_drawn, _) = renderer.drawn_photons()?;
     let (drawn, what) = if row.volume {
         (renderer.drawn_volume_photons()?, format!("of {} volume photons drawn", traced.volume.len()))
     } else {
-        (global_drawn, format!("of {} global photons drawn", traced.indirect().len()))
+        (global_drawn, format!("of {global_count} global photons drawn"))
     };
     let (breakdown, timestamps) = renderer.render_timed()?;
     println!(
