@@ -26,6 +26,8 @@
 mod frame_stats;
 mod orbit;
 mod panel;
+mod photon_sets;
+mod scene_watch;
 
 use crate::progress_bar::TerminalProgress;
 use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution};
@@ -41,9 +43,10 @@ use hikari_gpu::present::{PresentMode, PresentPass};
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use orbit::Orbit;
 use panel::{Controls, Panel, Readouts};
+use photon_sets::PhotonSets;
+use scene_watch::SceneWatch;
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
 use std::time::Instant;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
@@ -121,7 +124,7 @@ struct Viewer {
     traced: Option<TracedPhotons>,
     trace_seconds: f64,
     /// Fresh photon sets from the tracing thread.
-    photon_sets: Option<Receiver<TracedPhotons>>,
+    photon_sets: Option<PhotonSets>,
     /// Photon sets drawn so far.
     sets_used: u64,
     session: Option<Session>,
@@ -140,9 +143,8 @@ struct Viewer {
     fly_speed: f32,
     /// When the fly keys were last applied.
     last_fly: Option<Instant>,
-    /// The scene file's modification time (None for built-in scenes).
-    watched: Option<std::time::SystemTime>,
-    last_watch: Option<Instant>,
+    /// Saves of the scene file.
+    watch: SceneWatch,
     /// The error of the last reload that failed, shown in the title.
     reload_error: Option<String>,
     /// What the panel edits, and what the renderer was last given.
@@ -166,9 +168,9 @@ impl Viewer {
             lod: None,
             mode: hikari_gpu::present::PresentMode::Radiance,
         };
-        let watched = modified(&args.scene);
+        let watch = SceneWatch::new(&args.scene);
         Viewer {
-            watched,
+            watch,
             orbit: Orbit::new(&scene.camera),
             args,
             scene,
@@ -189,7 +191,6 @@ impl Viewer {
             flying: [false; 6],
             fly_speed,
             last_fly: None,
-            last_watch: None,
             reload_error: None,
             applied: controls.clone(),
             controls,
@@ -256,25 +257,10 @@ impl Viewer {
         Ok(Session { window, surface, config, renderer, present, mean, panel })
     }
 
-    /// A thread tracing photon sets of the scene with seeds seed + 1, seed + 2,
-    /// … (one set ahead of the window at most), until the window closes.
-    fn start_tracing(&self) -> Result<Receiver<TracedPhotons>> {
+    /// Photon sets of the scene as loaded now, from a new thread.
+    fn start_tracing(&self) -> Result<PhotonSets> {
         let scene = Scene::load(&self.args.scene).map_err(|e| UsageError(e.to_string()))?;
-        let (photons, seed) = (self.args.photons, self.args.seed);
-        let (sender, receiver) = sync_channel(1);
-        std::thread::Builder::new()
-            .name("photon sets".into())
-            .spawn(move || {
-                for k in 1.. {
-                    let settings = TraceSettings { photons, seed: seed.wrapping_add(k), ..Default::default() };
-                    let traced = trace_photons(&scene, &settings, &hikari_core::progress::Silent);
-                    if sender.send(traced).is_err() {
-                        return; // the window closed
-                    }
-                }
-            })
-            .map_err(|e| anyhow!("cannot start the photon-tracing thread: {e}"))?;
-        Ok(receiver)
+        PhotonSets::start(scene, self.args.photons, self.args.seed)
     }
 
     /// A renderer for frames of `width × height` from the orbit's camera.
@@ -302,31 +288,14 @@ impl Viewer {
     fn next_photon_set(&mut self) -> Result<Option<TracedPhotons>> {
         // The first frame draws the set the renderer was built with.
         let (Some(sets), Some(_)) = (&self.photon_sets, self.last_frame) else { return Ok(None) };
-        let wait = self.args.frames.is_some();
-        let next = if wait {
-            Some(sets.recv().map_err(|_| anyhow!("the photon-tracing thread stopped"))?)
-        } else {
-            match sets.try_recv() {
-                Ok(traced) => Some(traced),
-                Err(TryRecvError::Empty) => None,
-                Err(TryRecvError::Disconnected) => return Err(anyhow!("the photon-tracing thread stopped")),
-            }
-        };
-        Ok(next)
+        sets.next(self.args.frames.is_some())
     }
 
     /// Reloads the scene file when it changed (checked four times a second).
     fn watch(&mut self) -> Result<()> {
-        let now = Instant::now();
-        if self.watched.is_none() || self.last_watch.is_some_and(|t| (now - t).as_secs_f32() < 0.25) {
+        if !self.watch.changed() {
             return Ok(());
         }
-        self.last_watch = Some(now);
-        let stamp = modified(&self.args.scene);
-        if stamp == self.watched || stamp.is_none() {
-            return Ok(());
-        }
-        self.watched = stamp;
         let scene = match Scene::load(&self.args.scene) {
             Ok(scene) => scene,
             Err(e) => {
@@ -691,12 +660,4 @@ impl ApplicationHandler for Viewer {
             session.window.request_redraw();
         }
     }
-}
-
-/// The modification time of the scene file `spec` (None for built-ins).
-fn modified(spec: &str) -> Option<std::time::SystemTime> {
-    if builtin::source(spec).is_some() {
-        return None;
-    }
-    std::fs::metadata(spec).and_then(|m| m.modified()).ok()
 }
