@@ -24,6 +24,12 @@ enum Command {
     /// Render a scene to an image.
     Render(render_cmd::RenderArgs),
     /// Look around a scene in a window (the GPU renderer, live).
+    #[command(after_help = "Controls: left drag orbits; middle or shift + left drag pans; the wheel zooms; \
+right drag turns in place and W/A/S/D/Q/E fly (the wheel sets the speed while the right button is held); \
+Home resets the camera; C prints it as a [camera] table; T prints per-pass GPU times; F12 writes \
+hikari-view-N.png and .exr; F1 hides the panel; Escape quits.\n\nWhile the camera stands still, fresh photon \
+sets are traced in the background and the window shows the running mean of their frames. Saving the scene \
+file reloads it.")]
     View(view::ViewArgs),
     /// List the built-in scenes.
     Scenes,
