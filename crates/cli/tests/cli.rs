@@ -7,6 +7,13 @@ fn hikari(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_hikari")).args(args).current_dir(dir).output().expect("the binary runs")
 }
 
+/// One virtual X server at a time: `xvfb-run -a` picks a free display
+/// number, and two started at once can pick the same one.
+fn one_display() -> std::sync::MutexGuard<'static, ()> {
+    static DISPLAY: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    DISPLAY.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 fn scratch_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hikari-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -263,6 +270,7 @@ fn the_gl_backend_renders_or_falls_back_with_the_reason() {
 /// written, one summary line.
 #[test]
 fn view_runs_unattended_under_xvfb() {
+    let _display = one_display();
     let dir = scratch_dir("view");
     let out = Command::new("xvfb-run")
         .args(["-a", "-s", "-screen 0 640x480x24", env!("CARGO_BIN_EXE_hikari")])
@@ -306,6 +314,7 @@ fn view_without_a_display_says_so() {
 /// differ about 0.35 times as much as 1 frame).
 #[test]
 fn view_converges_while_the_camera_stands_still() {
+    let _display = one_display();
     let dir = scratch_dir("converge");
     let run = |frames: &str, seed: &str, file: &str| {
         let out = Command::new("xvfb-run")
@@ -342,6 +351,7 @@ fn view_converges_while_the_camera_stands_still() {
 /// flown and turned, and the summary counts the moves.
 #[test]
 fn view_follows_keys_and_mouse() {
+    let _display = one_display();
     let dir = scratch_dir("drive");
     let script = r#"
 "$1" view cornell-box --size 64x48 --photons 2000 --frames 100000 -q > out.txt 2> err.txt &
@@ -395,6 +405,7 @@ wait $pid
 /// error with its place and keeps the last good scene on screen.
 #[test]
 fn view_reloads_the_scene_file() {
+    let _display = one_display();
     let dir = scratch_dir("reload");
     std::fs::write(dir.join("scene.toml"), SCENE).unwrap();
     std::fs::write(dir.join("broken.toml"), SCENE.replace("radius = 1.0", "radius = = 1.0")).unwrap();
