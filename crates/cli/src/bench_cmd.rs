@@ -4,7 +4,7 @@
 //! the static rows; the dynamic rows (what the viewer does) time a camera
 //! that moves every frame, and photons re-traced on the CPU every frame.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::Args;
 use hikari_core::lod::LodSettings;
 use hikari_core::photon::{TraceSettings, trace_photons};
@@ -152,12 +152,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             motion: Motion::Still,
         });
     }
-    let mut ctx = Some(ctx);
+    // A row the adapter cannot run (media without f32 blending, a size over
+    // its limits) is reported and the table goes on.
     for row in rows {
-        let Some(context) = ctx.take() else { bail!("GPU context lost") };
-        let (renderer, drawn) = bench_row(context, &row, args.frames)?;
-        ctx = Some(renderer.ctx);
-        let _ = drawn;
+        if let Err(e) = bench_row(ctx.clone(), &row, args.frames) {
+            println!("{}: not run on this adapter: {e:#}", row.label);
+        }
     }
     Ok(())
 }
@@ -209,9 +209,7 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
     }
     renderer.wait()?;
     let frame = start.elapsed().as_secs_f64() / frames as f64;
-    if row.motion == Motion::Retrace {
-        println!("    tracing {:.2} ms of each frame (CPU, all cores)", tracing / frames as f64 * 1e3);
-    }
+
     let (global_drawn, _) = renderer.drawn_photons()?;
     let (drawn, what) = if row.volume {
         (renderer.drawn_volume_photons()?, format!("of {} volume photons drawn", traced.volume.len()))
@@ -231,5 +229,8 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         breakdown.iter().map(|(stage, t): &(Stage, f64)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
     let how = if timestamps { "GPU timestamps" } else { "wall-clock, separate submits" };
     println!("    per pass ({how}): {}", parts.join(", "));
+    if row.motion == Motion::Retrace {
+        println!("    tracing {:.2} ms of each frame (CPU, all cores)", tracing / frames as f64 * 1e3);
+    }
     Ok((renderer, drawn))
 }
