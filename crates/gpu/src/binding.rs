@@ -67,6 +67,39 @@ pub fn pipeline_layout(device: &wgpu::Device, label: &str, layout: &wgpu::BindGr
     })
 }
 
+/// A pipeline drawing `vs_fullscreen` (fullscreen.wgsl) and `fs_main` of
+/// `module` into one target of `format`, no blending: 3 vertices shade
+/// every pixel.
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_fullscreen"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
 /// A compute pipeline running `entry_point` of `module`.
 pub fn compute_pipeline(
     device: &wgpu::Device,

@@ -34,6 +34,9 @@ pub use renderer::{GpuRenderer, GpuSettings};
 /// (the shared WGSL calls it in every loop; the specular pass counts).
 pub const UNCOUNTED_LOOPS_WGSL: &str = "fn loop_iteration() -> bool { return true; }\n";
 
+/// `vs_fullscreen`: one triangle over the screen (`binding::fullscreen_pipeline`).
+pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
+
 /// The WGSL mirror of `hikari_core::estimate`, prepended to the shaders that use it.
 pub const ESTIMATE_WGSL: &str = include_str!("estimate.wgsl");
 pub mod photon_grid;

@@ -189,18 +189,8 @@ fn clip_from_world(camera: &hikari_core::camera::Camera, bounds: (Vec3, Vec3)) -
 
 /// Near and far planes enclosing the scene bounds `(lo, hi)` seen from `eye`.
 fn depth_range((lo, hi): (Vec3, Vec3), eye: Vec3) -> (f32, f32) {
-    let far = (0..8)
-        .map(|i| {
-            let corner = Vec3::new(
-                if i & 1 == 0 { lo.x } else { hi.x },
-                if i & 2 == 0 { lo.y } else { hi.y },
-                if i & 4 == 0 { lo.z } else { hi.z },
-            );
-            (corner - eye).length()
-        })
-        .fold(0.0f32, f32::max)
-        * 1.01;
-    (far.max(1e-3) * 1e-4, far.max(1e-3))
+    let far = crate::shadow::shadow_range(eye, lo, hi).max(1e-3);
+    (far * 1e-4, far)
 }
 
 impl GpuRenderer {
@@ -525,20 +515,27 @@ impl GpuRenderer {
     /// Renders one frame and times each stage: with GPU timestamps written
     /// between the stages when the adapter has them (true = timestamps),
     /// else wall-clock around a separate submit per stage, waited for.
+    /// The frame is a whole one, as `render` makes it (the specular pass
+    /// split further if it ran over budget; that rerun is not timed).
     pub fn render_timed(&self) -> Result<(Vec<(Stage, f64)>, bool), GpuError> {
-        if self.ctx.timestamps {
-            return Ok((self.render_timestamped()?, true));
-        }
-        let mut times = Vec::new();
-        for stage in Stage::ALL {
-            let start = std::time::Instant::now();
-            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-            self.record_stage(stage, &mut encoder);
-            self.ctx.queue.submit([encoder.finish()]);
-            self.wait()?;
-            times.push((stage, start.elapsed().as_secs_f64()));
-        }
-        Ok((times, false))
+        let scopes = self.ctx.error_scopes();
+        let timed = if self.ctx.timestamps {
+            (self.render_timestamped()?, true)
+        } else {
+            let mut times = Vec::new();
+            for stage in Stage::ALL {
+                let start = std::time::Instant::now();
+                let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+                self.record_stage(stage, &mut encoder);
+                self.ctx.queue.submit([encoder.finish()]);
+                self.wait()?;
+                times.push((stage, start.elapsed().as_secs_f64()));
+            }
+            (times, false)
+        };
+        scopes.finish()?;
+        self.settle_specular()?;
+        Ok(timed)
     }
 
     fn render_timestamped(&self) -> Result<Vec<(Stage, f64)>, GpuError> {

@@ -15,7 +15,7 @@ fn shaders() -> Vec<(&'static str, String)> {
     vec![
         ("gbuffer.wgsl", hikari_gpu::gbuffer::SHADER.to_string()),
         ("gbuffer.wgsl + gbuffer_storage.wgsl", hikari_gpu::gbuffer::storage_shader_source()),
-        ("present.wgsl", hikari_gpu::present::SHADER.to_string()),
+        ("present.wgsl", hikari_gpu::present::shader_source()),
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
         ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
         ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
@@ -146,7 +146,7 @@ fn shared_structs_match_wgsl_layouts() {
     let (size, members) = wgsl_layout(&resolve, "Terms");
     assert_eq!(size as usize, size_of::<hikari_gpu::resolve::Terms>());
     assert_eq!(members[4], ("volume".to_string(), offset_of!(hikari_gpu::resolve::Terms, volume) as u32));
-    let present = hikari_gpu::present::SHADER;
+    let present = hikari_gpu::present::shader_source();
     assert_layout!(present, "PresentParams", hikari_gpu::present::PresentParams, [scale, encode_srgb, mode, _pad1]);
     let volume = hikari_gpu::volume::shader_source();
     assert_layout!(

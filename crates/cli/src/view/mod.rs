@@ -385,7 +385,16 @@ impl Viewer {
             self.sets_used += 1;
         }
         if moved || fresh || restart || session.mean.count() == 0 {
-            session.renderer.render()?;
+            // Every 2 s (panel shown) the frame itself is the timed one.
+            let timing_due = session.panel.visible && self.last_timing.is_none_or(|t| t.elapsed().as_secs_f64() > 2.0);
+            if timing_due {
+                self.last_timing = Some(Instant::now());
+                let (times, timestamps) = session.renderer.render_timed()?;
+                self.readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
+                self.readouts.timestamps = timestamps;
+            } else {
+                session.renderer.render()?;
+            }
             let ctx = &session.renderer.ctx;
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             session.mean.record(&ctx.queue, &mut encoder);
@@ -439,12 +448,6 @@ impl Viewer {
         self.last_frame = Some(now);
         if let Some(edit) = self.pending_edit.take() {
             self.edit_latencies.push((now - edit).as_secs_f64());
-        }
-        if self.last_timing.is_none_or(|t| (now - t).as_secs_f64() > 2.0) && session.panel.visible {
-            self.last_timing = Some(now);
-            let (times, timestamps) = session.renderer.render_timed()?;
-            self.readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
-            self.readouts.timestamps = timestamps;
         }
         if self.title_updated.is_none_or(|t| (now - t).as_secs_f64() > 0.5) && self.stats.frames() > 0 {
             let fps = self.stats.mean_fps();

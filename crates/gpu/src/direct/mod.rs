@@ -12,8 +12,9 @@ pub const LIGHT_EVAL_WGSL: &str = include_str!("light_eval.wgsl");
 
 pub fn shader_source() -> String {
     format!(
-        "{}\n{}\n{}\n{}",
+        "{}\n{}\n{}\n{}\n{}",
         crate::UNCOUNTED_LOOPS_WGSL,
+        crate::FULLSCREEN_WGSL,
         crate::media::MEDIA_WGSL,
         LIGHT_EVAL_WGSL,
         include_str!("direct.wgsl")
@@ -67,31 +68,7 @@ impl DirectPass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "direct", &layout);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("direct"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: target_format,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::binding::fullscreen_pipeline(device, "direct", &pipeline_layout, &module, target_format);
         DirectPass { pipeline, layout }
     }
 

@@ -5,7 +5,10 @@
 use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
-pub const SHADER: &str = include_str!("present.wgsl");
+/// present.wgsl after the shared fullscreen triangle.
+pub fn shader_source() -> String {
+    format!("{}\n{}", crate::FULLSCREEN_WGSL, include_str!("present.wgsl"))
+}
 
 /// Mirrors `PresentParams` in present.wgsl.
 #[repr(C)]
@@ -41,7 +44,7 @@ impl PresentPass {
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("present.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         use crate::binding::{entry, texture, uniform};
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -52,27 +55,7 @@ impl PresentPass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "present", &layout);
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("present"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_fullscreen"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = crate::binding::fullscreen_pipeline(device, "present", &pipeline_layout, &module, format);
         PresentPass { pipeline, layout, srgb_target: format.is_srgb() }
     }
 

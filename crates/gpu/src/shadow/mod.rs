@@ -45,7 +45,8 @@ impl ShadowViewParams {
 }
 
 /// The farthest distance from `from` to the box `[lo, hi]`, with 1% to spare
-/// (at least a tiny positive length, so the shader can divide by it).
+/// (at least a tiny positive length, so the shader can divide by it): the
+/// shadow views' range, and the far plane of the camera's.
 pub fn shadow_range(from: Vec3, lo: Vec3, hi: Vec3) -> f32 {
     let far = (from - lo).abs().max((from - hi).abs());
     (far.length() * 1.01).max(1e-20)
