@@ -57,6 +57,10 @@ pub struct RenderArgs {
     /// Random seed: the same seed gives the same image whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Render the scene's animations (`[[animation]]`) at this time, in
+    /// seconds (0 to 1,000,000).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_time, allow_negative_numbers = true)]
+    pub at: f32,
     /// Worker threads, 1 to 1024 [default: all cores].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     pub threads: Option<u64>,
@@ -96,6 +100,12 @@ pub struct RenderArgs {
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// An animation time in seconds: finite, in [0, 10⁶].
+pub fn parse_time(text: &str) -> Result<f32, String> {
+    let t: f32 = text.parse().map_err(|_| format!("`{text}` is not a number of seconds"))?;
+    if (0.0..=1e6).contains(&t) { Ok(t) } else { Err(format!("{t} s is outside 0 to 1,000,000 s")) }
 }
 
 pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -328,6 +338,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
 
     let mut scene = Scene::load(&args.scene).map_err(|e| UsageError(e.to_string()))?;
+    if scene.is_animated() {
+        scene = scene.at_time(args.at);
+    }
     let diagonal = scene.diagonal();
     radius_in_range("radius", args.radius, diagonal)?;
     radius_in_range("caustic-radius", args.caustic_radius, diagonal)?;

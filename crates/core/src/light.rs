@@ -9,7 +9,7 @@ use crate::sampling::{self, Rng, local_to_world};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Light {
     /// Isotropic point light; `intensity` in W/sr.
     Point { position: Vec3, intensity: Rgb },
@@ -52,6 +52,66 @@ impl Light {
             Light::Spot { intensity, cutoff, falloff_start, .. } => intensity * spot_solid_angle(cutoff, falloff_start),
             Light::Sphere { radius, radiance, .. } => radiance * PI * (4.0 * PI * radius * radius),
             Light::Quad { edge_u, edge_v, radiance, .. } => radiance * PI * edge_u.cross(edge_v).length(),
+        }
+    }
+
+    /// The point that places the light: position (point, spot), centre
+    /// (sphere) or corner (quad). Moving a light moves this point.
+    pub fn anchor(&self) -> Vec3 {
+        match *self {
+            Light::Point { position, .. } | Light::Spot { position, .. } => position,
+            Light::Sphere { center, .. } => center,
+            Light::Quad { corner, .. } => corner,
+        }
+    }
+
+    /// The same light with its anchor at `anchor`.
+    pub fn with_anchor(&self, anchor: Vec3) -> Light {
+        let mut light = self.clone();
+        match &mut light {
+            Light::Point { position, .. } | Light::Spot { position, .. } => *position = anchor,
+            Light::Sphere { center, .. } => *center = anchor,
+            Light::Quad { corner, .. } => *corner = anchor,
+        }
+        light
+    }
+
+    /// Intensity (point, spot; W/sr) or radiance (area lights; W/(m² sr)).
+    pub fn emission(&self) -> Rgb {
+        match *self {
+            Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity,
+            Light::Sphere { radiance, .. } | Light::Quad { radiance, .. } => radiance,
+        }
+    }
+
+    /// The same light emitting `emission` (see `emission`).
+    pub fn with_emission(&self, emission: Rgb) -> Light {
+        let mut light = self.clone();
+        match &mut light {
+            Light::Point { intensity, .. } | Light::Spot { intensity, .. } => *intensity = emission,
+            Light::Sphere { radiance, .. } | Light::Quad { radiance, .. } => *radiance = emission,
+        }
+        light
+    }
+
+    /// The light carried by the rigid motion `motion` (rotation and
+    /// translation): its anchor moved, its axis or edges turned.
+    pub fn moved(&self, motion: &glam::Affine3A) -> Light {
+        let point = |p: Vec3| motion.transform_point3(p);
+        let vector = |v: Vec3| motion.transform_vector3(v);
+        match self.clone() {
+            Light::Point { position, intensity } => Light::Point { position: point(position), intensity },
+            Light::Spot { position, axis, intensity, cutoff, falloff_start } => Light::Spot {
+                position: point(position),
+                axis: vector(axis).normalize(),
+                intensity,
+                cutoff,
+                falloff_start,
+            },
+            Light::Sphere { center, radius, radiance } => Light::Sphere { center: point(center), radius, radiance },
+            Light::Quad { corner, edge_u, edge_v, radiance } => {
+                Light::Quad { corner: point(corner), edge_u: vector(edge_u), edge_v: vector(edge_v), radiance }
+            }
         }
     }
 

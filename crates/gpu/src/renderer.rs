@@ -429,6 +429,37 @@ impl GpuRenderer {
         self.ctx.check()
     }
 
+    /// Draws the next frames of `scene`, the renderer's scene moved (the
+    /// same surfaces, lights and media, posed anew: `Scene::posed`), with
+    /// `traced`, its photons. Pipelines, targets and the photon passes stay;
+    /// the geometry, lights, shadow views, BVH and photons are uploaded.
+    pub fn set_scene(&mut self, scene: &Scene, traced: &TracedPhotons) -> Result<(), GpuError> {
+        let scopes = self.ctx.error_scopes();
+        let (device, queue) = (&self.ctx.device, &self.ctx.queue);
+        self.scene = SceneBuffers::upload(device, scene);
+        self.gbuffer_binding = self.gbuffer_pass.bind(device, &self.scene, &self.targets.gbuffer);
+        self.bounds = scene.accel.bounds();
+        let lights = GpuLights::new(scene, self.settings.area_light_samples);
+        if !self.targets.shadow_maps.update(queue, &lights.views, self.bounds) {
+            self.targets.shadow_maps =
+                self.shadow_pass.create_maps(device, &lights.views, self.settings.shadow_map_size, self.bounds);
+        }
+        self.direct_binding = self.direct_pass.bind(
+            device,
+            &self.targets.gbuffer,
+            &lights,
+            &self.targets.shadow_maps,
+            self.settings.shadow_bias,
+            &self.media,
+        );
+        self.specular_pass.set_scene(device, queue, scene, &self.scene.surfaces, &lights, &self.targets.shadow_maps);
+        self.media.set_scene(queue, scene);
+        self.clip_from_world = clip_from_world(&self.camera, self.bounds);
+        self.media.set_camera(queue, &self.camera, self.clip_from_world);
+        scopes.finish()?;
+        self.set_photons(scene, traced)
+    }
+
     fn volume_params(&self) -> VolumeParams {
         VolumeParams {
             clip_from_world: self.clip_from_world.to_cols_array_2d(),

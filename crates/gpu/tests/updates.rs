@@ -130,3 +130,72 @@ fn terms_leave_out_what_is_toggled_off() {
     assert!(darker > all.len() / 2, "only {darker} pixels lost light");
     assert!(worst < 1e-5, "worst {worst}");
 }
+
+/// `cornell-caustic` with its glass ball and sphere light named and moving.
+fn moving_caustic_scene() -> Scene {
+    let text = hikari_core::scene::builtin::source("cornell-caustic")
+        .unwrap()
+        .replace("shape = \"sphere\"\ncenter = [0.15", "name = \"ball\"\nshape = \"sphere\"\ncenter = [0.15")
+        .replace("[[light]]\ntype = \"sphere\"", "[[light]]\nname = \"lamp\"\ntype = \"sphere\"")
+        + r#"
+[[animation]]
+target = "lamp"
+type = "rotate"
+center = [0.0, 0.8, 0.0]
+period = 4.0
+
+[[animation]]
+target = "ball"
+type = "move"
+offset = [-0.3, 0.0, 0.2]
+period = 2.0
+"#;
+    Scene::from_toml(&text, "moving-caustic.toml", None).unwrap()
+}
+
+/// A moved scene (`GpuRenderer::set_scene` with the posed scene and its
+/// photons) draws what a renderer built for the posed scene draws: the
+/// geometry, shadow views, BVH, lights and photon maps all follow.
+fn assert_moved_scene_draws_as_built(scene: Scene) {
+    let name = scene.source.clone();
+    let pose = |t: f32| {
+        let mut posed = scene.at_time(t);
+        posed.camera = posed.camera.with_resolution(48, 40).unwrap();
+        posed
+    };
+    let (before, after) = (pose(0.0), pose(1.3));
+    let trace = |s: &Scene| trace_photons(s, &TraceSettings { photons: 5_000, seed: 2, ..Default::default() }, &Silent);
+    let (first, second) = (trace(&before), trace(&after));
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&before);
+    let settings = GpuSettings::new(global, caustic);
+    let Some(ctx) = media_context(&name, &before) else { return };
+    let mut gpu = GpuRenderer::new(ctx.clone(), &before, &first, settings.clone()).expect("GPU renderer");
+    gpu.render().expect("first frame");
+    let (first_image, _) = gpu.read_image().unwrap();
+    gpu.set_scene(&after, &second).unwrap();
+    gpu.render().expect("frame of the moved scene");
+    let (updated, _) = gpu.read_image().unwrap();
+    let built = GpuRenderer::new(ctx, &after, &second, settings).expect("GPU renderer");
+    built.render().expect("frame");
+    let (built_image, _) = built.read_image().unwrap();
+    let differing = updated.pixels.iter().zip(&built_image.pixels).filter(|(a, b)| **a != **b).count();
+    let changed = updated
+        .pixels
+        .iter()
+        .zip(&first_image.pixels)
+        .filter(|(a, b)| (**a - **b).abs().max_element() > 0.05 * b.max_element().max(1e-3))
+        .count();
+    eprintln!("{name}: {differing} pixels differ from the built renderer, {changed} changed by the motion");
+    assert_eq!(differing, 0);
+    assert!(changed > updated.pixels.len() / 4, "the motion changed only {changed} pixels");
+}
+
+#[test]
+fn moved_scene_draws_as_built_in_cornell_orbit() {
+    assert_moved_scene_draws_as_built(Scene::load("cornell-orbit").unwrap());
+}
+
+#[test]
+fn moved_glass_and_area_light_draw_as_built() {
+    assert_moved_scene_draws_as_built(moving_caustic_scene());
+}

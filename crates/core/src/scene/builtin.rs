@@ -1,7 +1,7 @@
 //! Built-in scenes: scene files stored in the repository's `scenes/` folder
 //! and embedded in the binary, so users can copy and edit them.
 
-pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic", "fog-stage", "fog-stage-layered"];
+pub const NAMES: &[&str] = &["cornell-box", "cornell-caustic", "fog-stage", "fog-stage-layered", "cornell-orbit"];
 
 pub const DEFAULT: &str = "cornell-box";
 
@@ -11,6 +11,7 @@ pub fn source(name: &str) -> Option<&'static str> {
         "cornell-caustic" => Some(include_str!("../../../../scenes/cornell-caustic.toml")),
         "fog-stage" => Some(include_str!("../../../../scenes/fog-stage.toml")),
         "fog-stage-layered" => Some(include_str!("../../../../scenes/fog-stage-layered.toml")),
+        "cornell-orbit" => Some(include_str!("../../../../scenes/cornell-orbit.toml")),
         _ => None,
     }
 }

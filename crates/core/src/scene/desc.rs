@@ -21,6 +21,8 @@ pub struct SceneDesc {
     pub light: Vec<Spanned<LightDesc>>,
     #[serde(default)]
     pub medium: Vec<Spanned<MediumDesc>>,
+    #[serde(default)]
+    pub animation: Vec<Spanned<AnimationDesc>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -61,6 +63,8 @@ pub struct MaterialDesc {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectDesc {
+    /// Lets animations and the viewer's panel refer to the object.
+    pub name: Option<String>,
     /// Spanned so that an unknown name is reported where it is written.
     pub material: Spanned<String>,
     pub mesh: Option<String>,
@@ -82,6 +86,7 @@ pub struct ObjectDesc {
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct LightDesc {
+    pub name: Option<String>,
     #[serde(rename = "type")]
     pub kind: String,
     pub position: Option<V3>,
@@ -110,4 +115,19 @@ pub struct MediumDesc {
     pub g: Option<f32>,
     /// A closed mesh bounding the medium; none: the whole scene.
     pub region: Option<String>,
+}
+
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct AnimationDesc {
+    /// The `name` of an object or a light; spanned to locate an unknown one.
+    pub target: Spanned<String>,
+    /// "rotate" (with `center`, `axis`) or "move" (with `offset`).
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub center: Option<V3>,
+    pub axis: Option<V3>,
+    pub offset: Option<V3>,
+    /// Seconds.
+    pub period: f32,
 }

@@ -46,3 +46,6 @@ pub const MAX_SIDE: u32 = 16384;
 /// Largest image, in pixels (8192 × 8192): a float RGB image of this size
 /// takes 768 MiB, and the renderers keep a few per-pixel buffers.
 pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Range of an animation's `period`, seconds.
+pub const PERIOD: (f32, f32) = (1e-3, 1e6);

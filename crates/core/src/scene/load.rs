@@ -1,9 +1,9 @@
 //! Turns a parsed scene description into a `Scene`, checking every value.
 
-use super::desc::{CameraDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3};
+use super::desc::{AnimationDesc, CameraDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3};
 use super::error::{SceneError, line_col};
 use super::limits::{self, MAX_COORD, MAX_EMISSION, MIN_LENGTH};
-use super::{Scene, Surface};
+use super::{Animation, Motion, Names, Scene, Surface, Target};
 use crate::camera::Camera;
 use crate::geometry::{Accel, Sphere, Triangle, TriangleNormals};
 use crate::light::Light;
@@ -114,6 +114,16 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
     }
 
     let mut geometry = GeometryBuilder::default();
+    let mut names = Names::default();
+    // Animation targets, by name: objects and lights share one namespace.
+    let mut targets: HashMap<String, Target> = HashMap::new();
+    let mut name = |p: &Place, name: &Option<String>, target: Target| -> Result<Option<String>, SceneError> {
+        let Some(name) = name else { return Ok(None) };
+        if targets.insert(name.clone(), target).is_some() {
+            return Err(p.error(format!("an object or light named \"{name}\" is already defined")));
+        }
+        Ok(Some(name.clone()))
+    };
     for (i, o) in desc.object.iter().enumerate() {
         let p = place(o.span(), format!("[[object]] #{}", i + 1));
         let obj = o.get_ref();
@@ -128,6 +138,9 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
             at.error(format!("unknown material \"{}\" ({hint})", obj.material.get_ref()))
         })?;
         let surface = geometry.add_surface(Surface { material, emitter: None });
+        if let Some(n) = name(&p, &obj.name, Target::Object(surface))? {
+            names.objects.push((n, surface));
+        }
         let start = geometry.counts();
         load_object(obj, &p, base_dir, surface, &mut geometry)?;
         geometry.check_since(start, &p)?;
@@ -137,6 +150,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
     for (i, l) in desc.light.iter().enumerate() {
         let p = place(l.span(), format!("[[light]] #{}", i + 1));
         let light = load_light(l.get_ref(), &p)?;
+        names.lights.push(name(&p, &l.get_ref().name, Target::Light(lights.len() as u32))?);
         // Area lights are also surfaces: they occlude, and the eye sees them.
         if light.is_area() {
             let emitter_material = materials.len() as u32;
@@ -185,10 +199,58 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         message: e,
     })?;
 
+    let mut animations = Vec::new();
+    for (i, a) in desc.animation.iter().enumerate() {
+        let p = place(a.span(), format!("[[animation]] #{}", i + 1));
+        let target = a.get_ref().target.get_ref();
+        let target = *targets.get(target).ok_or_else(|| {
+            let mut known: Vec<&str> = targets.keys().map(String::as_str).collect();
+            known.sort();
+            let hint = if known.is_empty() {
+                "no object or light has a `name`".to_string()
+            } else {
+                format!("named: {}", known.join(", "))
+            };
+            place(a.get_ref().target.span(), p.context.clone())
+                .error(format!("no object or light is named \"{target}\" ({hint})"))
+        })?;
+        animations.push(Animation { target, motion: load_motion(a.get_ref(), &p)? });
+    }
+
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = geometry.triangles.into_iter().unzip();
     let (spheres, sphere_surfaces): (Vec<_>, Vec<_>) = geometry.spheres.into_iter().unzip();
     let accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
-    Ok(Scene { source: file.to_string(), camera, materials, surfaces: geometry.surfaces, lights, accel, media })
+    Ok(Scene {
+        source: file.to_string(),
+        camera,
+        materials,
+        surfaces: geometry.surfaces,
+        lights,
+        accel,
+        media,
+        names,
+        animations,
+    })
+}
+
+fn load_motion(a: &AnimationDesc, p: &Place) -> Result<Motion, SceneError> {
+    let given = [("center", a.center.is_some()), ("axis", a.axis.is_some()), ("offset", a.offset.is_some())];
+    let period = p.in_range("period", a.period, limits::PERIOD)?;
+    match a.kind.as_str() {
+        "rotate" => {
+            p.only("a rotation", &given, &["center", "axis"])?;
+            Ok(Motion::Rotate {
+                center: p.coord("center", p.required("center", a.center)?)?,
+                axis: p.direction("axis", a.axis.unwrap_or([0.0, 1.0, 0.0]))?,
+                period,
+            })
+        }
+        "move" => {
+            p.only("a move", &given, &["offset"])?;
+            Ok(Motion::Move { offset: p.coord("offset", p.required("offset", a.offset)?)?, period })
+        }
+        other => Err(p.error(format!("unknown animation type \"{other}\" (expected rotate or move)"))),
+    }
 }
 
 fn load_medium(m: &MediumDesc, p: &Place) -> Result<Medium, SceneError> {

@@ -1,12 +1,14 @@
 //! The scene: camera, materials, surfaces, lights and the BVH over them,
 //! loaded from a TOML file (docs/scene-format.md) or a built-in scene.
 
+mod animation;
 pub mod builtin;
 mod desc;
 mod error;
 pub mod limits;
 mod load;
 
+pub use animation::{Animation, Motion, Names, Pose, Target};
 pub use error::SceneError;
 
 use crate::camera::Camera;
@@ -32,6 +34,10 @@ pub struct Scene {
     pub accel: Accel,
     /// Participating media (none: clear air).
     pub media: crate::medium::Media,
+    /// Names of objects and lights (for animations and the viewer).
+    pub names: Names,
+    /// How lights and objects move (`posed`); empty for a still scene.
+    pub animations: Vec<Animation>,
 }
 
 impl Scene {

@@ -156,6 +156,13 @@ impl GpuMedia {
         queue.write_buffer(&self.clip_buffer, 0, bytemuck::bytes_of(&clip_from_world.to_cols_array_2d()));
     }
 
+    /// Follows a moved `scene` (its media and regions unchanged): view rays
+    /// that see no surface end at the new scene's `max_view_distance`.
+    pub fn set_scene(&mut self, queue: &wgpu::Queue, scene: &Scene) {
+        self.params.max_distance = max_view_distance(scene);
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+    }
+
     pub fn new(
         device: &wgpu::Device,
         scene: &Scene,

@@ -59,8 +59,27 @@ pub struct ShadowMaps {
     pub texture: wgpu::Texture,
     depth: wgpu::Texture,
     view_bind_groups: Vec<wgpu::BindGroup>,
+    /// Each view's parameters, as bound in `view_bind_groups`.
+    view_buffers: Vec<wgpu::Buffer>,
     /// All views, for the direct pass's lookups.
     pub views_buffer: wgpu::Buffer,
+}
+
+impl ShadowMaps {
+    /// Moves the views to `views` (lights moved) in a scene now within
+    /// `bounds`, from the next frame on. False, with nothing written, when
+    /// the number of views differs: then the maps must be created anew.
+    pub fn update(&self, queue: &wgpu::Queue, views: &[ShadowView], bounds: (Vec3, Vec3)) -> bool {
+        if views.len() != self.view_buffers.len() || views.is_empty() {
+            return false;
+        }
+        let params: Vec<ShadowViewParams> = views.iter().map(|v| ShadowViewParams::new(v, bounds)).collect();
+        for (buffer, p) in self.view_buffers.iter().zip(&params) {
+            queue.write_buffer(buffer, 0, bytemuck::bytes_of(p));
+        }
+        queue.write_buffer(&self.views_buffer, 0, bytemuck::cast_slice(&params));
+        true
+    }
 }
 
 pub struct ShadowPass {
@@ -143,14 +162,19 @@ impl ShadowPass {
             view_formats: &[],
         });
         let params: Vec<ShadowViewParams> = views.iter().map(|v| ShadowViewParams::new(v, bounds)).collect();
-        let view_bind_groups = params
+        let view_buffers: Vec<wgpu::Buffer> = params
             .iter()
             .map(|p| {
-                let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                     label: Some("shadow view"),
                     contents: bytemuck::bytes_of(p),
-                    usage: wgpu::BufferUsages::UNIFORM,
-                });
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                })
+            })
+            .collect();
+        let view_bind_groups = view_buffers
+            .iter()
+            .map(|buffer| {
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("shadow view"),
                     layout: &self.layout,
@@ -162,9 +186,9 @@ impl ShadowPass {
         let views_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow views"),
             contents: bytemuck::cast_slice(if params.is_empty() { &zero[..] } else { &params }),
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         });
-        ShadowMaps { size, layers, texture, depth, view_bind_groups, views_buffer }
+        ShadowMaps { size, layers, texture, depth, view_bind_groups, view_buffers, views_buffer }
     }
 
     /// Renders every shadow view of `maps`.

@@ -134,6 +134,47 @@ pub struct SpecularPass {
     /// budget and is kept for the next frames.
     slices: std::cell::Cell<u32>,
     bindings: Bindings,
+    /// The photon grids now bound.
+    grid: wgpu::Buffer,
+    shadow_bias: f32,
+}
+
+/// What the pass reads of the scene itself: the flat BVH, and the lights
+/// (with their shadow maps) for direct light at specular hits.
+struct SceneData {
+    nodes: wgpu::Buffer,
+    prims: wgpu::Buffer,
+    direct: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    samples: wgpu::Buffer,
+}
+
+impl SceneData {
+    fn upload(device: &wgpu::Device, scene: &Scene, lights: &GpuLights, maps: &ShadowMaps, bias: f32) -> Self {
+        let bvh = FlatBvh::new(&scene.accel);
+        let storage = wgpu::BufferUsages::STORAGE;
+        let direct_params =
+            DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, _pad: 0 };
+        SceneData {
+            nodes: padded_buffer(device, "bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage),
+            prims: padded_buffer(device, "bvh prims", bytemuck::cast_slice(&bvh.prims), storage),
+            direct: padded_buffer(
+                device,
+                "specular direct params",
+                bytemuck::bytes_of(&direct_params),
+                wgpu::BufferUsages::UNIFORM,
+            ),
+            lights: padded_buffer(device, "specular lights", bytemuck::cast_slice(&lights.lights), storage),
+            samples: padded_buffer(device, "specular light samples", bytemuck::cast_slice(&lights.samples), storage),
+        }
+    }
+}
+
+/// A buffer holding `bytes`; wgpu refuses empty bindings, so an empty one
+/// holds zero words instead.
+fn padded_buffer(device: &wgpu::Device, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    let padded: &[u8] = if bytes.is_empty() { &[0; 48] } else { bytes };
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: padded, usage })
 }
 
 /// Everything the pass binds but the photon grids, kept to rebind new ones.
@@ -295,8 +336,6 @@ impl SpecularPass {
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
         let pipeline = crate::binding::compute_pipeline(device, "specular", &pipeline_layout, &module, "main");
 
-        // Static scene data: the flat BVH; the photon grids (`PackedGrids`).
-        let bvh = FlatBvh::new(&scene.accel);
         let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();
         let params = SpecularParams {
@@ -313,31 +352,17 @@ impl SpecularPass {
             normal_test: inputs.global.normal_test as u32,
             ..grid_params
         };
-        let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
-            // wgpu refuses empty bindings: pad to one zero word.
-            let padded: &[u8] = if bytes.is_empty() { &[0; 48] } else { bytes };
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents: padded, usage })
-        };
         let storage_usage = wgpu::BufferUsages::STORAGE;
-        let params_buffer = buffer(
+        let params_buffer = padded_buffer(
+            device,
             "specular params",
             bytemuck::bytes_of(&params),
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let nodes = buffer("bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage_usage);
-        let prims = buffer("bvh prims", bytemuck::cast_slice(&bvh.prims), storage_usage);
-        let grid = buffer("photon grids", bytemuck::cast_slice(&words), storage_usage);
+        let grid = padded_buffer(device, "photon grids", bytemuck::cast_slice(&words), storage_usage);
         let keep = |b: &wgpu::Buffer| b.clone();
-        let direct_params = DirectParams {
-            light_count: lights.lights.len() as u32,
-            shadow_size: maps.size,
-            bias: inputs.shadow_bias,
-            _pad: 0,
-        };
-        let direct_buffer =
-            buffer("specular direct params", bytemuck::bytes_of(&direct_params), wgpu::BufferUsages::UNIFORM);
-        let lights_buffer = buffer("specular lights", bytemuck::cast_slice(&lights.lights), storage_usage);
-        let samples_buffer = buffer("specular light samples", bytemuck::cast_slice(&lights.samples), storage_usage);
+        let SceneData { nodes, prims, direct, lights, samples } =
+            SceneData::upload(device, scene, lights, maps, inputs.shadow_bias);
         let output = crate::binding::storage_output_texture(device, "specular radiance", width, height);
         let accum = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("specular accumulation"),
@@ -366,9 +391,9 @@ impl SpecularPass {
             prims,
             surfaces: keep(surfaces),
             regions: keep(&media.regions),
-            direct: direct_buffer,
-            lights: lights_buffer,
-            samples: samples_buffer,
+            direct,
+            lights,
+            samples,
             views: keep(&maps.views_buffer),
             maps: maps_view,
             normal: gbuffer.normal.create_view(&Default::default()),
@@ -381,6 +406,8 @@ impl SpecularPass {
         let bind_group = bindings.bind_group(device, &grid);
         let enabled = has_specular_surfaces(scene);
         SpecularPass {
+            grid,
+            shadow_bias: inputs.shadow_bias,
             pipeline,
             bind_group,
             width,
@@ -401,12 +428,7 @@ impl SpecularPass {
     /// a new grid buffer and bind group, nothing else rebuilt.
     pub fn set_photons(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, inputs: &SpecularInputs) {
         let (words, grid_params) = PackedGrids::new(inputs);
-        let padded: &[u32] = if words.is_empty() { &[0; 12] } else { &words };
-        let grid = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("photon grids"),
-            contents: bytemuck::cast_slice(padded),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        self.grid = padded_buffer(device, "photon grids", bytemuck::cast_slice(&words), wgpu::BufferUsages::STORAGE);
         self.params = SpecularParams {
             power_unit: grid_params.power_unit,
             global_buckets: grid_params.global_buckets,
@@ -423,7 +445,36 @@ impl SpecularPass {
             ..self.params
         };
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
-        self.bind_group = self.bindings.bind_group(device, &grid);
+        self.bind_group = self.bindings.bind_group(device, &self.grid);
+    }
+
+    /// Traces the moved `scene` (same surfaces and lights, posed anew) from
+    /// the next frame on: a new BVH and lights; `surfaces` and `maps` are
+    /// the renderer's, which may be new buffers too. Photon grids stay (the
+    /// renderer gives the moved scene's photons with `set_photons`).
+    pub fn set_scene(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        surfaces: &wgpu::Buffer,
+        lights: &GpuLights,
+        maps: &ShadowMaps,
+    ) {
+        let SceneData { nodes, prims, direct, lights, samples } =
+            SceneData::upload(device, scene, lights, maps, self.shadow_bias);
+        let b = &mut self.bindings;
+        (b.nodes, b.prims, b.direct, b.lights, b.samples) = (nodes, prims, direct, lights, samples);
+        b.surfaces = surfaces.clone();
+        b.views = maps.views_buffer.clone();
+        b.maps = maps.texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        self.params.epsilon = scene.accel.epsilon;
+        queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
+        self.enabled = has_specular_surfaces(scene);
+        self.bind_group = self.bindings.bind_group(device, &self.grid);
     }
 
     /// Casts its primary rays from `camera` (same resolution) from the next frame on.
