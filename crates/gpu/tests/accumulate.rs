@@ -47,3 +47,45 @@ fn the_running_mean_is_the_mean_of_the_frames() {
     assert!(differ > 500, "the two photon sets gave nearly the same frame ({differ} pixels differ)");
     assert!(worst < 1e-6, "worst relative difference {worst}");
 }
+
+/// The running mean's noise falls as 1/K: on cornell-box's back wall (flat,
+/// lit by indirect light from everywhere), the variance of the difference
+/// between two independent K-frame means is 2σ²/K, so it falls by 4 from
+/// K = 1 to 4 and again to 16 (accepted: 2.5 to 6.4, for a test over
+/// about 200 correlated pixels).
+#[test]
+fn the_mean_of_k_frames_has_a_kth_of_the_variance() {
+    let ctx = test_context("accumulate variance");
+    let mut scene = Scene::load("cornell-box").unwrap();
+    scene.camera = scene.camera.with_resolution(40, 32).unwrap();
+    let (w, h) = (40usize, 32usize);
+    let trace = |seed| trace_photons(&scene, &TraceSettings { photons: 2_000, seed, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &trace(0), GpuSettings::new(global, caustic)).unwrap();
+    let mut mean = AccumulatePass::new(&ctx.device, gpu.resolved());
+    let mut mean_of = |first_seed: u64, k: u64| {
+        mean.reset();
+        for seed in first_seed..first_seed + k {
+            gpu.set_photons(&scene, &trace(seed)).unwrap();
+            gpu.render().unwrap();
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            mean.record(&ctx.queue, &mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+        }
+        gpu.read(&mean.mean).unwrap()
+    };
+    // The back wall: above the blocks, between the side walls.
+    let wall: Vec<usize> = (3..13).flat_map(|y| (12..28).map(move |x| y * w + x)).collect();
+    assert!(wall.iter().all(|&i| i < w * h));
+    let mut variance = |k: u64| {
+        let (a, b) = (mean_of(1000, k), mean_of(2000, k));
+        let diffs: Vec<f64> = wall.iter().map(|&i| (a[i].x - b[i].x) as f64).collect();
+        let m = diffs.iter().sum::<f64>() / diffs.len() as f64;
+        diffs.iter().map(|d| (d - m) * (d - m)).sum::<f64>() / diffs.len() as f64
+    };
+    let (v1, v4, v16) = (variance(1), variance(4), variance(16));
+    eprintln!("variance of the difference: K=1 {v1:.3e}, K=4 {v4:.3e}, K=16 {v16:.3e}");
+    for (ratio, what) in [(v1 / v4, "1 → 4"), (v4 / v16, "4 → 16")] {
+        assert!((2.5..6.4).contains(&ratio), "variance fell by {ratio} from K = {what}");
+    }
+}

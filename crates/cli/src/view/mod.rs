@@ -1,53 +1,68 @@
 //! `hikari view`: the GPU renderer in a window, drawn straight to the
-//! swapchain, with an orbiting camera. A moved camera only updates the
-//! passes' uniforms (`GpuRenderer::set_camera`). While the camera stands
-//! still, a background thread traces fresh photon sets (seeds seed + 1,
-//! seed + 2, …, all cores) and the window shows the running mean of their
-//! frames (`AccumulatePass`), so the noise falls as you look; a move
-//! starts the mean over. With `--frames N` every frame waits for its own
-//! photon set, so the last frame is the mean of N sets, reproducibly.
+//! swapchain, with an orbiting camera, moving lights and objects.
+//!
+//! A moved camera only updates the passes' uniforms
+//! (`GpuRenderer::set_camera`). Photons come from a background thread
+//! (`PhotonSets`, all cores) that traces the scene as posed now: the time
+//! of its animations and the panel's edits of lights and named objects.
+//! When the pose changes, the window keeps drawing the last complete set,
+//! in the scene it was traced in, until the new one arrives
+//! (`GpuRenderer::set_scene`): a frame never waits for tracing. While
+//! nothing moves, fresh sets (new seeds) keep coming and the window shows
+//! the running mean of their frames (`AccumulatePass`), so the noise falls
+//! as you look; any change starts the mean over. With `--frames N` every
+//! frame waits for the set of its own pose, and the animation advances
+//! `--step` seconds per frame, so runs are reproducible.
 //!
 //! Controls: left drag orbits, middle or shift + left drag pans, the wheel
 //! zooms; right drag turns in place and WASD/QE fly (the wheel sets the
 //! flying speed while the right button is held); Home resets the camera, C
-//! prints it as a `[camera]` table, T prints the passes' GPU times, F12
-//! writes a PNG and an EXR of the frame, F1 hides the panel, Escape quits.
+//! prints it as a `[camera]` table, T prints the passes' GPU times, Space
+//! pauses the animations, F12 writes a PNG and an EXR of the frame, F1
+//! hides the panel, Escape quits.
 //!
-//! The panel (egui) shows the frame rate, per-pass GPU times and photon
-//! counts, and edits the image's terms, the radii, LOD, exposure and debug
-//! views (G-buffer normals, albedo). Exposure and views take effect on the
-//! next frame; terms, radii and LOD restart the mean (radii rebuild the
-//! specular pass's photon grids; no photons are re-traced).
+//! The panel (egui) shows the frame rate, per-pass GPU times, photon counts
+//! and tracing rate, and edits the image's terms, the radii, LOD,
+//! exposure, photons per set ("trace every frame" sizes them to keep up
+//! with the frame rate), the lights (position, direction, colour,
+//! strength), named objects' positions and debug views (G-buffer normals,
+//! albedo). Exposure and views take effect on the next frame; terms, radii
+//! and LOD restart the mean (radii rebuild the specular pass's photon
+//! grids; no photons are re-traced); photon counts, lights and objects
+//! re-trace.
 //!
 //! A scene file is watched: saving it reloads the scene (the camera kept);
-//! a file with an error prints it (`FILE:LINE:COLUMN`, also in the title)
-//! and the last good scene stays on screen.
+//! a file with an error prints it (`FILE:LINE:COLUMN`, also in the title
+//! and the panel) and the last good scene stays on screen.
 
+mod clock;
 mod frame_stats;
 mod orbit;
 mod panel;
 mod photon_sets;
 mod scene_watch;
+mod trace_budget;
 
-use crate::progress_bar::TerminalProgress;
-use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution};
+use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution, parse_time};
 use anyhow::{Result, anyhow};
 use clap::Args;
+use clock::AnimationClock;
 use frame_stats::FrameStats;
+use glam::Vec3;
 use hikari_core::output::write_image;
-use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
-use hikari_core::scene::{Scene, builtin};
+use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
 use hikari_gpu::present::{PresentMode, PresentPass};
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use orbit::Orbit;
 use panel::{Controls, Panel, Readouts};
-use photon_sets::PhotonSets;
+use photon_sets::{Job, PhotonSet, PhotonSets};
 use scene_watch::SceneWatch;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
+use trace_budget::TraceBudget;
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
@@ -60,10 +75,10 @@ pub struct ViewArgs {
     /// A built-in scene name (see `hikari scenes`) or a path to a .toml scene file.
     #[arg(default_value = builtin::DEFAULT)]
     pub scene: String,
-    /// Photon paths emitted from the lights (1 to 100,000,000).
+    /// Photon paths per photon set (1 to 100,000,000).
     #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=MAX_PHOTONS))]
     pub photons: u64,
-    /// Random seed of the photon set.
+    /// Random seed of the first photon set (set k uses seed + k).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Exposure in stops (-64 to 64).
@@ -78,6 +93,17 @@ pub struct ViewArgs {
     /// Write the last frame to this .png or .exr on exit.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
+    /// The animations' time at the first frame, in seconds (0 to 1,000,000).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_time, allow_negative_numbers = true)]
+    pub at: f32,
+    /// With --frames: seconds of animation per frame (0: the scene stands
+    /// still and the frames converge).
+    #[arg(long, default_value_t = 0.0, requires = "frames", value_parser = parse_time)]
+    pub step: f32,
+    /// Size each photon set so that tracing keeps up with the frame rate
+    /// (--photons is the first set's count).
+    #[arg(long)]
+    pub trace_every_frame: bool,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
@@ -112,29 +138,39 @@ struct Session {
     config: wgpu::SurfaceConfiguration,
     renderer: GpuRenderer,
     present: PresentPass,
-    /// The mean of the frames since the camera last moved.
+    /// The mean of the frames since the camera or the scene last changed.
     mean: AccumulatePass,
     panel: Panel,
 }
 
 struct Viewer {
     args: ViewArgs,
-    scene: Scene,
+    /// The scene as loaded (poses are made from it).
+    base: Arc<Scene>,
     orbit: Orbit,
-    traced: Option<TracedPhotons>,
-    trace_seconds: f64,
-    /// Fresh photon sets from the tracing thread.
+    /// The photon set on screen, with the posed scene it was traced in.
+    shown: Option<PhotonSet>,
+    /// The background tracer, and the pose and count last asked of it.
     photon_sets: Option<PhotonSets>,
-    /// Photon sets drawn so far.
+    requested: Option<(Pose, u64)>,
+    clock: AnimationClock,
+    budget: TraceBudget,
+    /// Photon sets drawn so far; seconds spent tracing the ones received.
     sets_used: u64,
+    trace_seconds: f64,
+    first_trace_seconds: f64,
     session: Option<Session>,
     error: Option<anyhow::Error>,
     stats: FrameStats,
     last_frame: Option<Instant>,
     started: Option<Instant>,
     /// When the camera was last moved and the move is not on screen yet.
-    pending_edit: Option<Instant>,
-    edit_latencies: Vec<f64>,
+    pending_camera: Option<Instant>,
+    camera_latencies: Vec<f64>,
+    /// Pose requests (number, when) whose set is not on screen yet, and
+    /// the latency of each that reached it.
+    pending_poses: Vec<(u64, Instant)>,
+    pose_latencies: Vec<f64>,
     cursor: PhysicalPosition<f64>,
     dragging: Option<MouseButton>,
     shift: bool,
@@ -156,35 +192,53 @@ struct Viewer {
     title_updated: Option<Instant>,
 }
 
+/// The panel's starting values for `scene` (its lights and objects unedited).
+fn controls_for(scene: &Scene, args: &ViewArgs) -> Controls {
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
+    let rest = scene.rest_pose();
+    Controls {
+        exposure: args.exposure,
+        global_radius: global.radius,
+        caustic_radius: caustic.radius,
+        volume_radius: default_radius(scene),
+        terms: hikari_gpu::resolve::Terms::ALL,
+        lod: None,
+        mode: PresentMode::Radiance,
+        photons: args.photons,
+        trace_every_frame: args.trace_every_frame,
+        playing: true,
+        lights: rest.lights,
+        offsets: rest.offsets,
+    }
+}
+
 impl Viewer {
     fn new(args: ViewArgs, scene: Scene) -> Self {
         let fly_speed = 0.25 * scene.diagonal();
-        let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
-        let controls = Controls {
-            exposure: args.exposure,
-            global_radius: global.radius,
-            caustic_radius: caustic.radius,
-            terms: hikari_gpu::resolve::Terms::ALL,
-            lod: None,
-            mode: hikari_gpu::present::PresentMode::Radiance,
-        };
+        let controls = controls_for(&scene, &args);
         let watch = SceneWatch::new(&args.scene);
+        let clock = AnimationClock::new(args.at, args.frames.map(|_| args.step));
         Viewer {
             watch,
             orbit: Orbit::new(&scene.camera),
-            args,
-            scene,
-            traced: None,
-            trace_seconds: 0.0,
+            base: Arc::new(scene),
+            shown: None,
             photon_sets: None,
+            requested: None,
+            clock,
+            budget: TraceBudget::default(),
             sets_used: 0,
+            trace_seconds: 0.0,
+            first_trace_seconds: 0.0,
             session: None,
             error: None,
             stats: FrameStats::default(),
             last_frame: None,
             started: None,
-            pending_edit: None,
-            edit_latencies: Vec::new(),
+            pending_camera: None,
+            camera_latencies: Vec::new(),
+            pending_poses: Vec::new(),
+            pose_latencies: Vec::new(),
             cursor: PhysicalPosition::new(0.0, 0.0),
             dragging: None,
             shift: false,
@@ -198,6 +252,7 @@ impl Viewer {
             last_timing: None,
             screenshots: 0,
             title_updated: None,
+            args,
         }
     }
 
@@ -206,10 +261,64 @@ impl Viewer {
         event_loop.exit();
     }
 
+    /// The pose the panel and the clock ask for now.
+    fn pose(&self) -> Pose {
+        Pose {
+            time: if self.base.is_animated() { self.clock.time() } else { 0.0 },
+            lights: self.controls.lights.clone(),
+            offsets: self.controls.offsets.clone(),
+        }
+    }
+
+    /// Starts the tracing thread for the scene as loaded and waits for its
+    /// first set (the scene at the clock's time), which it puts on screen.
+    fn start_tracing(&mut self) -> Result<()> {
+        self.photon_sets = Some(PhotonSets::start(self.base.clone())?);
+        self.requested = None;
+        self.pending_poses.clear();
+        if !self.args.quiet {
+            eprintln!("view: tracing {} photon paths", self.controls.photons);
+        }
+        self.request(self.pose())?;
+        let first = self.photon_sets.as_mut().expect("started").next(true)?.expect("the first set");
+        self.first_trace_seconds = first.seconds;
+        self.received(&first);
+        self.shown = Some(first);
+        self.sets_used = 1;
+        Ok(())
+    }
+
+    /// Asks for a set of `pose` with the panel's photon count.
+    fn request(&mut self, pose: Pose) -> Result<()> {
+        let Some(sets) = &mut self.photon_sets else { return Ok(()) };
+        let photons = if self.controls.trace_every_frame {
+            self.budget.photons(self.controls.photons)
+        } else {
+            self.controls.photons
+        };
+        self.controls.photons = photons;
+        let seed = self.args.seed.wrapping_add(sets.newest().map_or(0, |n| n + 1));
+        let id = sets.request(Job { pose: pose.clone(), photons, seed })?;
+        let changed = self.requested.as_ref().is_some_and(|(p, _)| *p != pose);
+        if changed {
+            self.pending_poses.push((id, Instant::now()));
+        }
+        self.requested = Some((pose, photons));
+        Ok(())
+    }
+
+    fn received(&mut self, set: &PhotonSet) {
+        self.budget.traced(set.photons, set.seconds);
+        self.trace_seconds += set.seconds;
+        self.readouts.trace_ms = set.seconds * 1e3;
+        self.readouts.photons_per_set = set.photons;
+        self.readouts.stored = [set.traced.indirect().len(), set.traced.caustic.len(), set.traced.volume.len()];
+    }
+
     /// Opens the window, finds an adapter that can present to it, traces
-    /// the photons (once) and builds the renderer.
+    /// the first photon set and builds the renderer.
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<Session> {
-        let (width, height) = self.args.size.unwrap_or((self.scene.camera.width, self.scene.camera.height));
+        let (width, height) = self.args.size.unwrap_or((self.base.camera.width, self.base.camera.height));
         let attributes = Window::default_attributes()
             .with_title(format!("hikari view — {}", self.args.scene))
             .with_inner_size(PhysicalSize::new(width, height));
@@ -237,16 +346,9 @@ impl Viewer {
             color_space: wgpu::SurfaceColorSpace::Auto,
         };
         ctx.scoped(|| surface.configure(&ctx.device, &config))?;
-        if self.traced.is_none() {
-            let progress = TerminalProgress::new(self.args.quiet);
-            let start = Instant::now();
-            let settings = TraceSettings { photons: self.args.photons, seed: self.args.seed, ..Default::default() };
-            self.traced = Some(trace_photons(&self.scene, &settings, &progress));
-            self.trace_seconds = start.elapsed().as_secs_f64();
-        }
-        if self.photon_sets.is_none() {
-            self.photon_sets = Some(self.start_tracing()?);
-            self.sets_used = 1;
+        if self.shown.is_none() {
+            self.clock.tick(Instant::now());
+            self.start_tracing()?;
         }
         eprintln!("view: {} on {}", self.args.scene, ctx.describe());
         let present = PresentPass::new(&ctx.device, format);
@@ -257,38 +359,27 @@ impl Viewer {
         Ok(Session { window, surface, config, renderer, present, mean, panel })
     }
 
-    /// Photon sets of the scene as loaded now, from a new thread.
-    fn start_tracing(&self) -> Result<PhotonSets> {
-        let scene = Scene::load(&self.args.scene).map_err(|e| UsageError(e.to_string()))?;
-        PhotonSets::start(scene, self.args.photons, self.args.seed)
-    }
-
-    /// A renderer for frames of `width × height` from the orbit's camera.
+    /// A renderer for frames of `width × height` from the orbit's camera,
+    /// of the set on screen.
     fn renderer(&mut self, ctx: GpuContext, width: u32, height: u32) -> Result<GpuRenderer> {
-        self.scene.camera = self.orbit.camera(width, height);
-        let scene = &self.scene;
-        let traced = self.traced.as_ref().expect("photons are traced before the renderer is built");
-        self.readouts.photons_per_set = self.args.photons;
-        self.readouts.stored = [traced.indirect().len(), traced.caustic.len(), traced.volume.len()];
-        self.readouts.diagonal = scene.diagonal();
-        let (mut global, mut caustic) = PhotonCpuSettings::default().estimate_params(scene);
+        let shown = self.shown.as_ref().expect("a photon set is traced before the renderer is built");
+        let mut scene = Scene::clone(&shown.scene);
+        scene.camera = self.orbit.camera(width, height);
+        let r = &mut self.readouts;
+        r.diagonal = scene.diagonal();
+        r.has_media = !scene.media.is_empty();
+        r.light_names = self.base.names.lights.clone();
+        r.objects = self.base.names.objects.clone();
+        let (mut global, mut caustic) = PhotonCpuSettings::default().estimate_params(&scene);
         global.radius = self.applied.global_radius;
         caustic.radius = self.applied.caustic_radius;
         let settings = GpuSettings {
-            volume_radius: default_radius(scene),
+            volume_radius: self.applied.volume_radius,
             terms: self.applied.terms,
             lod: self.applied.lod,
             ..GpuSettings::new(global, caustic)
         };
-        Ok(GpuRenderer::new(ctx, scene, traced, settings)?)
-    }
-
-    /// The next photon set: waited for in unattended runs (after the first
-    /// frame), taken if ready otherwise.
-    fn next_photon_set(&mut self) -> Result<Option<TracedPhotons>> {
-        // The first frame draws the set the renderer was built with.
-        let (Some(sets), Some(_)) = (&self.photon_sets, self.last_frame) else { return Ok(None) };
-        sets.next(self.args.frames.is_some())
+        Ok(GpuRenderer::new(ctx, &scene, &shown.traced, settings)?)
     }
 
     /// Reloads the scene file when it changed (checked four times a second).
@@ -301,27 +392,28 @@ impl Viewer {
             Err(e) => {
                 eprintln!("view: {e} (the last good scene stays)");
                 self.reload_error = Some(e.to_string());
+                self.readouts.reload_error = self.reload_error.clone();
                 return Ok(());
             }
         };
         self.reload_error = None;
+        self.readouts.reload_error = None;
         let Some(session) = self.session.take() else { return Ok(()) };
         let Session { window, surface, config, renderer, present, panel, .. } = session;
         let ctx = renderer.ctx.clone();
         drop(renderer);
-        // The new scene with the current camera, its first photon set now,
-        // the next ones from a new tracing thread (the old one ends when
-        // its channel closes).
-        self.scene = scene;
-        let settings = TraceSettings { photons: self.args.photons, seed: self.args.seed, ..Default::default() };
-        self.traced = Some(trace_photons(&self.scene, &settings, &hikari_core::progress::Silent));
-        self.photon_sets = Some(self.start_tracing()?);
-        self.sets_used = 1;
+        // The new scene with the current camera and settings (its own
+        // lights and objects, unedited), from a new tracing thread (the old
+        // one ends when its channels close).
+        let fresh = controls_for(&scene, &self.args);
+        (self.controls.lights, self.controls.offsets) = (fresh.lights, fresh.offsets);
+        self.applied = self.controls.clone();
+        self.base = Arc::new(scene);
+        self.start_tracing()?;
         let renderer = self.renderer(ctx, config.width, config.height)?;
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
         self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
-        self.last_frame = None;
-        self.edited();
+        self.camera_moved();
         eprintln!("view: reloaded {}", self.args.scene);
         Ok(())
     }
@@ -337,15 +429,47 @@ impl Viewer {
         }
         let step = self.fly_speed * dt;
         self.orbit.fly((w - s) * step, (d - a) * step, (e - q) * step);
-        self.edited();
+        self.camera_moved();
     }
 
-    /// Renders (when the camera moved or a new photon set came), adds the
-    /// frame to the mean, and presents the mean.
+    /// Asks the tracer for what this frame needs: the new pose when the
+    /// clock or an edit moved anything (or the photon count changed), else
+    /// (nothing pending) the next set of the pose on screen, to converge.
+    fn ask_for_photons(&mut self) -> Result<()> {
+        if self.last_frame.is_none() {
+            return Ok(()); // the first frame draws the set the renderer was built with
+        }
+        let pose = self.pose();
+        let photons = self.controls.photons;
+        let changed = self.requested.as_ref().is_none_or(|(p, n)| *p != pose || *n != photons);
+        let idle = match (&self.photon_sets, &self.shown) {
+            (Some(sets), Some(shown)) => sets.newest() == Some(shown.id),
+            _ => false,
+        };
+        if changed || idle { self.request(pose) } else { Ok(()) }
+    }
+
+    /// Renders (when the camera moved, a setting changed or a new photon
+    /// set came), adds the frame to the mean, and presents the mean.
     fn frame(&mut self) -> Result<()> {
         self.watch()?;
         self.fly();
-        let new_set = self.next_photon_set()?;
+        self.clock.playing = self.controls.playing;
+        if self.last_frame.is_some() {
+            self.clock.tick(Instant::now());
+        }
+        self.readouts.time = self.base.is_animated().then(|| self.clock.time());
+        self.ask_for_photons()?;
+        let new_set = match (&mut self.photon_sets, self.last_frame) {
+            (Some(sets), Some(_)) => sets.next(self.args.frames.is_some())?,
+            _ => None,
+        };
+        if let Some(sets) = &self.photon_sets {
+            self.readouts.photon_sets = sets.received;
+        }
+        if let Some(set) = &new_set {
+            self.received(set);
+        }
         let Some(session) = &mut self.session else { return Ok(()) };
         let (width, height) = (session.config.width, session.config.height);
         let camera = self.orbit.camera(width, height);
@@ -355,33 +479,43 @@ impl Viewer {
             session.renderer.set_camera(&camera)?;
             session.mean.reset();
         }
-        let edited = self.controls != self.applied;
-        let restart = self.controls.terms != self.applied.terms
-            || self.controls.lod != self.applied.lod
-            || self.controls.global_radius != self.applied.global_radius
-            || self.controls.caustic_radius != self.applied.caustic_radius;
+        let c = &self.controls;
+        let a = &self.applied;
+        let restart = c.terms != a.terms
+            || c.lod != a.lod
+            || c.global_radius != a.global_radius
+            || c.caustic_radius != a.caustic_radius
+            || c.volume_radius != a.volume_radius;
         if restart {
             let settings = &mut session.renderer.settings;
-            settings.terms = self.controls.terms;
-            settings.lod = self.controls.lod;
-            let radii_changed = settings.global.radius != self.controls.global_radius
-                || settings.caustic.radius != self.controls.caustic_radius;
-            settings.global.radius = self.controls.global_radius;
-            settings.caustic.radius = self.controls.caustic_radius;
+            settings.terms = c.terms;
+            settings.lod = c.lod;
+            let radii_changed = settings.global.radius != c.global_radius
+                || settings.caustic.radius != c.caustic_radius
+                || settings.volume_radius != c.volume_radius;
+            settings.global.radius = c.global_radius;
+            settings.caustic.radius = c.caustic_radius;
+            settings.volume_radius = c.volume_radius;
             if radii_changed && new_set.is_none() {
-                // The specular pass's grids are cells of the radius.
-                let traced = self.traced.as_ref().expect("a photon set is drawn");
-                session.renderer.set_photons(&self.scene, traced)?;
+                // The specular pass's grids are cells of the radii.
+                let shown = self.shown.as_ref().expect("a photon set is drawn");
+                session.renderer.set_photons(&shown.scene, &shown.traced)?;
             }
             session.mean.reset();
         }
-        if edited {
-            self.applied = self.controls.clone();
+        if *c != *a {
+            self.applied = c.clone();
         }
         let fresh = new_set.is_some();
-        if let Some(traced) = new_set {
-            session.renderer.set_photons(&self.scene, &traced)?;
-            self.traced = Some(traced);
+        if let Some(set) = new_set {
+            let same_scene = self.shown.as_ref().is_some_and(|s| s.pose == set.pose);
+            if same_scene {
+                session.renderer.set_photons(&set.scene, &set.traced)?;
+            } else {
+                session.renderer.set_scene(&set.scene, &set.traced)?;
+                session.mean.reset();
+            }
+            self.shown = Some(set);
             self.sets_used += 1;
         }
         if moved || fresh || restart || session.mean.count() == 0 {
@@ -422,7 +556,6 @@ impl Viewer {
         };
         session.present.record(&ctx.device, &mut encoder, shown, &view, self.controls.exposure, self.controls.mode);
         self.readouts.frames_in_mean = session.mean.count();
-        self.readouts.photon_sets = self.sets_used;
         let size = [session.config.width, session.config.height];
         let panel = &mut session.panel;
         panel.draw(
@@ -443,15 +576,25 @@ impl Viewer {
         let now = Instant::now();
         if let Some(last) = self.last_frame {
             self.stats.push((now - last).as_secs_f64());
+            self.budget.frame((now - last).as_secs_f64());
         }
         self.started.get_or_insert(now);
         self.last_frame = Some(now);
-        if let Some(edit) = self.pending_edit.take() {
-            self.edit_latencies.push((now - edit).as_secs_f64());
+        if let Some(edit) = self.pending_camera.take() {
+            self.camera_latencies.push((now - edit).as_secs_f64());
         }
+        // Pose requests up to the set on screen have reached it.
+        let on_screen = self.shown.as_ref().map_or(0, |s| s.id);
+        let (done, waiting): (Vec<_>, Vec<_>) = self.pending_poses.drain(..).partition(|(id, _)| *id <= on_screen);
+        self.pending_poses = waiting;
+        self.pose_latencies.extend(done.iter().map(|(_, t)| (now - *t).as_secs_f64()));
         if self.title_updated.is_none_or(|t| (now - t).as_secs_f64() > 0.5) && self.stats.frames() > 0 {
             let fps = self.stats.mean_fps();
             self.readouts.fps = fps;
+            let elapsed = self.started.map_or(0.0, |s| (now - s).as_secs_f64());
+            self.readouts.sets_per_second =
+                if elapsed > 0.0 { self.photon_sets.as_ref().map_or(0, |s| s.received) as f64 / elapsed } else { 0.0 };
+            self.readouts.edit_latency_ms = mean(&self.pose_latencies).map(|s| s * 1e3);
             let frames = session.mean.count();
             let error = self.reload_error.as_ref().map_or(String::new(), |e| format!(" — error: {e}"));
             session
@@ -468,7 +611,7 @@ impl Viewer {
         let mut image = hikari_core::render::Image::new(session.config.width, session.config.height);
         for (pixel, value) in image.pixels.iter_mut().zip(session.renderer.read(&session.mean.mean)?) {
             let v = value.truncate();
-            *pixel = if v.is_finite() { v } else { glam::Vec3::ZERO };
+            *pixel = if v.is_finite() { v } else { Vec3::ZERO };
         }
         write_image(path, &image, self.controls.exposure)?;
         eprintln!("view: wrote {}", path.display());
@@ -501,25 +644,29 @@ impl Viewer {
             (Some(a), Some(b)) => (b - a).as_secs_f64(),
             _ => 0.0,
         };
-        let latency = if self.edit_latencies.is_empty() {
-            "no camera moves".to_string()
-        } else {
-            let mean = self.edit_latencies.iter().sum::<f64>() / self.edit_latencies.len() as f64;
-            format!("camera move to screen {:.1} ms mean over {} moves", mean * 1e3, self.edit_latencies.len())
+        let latency = |what: &str, latencies: &[f64], none: &str| match mean(latencies) {
+            None => none.to_string(),
+            Some(m) => format!("{what} to screen {:.1} ms mean over {}", m * 1e3, latencies.len()),
         };
+        let received = self.photon_sets.as_ref().map_or(0, |s| s.received);
+        let per_second = if seconds > 0.0 { received as f64 / seconds } else { 0.0 };
         println!(
-            "view: {} frames in {seconds:.2} s: mean {:.2} fps, 1% low {:.2} fps; {} photon sets drawn (the first traced in {:.2} s); {latency}",
+            "view: {} frames in {seconds:.2} s: mean {:.2} fps, 1% low {:.2} fps; {} photon sets drawn, \
+             {received} traced ({per_second:.2}/s, {:.1} ms each, the first {:.1} ms); {}; {}",
             self.stats.frames() + self.last_frame.is_some() as usize,
             self.stats.mean_fps(),
             self.stats.one_percent_low_fps(),
             self.sets_used,
-            self.trace_seconds,
+            if self.sets_used > 0 { self.trace_seconds / self.sets_used as f64 * 1e3 } else { 0.0 },
+            self.first_trace_seconds * 1e3,
+            latency("scene edit", &self.pose_latencies, "no scene edits"),
+            latency("camera move", &self.camera_latencies, "no camera moves"),
         );
     }
 
     /// The camera moved: the next presented frame shows it.
-    fn edited(&mut self) {
-        self.pending_edit.get_or_insert_with(Instant::now);
+    fn camera_moved(&mut self) {
+        self.pending_camera.get_or_insert_with(Instant::now);
     }
 
     fn key(&mut self, event_loop: &ActiveEventLoop, key: &Key) -> Result<()> {
@@ -530,9 +677,10 @@ impl Viewer {
                     s.panel.visible = !s.panel.visible;
                 }
             }
+            Key::Named(NamedKey::Space) => self.controls.playing = !self.controls.playing,
             Key::Named(NamedKey::Home) => {
                 self.orbit.reset();
-                self.edited();
+                self.camera_moved();
             }
             Key::Named(NamedKey::F12) => {
                 self.screenshots += 1;
@@ -558,6 +706,10 @@ impl Viewer {
         }
         Ok(())
     }
+}
+
+fn mean(values: &[f64]) -> Option<f64> {
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
 
 impl ApplicationHandler for Viewer {
@@ -626,7 +778,7 @@ impl ApplicationHandler for Viewer {
                     Some(MouseButton::Right) => self.orbit.look(dx, dy),
                     _ => return,
                 }
-                self.edited();
+                self.camera_moved();
                 Ok(())
             }
             WindowEvent::MouseWheel { delta, .. } => {
@@ -638,7 +790,7 @@ impl ApplicationHandler for Viewer {
                     self.fly_speed = (self.fly_speed * 1.25f32.powf(lines)).clamp(1e-6, 1e7);
                 } else {
                     self.orbit.zoom(lines);
-                    self.edited();
+                    self.camera_moved();
                 }
                 Ok(())
             }

@@ -1,7 +1,10 @@
 //! The viewer's panel (egui, drawn over the frame): frame rate and per-pass
-//! GPU times, photon counts, the terms of the image, radii, LOD, exposure
-//! and debug views. F1 hides it.
+//! GPU times, photon counts, the terms of the image, radii, LOD, exposure,
+//! photons per set, the animation clock, the lights and named objects, and
+//! debug views. F1 hides it.
 
+use glam::Vec3;
+use hikari_core::light::Light;
 use hikari_core::lod::LodSettings;
 use hikari_gpu::present::PresentMode;
 use hikari_gpu::resolve::Terms;
@@ -16,6 +19,16 @@ pub struct Controls {
     pub terms: Terms,
     pub lod: Option<LodSettings>,
     pub mode: PresentMode,
+    pub volume_radius: f32,
+    /// Photon paths per set (chosen by the budget while `trace_every_frame`).
+    pub photons: u64,
+    pub trace_every_frame: bool,
+    /// Whether the scene's animations play.
+    pub playing: bool,
+    /// The lights as edited (before their animations), and an offset per
+    /// surface (named objects are edited): `Pose::lights`, `Pose::offsets`.
+    pub lights: Vec<Light>,
+    pub offsets: Vec<Vec3>,
 }
 
 /// Read-outs, refreshed by the viewer.
@@ -33,6 +46,17 @@ pub struct Readouts {
     pub reload_error: Option<String>,
     /// The scene diagonal, for the radius sliders' range.
     pub diagonal: f32,
+    pub has_media: bool,
+    /// Names of the lights (`None`: unnamed) and the named objects' surfaces.
+    pub light_names: Vec<Option<String>>,
+    pub objects: Vec<(String, u32)>,
+    /// The animation time, when the scene is animated.
+    pub time: Option<f32>,
+    /// Photon sets traced per second, mean seconds per set, and the mean
+    /// latency from a scene edit to the screen (ms).
+    pub sets_per_second: f64,
+    pub trace_ms: f64,
+    pub edit_latency_ms: Option<f64>,
 }
 
 pub struct Panel {
@@ -118,6 +142,10 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
         "photons: {} per set; stored {} global, {} caustic, {} volume",
         r.photons_per_set, r.stored[0], r.stored[1], r.stored[2]
     ));
+    ui.label(format!("tracing: {:.1} sets/s, {:.1} ms per set", r.sets_per_second, r.trace_ms));
+    if let Some(ms) = r.edit_latency_ms {
+        ui.label(format!("scene edit to screen: {ms:.0} ms (mean)"));
+    }
     if let Some(error) = &r.reload_error {
         ui.colored_label(egui::Color32::LIGHT_RED, error);
     }
@@ -145,7 +173,15 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
     });
     let range = (r.diagonal * 1e-3)..=(r.diagonal * 0.2);
     ui.add(egui::Slider::new(&mut c.global_radius, range.clone()).logarithmic(true).text("global radius"));
-    ui.add(egui::Slider::new(&mut c.caustic_radius, range).logarithmic(true).text("caustic radius"));
+    ui.add(egui::Slider::new(&mut c.caustic_radius, range.clone()).logarithmic(true).text("caustic radius"));
+    if r.has_media {
+        ui.add(egui::Slider::new(&mut c.volume_radius, range).logarithmic(true).text("volume radius"));
+    }
+    ui.add_enabled(
+        !c.trace_every_frame,
+        egui::Slider::new(&mut c.photons, 1_000..=10_000_000).logarithmic(true).text("photons per set"),
+    );
+    ui.checkbox(&mut c.trace_every_frame, "trace every frame (photons to keep up)");
     ui.add(egui::Slider::new(&mut c.exposure, -8.0..=8.0).text("exposure (stops)"));
     let mut lod_on = c.lod.is_some();
     ui.checkbox(&mut lod_on, "level of detail");
@@ -157,10 +193,81 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
     } else {
         c.lod = None;
     }
+    if let Some(time) = r.time {
+        ui.checkbox(&mut c.playing, format!("animate (t = {time:.2} s; Space)"));
+    }
+    scene_edits(ui, c, r);
     ui.horizontal(|ui| {
         ui.label("show");
         ui.radio_value(&mut c.mode, PresentMode::Radiance, "image");
         ui.radio_value(&mut c.mode, PresentMode::Normals, "normals");
         ui.radio_value(&mut c.mode, PresentMode::Albedo, "albedo");
     });
+}
+
+/// Three drag fields for a point or vector; true when one changed.
+fn drag_vec3(ui: &mut egui::Ui, label: &str, v: &mut Vec3, speed: f32) -> bool {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        let mut changed = false;
+        for x in [&mut v.x, &mut v.y, &mut v.z] {
+            changed |= ui.add(egui::DragValue::new(x).speed(speed).max_decimals(3)).changed();
+        }
+        changed
+    })
+    .inner
+}
+
+/// The lights (position, a spot's direction, colour and strength) and the
+/// named objects (an offset from their place).
+fn scene_edits(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
+    let speed = r.diagonal * 0.002;
+    egui::CollapsingHeader::new("lights").default_open(false).show(ui, |ui| {
+        for (i, light) in c.lights.iter_mut().enumerate() {
+            let kind = match light {
+                Light::Point { .. } => "point",
+                Light::Spot { .. } => "spot",
+                Light::Sphere { .. } => "sphere",
+                Light::Quad { .. } => "quad",
+            };
+            let name = r.light_names.get(i).cloned().flatten().unwrap_or_else(|| format!("light #{}", i + 1));
+            ui.label(format!("{name} ({kind})"));
+            let mut anchor = light.anchor();
+            if drag_vec3(ui, "position", &mut anchor, speed) {
+                *light = light.with_anchor(anchor);
+            }
+            if let Light::Spot { axis, .. } = light {
+                let mut direction = *axis;
+                if drag_vec3(ui, "direction", &mut direction, 0.01) {
+                    if let Some(unit) = direction.try_normalize() {
+                        *axis = unit;
+                    }
+                }
+            }
+            let emission = light.emission();
+            let mut strength = emission.max_element();
+            let mut colour = (emission / strength.max(f32::MIN_POSITIVE)).to_array();
+            let changed = ui
+                .horizontal(|ui| {
+                    let c = ui.color_edit_button_rgb(&mut colour).changed();
+                    c | ui
+                        .add(egui::Slider::new(&mut strength, 1e-3..=1e6).logarithmic(true).text("strength"))
+                        .changed()
+                })
+                .inner;
+            // A black colour would leave no power to emit photons with.
+            if changed && colour.iter().copied().fold(0.0, f32::max) >= 1e-3 {
+                *light = light.with_emission(Vec3::from(colour) * strength);
+            }
+        }
+    });
+    if !r.objects.is_empty() {
+        egui::CollapsingHeader::new("objects").default_open(false).show(ui, |ui| {
+            for (name, surface) in &r.objects {
+                if let Some(offset) = c.offsets.get_mut(*surface as usize) {
+                    drag_vec3(ui, name, offset, speed);
+                }
+            }
+        });
+    }
 }

@@ -1,46 +1,121 @@
-//! Fresh photon sets for the viewer's running mean, traced on a background
-//! thread (all cores, through rayon) so a frame never waits for tracing.
+//! The viewer's photon tracer: a background thread that traces photon sets
+//! on request (all cores, through rayon), so a frame never waits for
+//! tracing. A request names a pose of the scene (time and edits), a photon
+//! count and a seed; the thread always takes the newest request waiting,
+//! poses the scene (rebuilding its BVH) and traces it. Results come back
+//! with the posed scene they were traced in, so the window always draws a
+//! scene and photons that belong together.
 
 use anyhow::{Result, anyhow};
 use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
-use hikari_core::scene::Scene;
-use std::sync::mpsc::{Receiver, TryRecvError, sync_channel};
+use hikari_core::scene::{Pose, Scene};
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
+use std::time::Instant;
 
-/// Sets k = 1, 2, … of a scene, traced with seed + k, at most one ahead of
-/// the window. The thread ends when this is dropped (its next send fails).
+/// One request.
+#[derive(Clone, Debug)]
+pub struct Job {
+    pub pose: Pose,
+    pub photons: u64,
+    pub seed: u64,
+}
+
+/// A traced set: the request's number, the posed scene and its photons.
+pub struct PhotonSet {
+    pub id: u64,
+    pub pose: Pose,
+    pub scene: Arc<Scene>,
+    pub traced: TracedPhotons,
+    /// Seconds spent posing and tracing, and the photon paths traced.
+    pub seconds: f64,
+    pub photons: u64,
+}
+
 pub struct PhotonSets {
-    receiver: Receiver<TracedPhotons>,
+    jobs: Sender<(u64, Job)>,
+    results: Receiver<PhotonSet>,
+    /// Requests made so far (the newest has number `requested - 1`).
+    requested: u64,
+    /// Sets that came back, including those too old to draw.
+    pub received: u64,
 }
 
 impl PhotonSets {
-    pub fn start(scene: Scene, photons: u64, seed: u64) -> Result<Self> {
-        let (sender, receiver) = sync_channel(1);
+    /// A tracing thread for poses of `scene` (as loaded). It ends when this
+    /// is dropped (its channels close).
+    pub fn start(scene: Arc<Scene>) -> Result<Self> {
+        let (jobs, job_receiver) = channel::<(u64, Job)>();
+        let (sender, results) = channel();
         std::thread::Builder::new()
             .name("photon sets".into())
             .spawn(move || {
-                for k in 1.. {
-                    let settings = TraceSettings { photons, seed: seed.wrapping_add(k), ..Default::default() };
+                let mut posed: Option<(Pose, Arc<Scene>)> = None;
+                while let Ok(mut job) = job_receiver.recv() {
+                    // Only the newest request matters: older ones are stale.
+                    while let Ok(newer) = job_receiver.try_recv() {
+                        job = newer;
+                    }
+                    let (id, Job { pose, photons, seed }) = job;
+                    let start = Instant::now();
+                    let scene = match &posed {
+                        Some((p, s)) if *p == pose => s.clone(),
+                        _ => {
+                            let s = Arc::new(scene.posed(&pose));
+                            posed = Some((pose.clone(), s.clone()));
+                            s
+                        }
+                    };
+                    let settings = TraceSettings { photons, seed, ..Default::default() };
                     let traced = trace_photons(&scene, &settings, &hikari_core::progress::Silent);
-                    if sender.send(traced).is_err() {
+                    let seconds = start.elapsed().as_secs_f64();
+                    let set = PhotonSet { id, pose, scene, traced, seconds, photons };
+                    if sender.send(set).is_err() {
                         return; // the window closed, or the scene was reloaded
                     }
                 }
             })
             .map_err(|e| anyhow!("cannot start the photon-tracing thread: {e}"))?;
-        Ok(PhotonSets { receiver })
+        Ok(PhotonSets { jobs, results, requested: 0, received: 0 })
     }
 
-    /// The next set: waited for when `wait`, else only if it is ready.
-    pub fn next(&self, wait: bool) -> Result<Option<TracedPhotons>> {
+    /// Asks for a set; returns its number. Requests are numbered from 0 in
+    /// the order made, so the same requests give the same numbers.
+    pub fn request(&mut self, job: Job) -> Result<u64> {
+        let id = self.requested;
+        self.jobs.send((id, job)).map_err(|_| anyhow!("the photon-tracing thread stopped"))?;
+        self.requested += 1;
+        Ok(id)
+    }
+
+    /// The number of the newest request, if any.
+    pub fn newest(&self) -> Option<u64> {
+        self.requested.checked_sub(1)
+    }
+
+    /// The newest set that came back, if any (older ones are dropped).
+    /// With `wait`, waits for the set of the newest request instead.
+    pub fn next(&mut self, wait: bool) -> Result<Option<PhotonSet>> {
         let stopped = || anyhow!("the photon-tracing thread stopped");
+        let mut newest = None;
+        loop {
+            match self.results.try_recv() {
+                Ok(set) => {
+                    self.received += 1;
+                    newest = Some(set);
+                }
+                Err(TryRecvError::Empty) => break,
+                Err(TryRecvError::Disconnected) => return Err(stopped()),
+            }
+        }
         if wait {
-            return self.receiver.recv().map(Some).map_err(|_| stopped());
+            let target = self.newest();
+            while newest.as_ref().map(|s| s.id) != target {
+                newest = Some(self.results.recv().map_err(|_| stopped())?);
+                self.received += 1;
+            }
         }
-        match self.receiver.try_recv() {
-            Ok(traced) => Ok(Some(traced)),
-            Err(TryRecvError::Empty) => Ok(None),
-            Err(TryRecvError::Disconnected) => Err(stopped()),
-        }
+        Ok(newest)
     }
 }
 
@@ -48,19 +123,38 @@ impl PhotonSets {
 mod tests {
     use super::*;
 
+    fn bits(t: &TracedPhotons) -> Vec<[u32; 3]> {
+        t.global.iter().map(|p| p.position.map(f32::to_bits)).collect()
+    }
+
     #[test]
-    fn sets_follow_the_seeds_in_order() {
-        let scene = || Scene::load("cornell-box").unwrap();
-        let sets = PhotonSets::start(scene(), 500, 7).unwrap();
-        for k in 1..=3u64 {
+    fn a_set_is_the_trace_of_its_request() {
+        let scene = Arc::new(Scene::load("cornell-orbit").unwrap());
+        let mut sets = PhotonSets::start(scene.clone()).unwrap();
+        for (k, time) in [(1u64, 0.0f32), (2, 1.7)] {
+            let pose = Pose { time, ..scene.rest_pose() };
+            let id = sets.request(Job { pose: pose.clone(), photons: 500, seed: 7 + k }).unwrap();
             let got = sets.next(true).unwrap().unwrap();
+            assert_eq!(got.id, id);
+            assert_eq!(got.pose, pose);
             let want = trace_photons(
-                &scene(),
+                &scene.posed(&pose),
                 &TraceSettings { photons: 500, seed: 7 + k, ..Default::default() },
                 &hikari_core::progress::Silent,
             );
-            let bits = |t: &TracedPhotons| t.global.iter().map(|p| p.position.map(f32::to_bits)).collect::<Vec<_>>();
-            assert_eq!(bits(&got), bits(&want), "set {k}");
+            assert_eq!(bits(&got.traced), bits(&want), "set {k}");
         }
+    }
+
+    #[test]
+    fn waiting_skips_to_the_newest_request() {
+        let scene = Arc::new(Scene::load("cornell-box").unwrap());
+        let mut sets = PhotonSets::start(scene.clone()).unwrap();
+        for seed in 0..5 {
+            sets.request(Job { pose: scene.rest_pose(), photons: 2000, seed }).unwrap();
+        }
+        let got = sets.next(true).unwrap().unwrap();
+        assert_eq!(got.id, 4);
+        assert!(sets.received <= 5);
     }
 }

@@ -81,6 +81,7 @@ impl Boundable for PrimBounds {
     }
 }
 
+#[derive(Clone)]
 pub struct Accel {
     triangles: Vec<Triangle>,
     spheres: Vec<Sphere>,

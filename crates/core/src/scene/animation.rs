@@ -110,12 +110,8 @@ impl Scene {
                 .filter(|a| a.target == target)
                 .fold(Affine3A::IDENTITY, |m, a| a.motion.at(pose.time) * m)
         };
-        let lights: Vec<Light> = pose
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, light)| light.moved(&motion_of(Target::Light(i as u32))))
-            .collect();
+        let lights: Vec<Light> =
+            pose.lights.iter().enumerate().map(|(i, light)| light.moved(&motion_of(Target::Light(i as u32)))).collect();
         // Per surface: the edit's translation, then the animations.
         let surface_motion: Vec<Affine3A> = self
             .surfaces
@@ -136,9 +132,8 @@ impl Scene {
             .map(|(t, s)| {
                 let m = moved(s);
                 let v = t.v.map(|p| m.transform_point3(p));
-                let normals = t.normals.map(|TriangleNormals(n)| {
-                    TriangleNormals(n.map(|x| m.transform_vector3(x).normalize()))
-                });
+                let normals =
+                    t.normals.map(|TriangleNormals(n)| TriangleNormals(n.map(|x| m.transform_vector3(x).normalize())));
                 (Triangle { v, normals }, s)
             })
             .unzip();
@@ -251,7 +246,9 @@ period = 2.0
         assert!((centre(&quarter, 0) - centre(&scene, 0)).length() < 1e-6);
         // Rest pose at time 0 leaves everything where it was.
         let rest = scene.posed(&scene.rest_pose());
-        let bits = |s: &Scene| s.accel.triangles().flat_map(|t| t.0.v).map(|v| v.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+        let bits = |s: &Scene| {
+            s.accel.triangles().flat_map(|t| t.0.v).map(|v| v.to_array().map(f32::to_bits)).collect::<Vec<_>>()
+        };
         assert_eq!(bits(&rest), bits(&scene));
     }
 

@@ -24,6 +24,7 @@ pub struct Surface {
     pub emitter: Option<u32>,
 }
 
+#[derive(Clone)]
 pub struct Scene {
     /// Where the scene came from (file path or `builtin:NAME`).
     pub source: String,
