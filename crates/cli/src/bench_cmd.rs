@@ -2,7 +2,9 @@
 //! this machine's GPU: frames per second and a per-pass breakdown (GPU
 //! timestamps where the adapter has them). Photon tracing is not timed in
 //! the static rows; the dynamic rows (what the viewer does) time a camera
-//! that moves every frame, and photons re-traced on the CPU every frame.
+//! that moves every frame, photons re-traced on the CPU every frame, and a
+//! light that moves every frame (the scene posed, its BVH rebuilt, its
+//! photons re-traced and uploaded with the moved scene).
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -45,6 +47,24 @@ enum Motion {
     Orbit,
     /// A new photon set is traced (all cores) and uploaded every frame.
     Retrace,
+    /// The first light orbits (`orbiting_light`), 1/60 s further every
+    /// frame: pose, trace, `set_scene`, render.
+    MovingLight,
+}
+
+/// `scene` with its first light orbiting a vertical axis 15% of the scene's
+/// diagonal away, once every 5 s.
+fn orbiting_light(mut scene: Scene) -> Scene {
+    use hikari_core::scene::{Animation, Motion as Move, Target};
+    let center = scene.lights[0].anchor() + glam::Vec3::X * 0.15 * scene.diagonal();
+    let motion = Move::Rotate { center, axis: glam::Vec3::Y, period: 5.0 };
+    scene.animations.push(Animation { target: Target::Light(0), motion });
+    scene
+}
+
+/// A dynamic row: `scene` at `size` with `photons` re-traced every frame as its light moves.
+fn moving_light_row(label: &'static str, scene: &'static str, size: (u32, u32), photons: u64) -> Row {
+    Row { label, scene, size, photons, volume: false, lod: None, motion: Motion::MovingLight }
 }
 
 /// The seed's fog-scene LOD settings, in scene units as given (its scene's
@@ -131,6 +151,24 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             lod: None,
             motion: Motion::Retrace,
         },
+        moving_light_row(
+            "cornell-box, moving light, 20,000 photons re-traced every frame",
+            "cornell-box",
+            (512, 512),
+            20_000,
+        ),
+        moving_light_row(
+            "cornell-box, moving light, 50,000 photons re-traced every frame",
+            "cornell-box",
+            (512, 512),
+            50_000,
+        ),
+        moving_light_row(
+            "cornell-box, moving light, 100,000 photons re-traced every frame",
+            "cornell-box",
+            (512, 512),
+            100_000,
+        ),
     ];
     if args.large {
         rows.push(Row {
@@ -151,6 +189,18 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             lod: None,
             motion: Motion::Still,
         });
+        for scene in ["cornell-box", "cornell-caustic"] {
+            rows.push(moving_light_row(
+                if scene == "cornell-box" {
+                    "cornell-box 1920x1080, moving light, 100,000 photons re-traced every frame"
+                } else {
+                    "cornell-caustic 1920x1080, moving light, 100,000 photons re-traced every frame"
+                },
+                scene,
+                (1920, 1080),
+                100_000,
+            ));
+        }
     }
     // A row the adapter cannot run (media without f32 blending, a size over
     // its limits) is reported and the table goes on.
@@ -165,6 +215,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u32)> {
     let mut scene = Scene::load(row.scene)?;
     scene.camera = scene.camera.with_resolution(row.size.0, row.size.1).map_err(anyhow::Error::msg)?;
+    let base = orbiting_light(scene.clone());
     let trace = |photons| trace_photons(&scene, &TraceSettings { photons, seed: 1, ..Default::default() }, &Silent);
     let traced = if row.volume {
         // Volume photons per emitted path, from a small trial.
@@ -204,6 +255,15 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
                 renderer.set_photons(&scene, &fresh)?;
                 global_count = fresh.indirect().len();
             }
+            Motion::MovingLight => {
+                let trace_start = Instant::now();
+                let posed = base.at_time((k + 1) as f32 / 60.0);
+                let settings = TraceSettings { photons: row.photons, seed: 2 + k as u64, ..Default::default() };
+                let fresh = trace_photons(&posed, &settings, &Silent);
+                tracing += trace_start.elapsed().as_secs_f64();
+                renderer.set_scene(&posed, &fresh)?;
+                global_count = fresh.indirect().len();
+            }
         }
         renderer.render()?;
     }
@@ -229,8 +289,9 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         breakdown.iter().map(|(stage, t): &(Stage, f64)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
     let how = if timestamps { "GPU timestamps" } else { "wall-clock, separate submits" };
     println!("    per pass ({how}): {}", parts.join(", "));
-    if row.motion == Motion::Retrace {
-        println!("    tracing {:.2} ms of each frame (CPU, all cores)", tracing / frames as f64 * 1e3);
+    if matches!(row.motion, Motion::Retrace | Motion::MovingLight) {
+        let what = if row.motion == Motion::MovingLight { "posing and tracing" } else { "tracing" };
+        println!("    {what} {:.2} ms of each frame (CPU, all cores)", tracing / frames as f64 * 1e3);
     }
     Ok((renderer, drawn))
 }

@@ -158,6 +158,8 @@ pub struct GpuRenderer {
     /// The scene's bounds (for the depth range of a moved camera).
     bounds: (Vec3, Vec3),
     volume_radius: f32,
+    /// The photons-as-points debug view, made when first drawn.
+    points: std::cell::OnceCell<crate::points::PointsPass>,
 }
 
 /// What the specular pass gathers from.
@@ -371,6 +373,7 @@ impl GpuRenderer {
             camera: scene.camera.clone(),
             bounds,
             volume_radius,
+            points: std::cell::OnceCell::new(),
             ctx,
         }
     }
@@ -434,6 +437,8 @@ impl GpuRenderer {
     /// `traced`, its photons. Pipelines, targets and the photon passes stay;
     /// the geometry, lights, shadow views, BVH and photons are uploaded.
     pub fn set_scene(&mut self, scene: &Scene, traced: &TracedPhotons) -> Result<(), GpuError> {
+        let counts = [traced.indirect().len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
+        Self::check_fits(&self.ctx, scene, &self.settings, counts)?;
         let scopes = self.ctx.error_scopes();
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         self.scene = SceneBuffers::upload(device, scene);
@@ -653,6 +658,28 @@ impl GpuRenderer {
             Stage::Specular => self.specular_pass.record(&self.ctx.queue, encoder),
             Stage::Resolve => self.resolve_pass.record(queue, encoder, &self.settings.terms),
         }
+    }
+
+    /// Draws the photons of the last frame (`render` first) as points into
+    /// the points view's target, and returns it. The pass is made on first
+    /// use and kept.
+    pub fn draw_points(&self, colors: crate::points::PointColors) -> Result<&wgpu::Texture, GpuError> {
+        let scopes = self.ctx.error_scopes();
+        let pass = self.points.get_or_init(|| crate::points::PointsPass::new(&self.ctx.device, &self.targets.gbuffer));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        let volume = self.has_media.then_some(&self.volume_lod);
+        pass.record(
+            &self.ctx.queue,
+            &mut encoder,
+            [Some(&self.global_lod), Some(&self.caustic_lod), volume],
+            &self.targets.gbuffer,
+            self.clip_from_world,
+            self.camera_position,
+            colors,
+        );
+        self.ctx.queue.submit([encoder.finish()]);
+        scopes.finish()?;
+        Ok(&pass.target)
     }
 
     /// The specular pass's radiance target.

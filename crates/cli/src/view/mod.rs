@@ -53,6 +53,7 @@ use hikari_core::output::write_image;
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
+use hikari_gpu::points::PointColors;
 use hikari_gpu::present::{PresentMode, PresentPass};
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use orbit::Orbit;
@@ -201,6 +202,7 @@ fn controls_for(scene: &Scene, args: &ViewArgs) -> Controls {
         global_radius: global.radius,
         caustic_radius: caustic.radius,
         volume_radius: default_radius(scene),
+        volume_slices: GpuSettings::new(global, caustic).volume_slices,
         terms: hikari_gpu::resolve::Terms::ALL,
         lod: None,
         mode: PresentMode::Radiance,
@@ -294,7 +296,7 @@ impl Viewer {
         let photons = if self.controls.trace_every_frame {
             self.budget.photons(self.controls.photons)
         } else {
-            self.controls.photons
+            self.controls.photons.min(self.budget.cap)
         };
         self.controls.photons = photons;
         let seed = self.args.seed.wrapping_add(sets.newest().map_or(0, |n| n + 1));
@@ -368,6 +370,7 @@ impl Viewer {
         let r = &mut self.readouts;
         r.diagonal = scene.diagonal();
         r.has_media = !scene.media.is_empty();
+        r.has_regions = hikari_gpu::media::GpuMedia::has_regions(&scene);
         r.light_names = self.base.names.lights.clone();
         r.objects = self.base.names.objects.clone();
         let (mut global, mut caustic) = PhotonCpuSettings::default().estimate_params(&scene);
@@ -375,6 +378,7 @@ impl Viewer {
         caustic.radius = self.applied.caustic_radius;
         let settings = GpuSettings {
             volume_radius: self.applied.volume_radius,
+            volume_slices: self.applied.volume_slices,
             terms: self.applied.terms,
             lod: self.applied.lod,
             ..GpuSettings::new(global, caustic)
@@ -432,6 +436,18 @@ impl Viewer {
         self.camera_moved();
     }
 
+    /// Builds the renderer anew (a setting that sizes its targets changed).
+    fn rebuild(&mut self) -> Result<()> {
+        let Some(session) = self.session.take() else { return Ok(()) };
+        let Session { window, surface, config, renderer, present, panel, .. } = session;
+        let ctx = renderer.ctx.clone();
+        drop(renderer);
+        let renderer = self.renderer(ctx, config.width, config.height)?;
+        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
+        self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
+        Ok(())
+    }
+
     /// Asks the tracer for what this frame needs: the new pose when the
     /// clock or an edit moved anything (or the photon count changed), else
     /// (nothing pending) the next set of the pose on screen, to converge.
@@ -460,6 +476,10 @@ impl Viewer {
         }
         self.readouts.time = self.base.is_animated().then(|| self.clock.time());
         self.ask_for_photons()?;
+        if self.controls.volume_slices != self.applied.volume_slices {
+            self.applied.volume_slices = self.controls.volume_slices;
+            self.rebuild()?;
+        }
         let new_set = match (&mut self.photon_sets, self.last_frame) {
             (Some(sets), Some(_)) => sets.next(self.args.frames.is_some())?,
             _ => None,
@@ -506,17 +526,35 @@ impl Viewer {
         if *c != *a {
             self.applied = c.clone();
         }
-        let fresh = new_set.is_some();
+        let mut fresh = false;
         if let Some(set) = new_set {
             let same_scene = self.shown.as_ref().is_some_and(|s| s.pose == set.pose);
-            if same_scene {
-                session.renderer.set_photons(&set.scene, &set.traced)?;
+            let applied = if same_scene {
+                session.renderer.set_photons(&set.scene, &set.traced)
             } else {
-                session.renderer.set_scene(&set.scene, &set.traced)?;
-                session.mean.reset();
+                session.renderer.set_scene(&set.scene, &set.traced)
+            };
+            match applied {
+                Ok(()) => {
+                    if !same_scene {
+                        session.mean.reset();
+                    }
+                    self.shown = Some(set);
+                    self.sets_used += 1;
+                    fresh = true;
+                }
+                // A set the adapter cannot hold (checked before anything
+                // changed): the last one stays and sets get smaller.
+                Err(GpuError::TooLarge(why)) => {
+                    let cap = (set.photons * 3 / 4).max(1);
+                    self.budget.cap = cap;
+                    self.controls.photons = self.controls.photons.min(cap);
+                    let warning = format!("{why}; photons per set lowered to {cap}");
+                    eprintln!("view: {warning}");
+                    self.readouts.warning = Some(warning);
+                }
+                Err(e) => return Err(e.into()),
             }
-            self.shown = Some(set);
-            self.sets_used += 1;
         }
         if moved || fresh || restart || session.mean.count() == 0 {
             // Every 2 s (panel shown) the frame itself is the timed one.
@@ -553,6 +591,8 @@ impl Viewer {
             PresentMode::Radiance => &session.mean.mean,
             PresentMode::Normals => &session.renderer.targets.gbuffer.normal,
             PresentMode::Albedo => &session.renderer.targets.gbuffer.albedo,
+            PresentMode::Photons => session.renderer.draw_points(PointColors::Power)?,
+            PresentMode::DetailLevels => session.renderer.draw_points(PointColors::DetailLevel)?,
         };
         session.present.record(&ctx.device, &mut encoder, shown, &view, self.controls.exposure, self.controls.mode);
         self.readouts.frames_in_mean = session.mean.count();

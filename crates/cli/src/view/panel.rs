@@ -20,6 +20,8 @@ pub struct Controls {
     pub lod: Option<LodSettings>,
     pub mode: PresentMode,
     pub volume_radius: f32,
+    /// Depth slices of the media regions' optical depth (rebuilds the renderer).
+    pub volume_slices: u32,
     /// Photon paths per set (chosen by the budget while `trace_every_frame`).
     pub photons: u64,
     pub trace_every_frame: bool,
@@ -47,6 +49,7 @@ pub struct Readouts {
     /// The scene diagonal, for the radius sliders' range.
     pub diagonal: f32,
     pub has_media: bool,
+    pub has_regions: bool,
     /// Names of the lights (`None`: unnamed) and the named objects' surfaces.
     pub light_names: Vec<Option<String>>,
     pub objects: Vec<(String, u32)>,
@@ -57,6 +60,8 @@ pub struct Readouts {
     pub sets_per_second: f64,
     pub trace_ms: f64,
     pub edit_latency_ms: Option<f64>,
+    /// The last thing the viewer had to refuse (a photon set too large).
+    pub warning: Option<String>,
 }
 
 pub struct Panel {
@@ -146,7 +151,7 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
     if let Some(ms) = r.edit_latency_ms {
         ui.label(format!("scene edit to screen: {ms:.0} ms (mean)"));
     }
-    if let Some(error) = &r.reload_error {
+    for error in [&r.reload_error, &r.warning].into_iter().flatten() {
         ui.colored_label(egui::Color32::LIGHT_RED, error);
     }
     egui::CollapsingHeader::new("GPU passes").default_open(false).show(ui, |ui| {
@@ -177,6 +182,9 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
     if r.has_media {
         ui.add(egui::Slider::new(&mut c.volume_radius, range).logarithmic(true).text("volume radius"));
     }
+    if r.has_regions {
+        ui.add(egui::Slider::new(&mut c.volume_slices, 1..=64).text("volume slices"));
+    }
     ui.add_enabled(
         !c.trace_every_frame,
         egui::Slider::new(&mut c.photons, 1_000..=10_000_000).logarithmic(true).text("photons per set"),
@@ -202,6 +210,11 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
         ui.radio_value(&mut c.mode, PresentMode::Radiance, "image");
         ui.radio_value(&mut c.mode, PresentMode::Normals, "normals");
         ui.radio_value(&mut c.mode, PresentMode::Albedo, "albedo");
+    });
+    ui.horizontal(|ui| {
+        ui.label("photons");
+        ui.radio_value(&mut c.mode, PresentMode::Photons, "as points");
+        ui.radio_value(&mut c.mode, PresentMode::DetailLevels, "LOD level");
     });
 }
 

@@ -30,6 +30,10 @@ pub enum PresentMode {
     Normals,
     /// A G-buffer's albedo.
     Albedo,
+    /// Photons as points coloured by power (`points::PointsPass`), as stored.
+    Photons,
+    /// Photons as points coloured by LOD detail level, as stored.
+    DetailLevels,
 }
 
 pub struct PresentPass {

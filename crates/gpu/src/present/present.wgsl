@@ -8,7 +8,7 @@ struct PresentParams {
     // 1: write sRGB-encoded values (a linear target); 0: linear (an sRGB target).
     encode_srgb: u32,
     // 0: radiance, tone-mapped; 1: a G-buffer normal (xyz · 0.5 + 0.5); 2: a
-    // G-buffer albedo (rgb) — debug views, shown as stored.
+    // G-buffer albedo (rgb), 3 and 4: photon points — debug views, shown as stored.
     mode: u32,
     _pad1: u32,
 }
@@ -33,7 +33,7 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     var c = texel * params.scale;
     if (params.mode == 1u) {
         c = texel * 0.5 + vec3<f32>(0.5) * f32(dot(texel, texel) > 0.0);
-    } else if (params.mode == 2u) {
+    } else if (params.mode >= 2u) {
         c = texel;
     }
     // Non-finite values show black, as in files.
