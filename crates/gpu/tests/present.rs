@@ -47,10 +47,10 @@ fn present_pass_tone_maps_as_png_output() {
         view_formats: &[],
     });
     let exposure = 0.5;
-    let pass = PresentPass::new(device, wgpu::TextureFormat::Rgba8Unorm);
+    let mut pass = PresentPass::new(device, wgpu::TextureFormat::Rgba8Unorm);
     let mut encoder = device.create_command_encoder(&Default::default());
     let mode = hikari_gpu::present::PresentMode::Radiance;
-    pass.record(device, &mut encoder, &frame, &target.create_view(&Default::default()), exposure, mode);
+    pass.record(device, &ctx.queue, &mut encoder, &frame, &target.create_view(&Default::default()), exposure, mode);
     ctx.queue.submit([encoder.finish()]);
     let shown = hikari_gpu::readback::read_rgba8(&ctx, &target).unwrap();
     let want = tone_map(&image, exposure);

@@ -594,7 +594,15 @@ impl Viewer {
             PresentMode::Photons => session.renderer.draw_points(PointColors::Power)?,
             PresentMode::DetailLevels => session.renderer.draw_points(PointColors::DetailLevel)?,
         };
-        session.present.record(&ctx.device, &mut encoder, shown, &view, self.controls.exposure, self.controls.mode);
+        session.present.record(
+            &ctx.device,
+            &ctx.queue,
+            &mut encoder,
+            shown,
+            &view,
+            self.controls.exposure,
+            self.controls.mode,
+        );
         self.readouts.frames_in_mean = session.mean.count();
         let size = [session.config.width, session.config.height];
         let panel = &mut session.panel;

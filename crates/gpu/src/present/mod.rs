@@ -3,7 +3,6 @@
 //! for PNG files, so the window shows what `--screenshot` writes.
 
 use bytemuck::{Pod, Zeroable};
-use wgpu::util::DeviceExt;
 
 /// present.wgsl after the shared fullscreen triangle.
 pub fn shader_source() -> String {
@@ -41,7 +40,14 @@ pub struct PresentPass {
     layout: wgpu::BindGroupLayout,
     /// The target is an sRGB format (its stores encode).
     srgb_target: bool,
+    params: wgpu::Buffer,
+    /// Bind groups of the textures shown lately (the mean, G-buffer views,
+    /// points), made once each; the oldest goes when a fifth comes.
+    bound: Vec<(wgpu::Texture, wgpu::BindGroup)>,
 }
+
+/// How many shown textures keep their bind groups.
+const BOUND_TEXTURES: usize = 4;
 
 impl PresentPass {
     /// A pass drawing into targets of `format`.
@@ -60,15 +66,22 @@ impl PresentPass {
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "present", &layout);
         let pipeline = crate::binding::fullscreen_pipeline(device, "present", &pipeline_layout, &module, format);
-        PresentPass { pipeline, layout, srgb_target: format.is_srgb() }
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("present params"),
+            size: std::mem::size_of::<PresentParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        PresentPass { pipeline, layout, srgb_target: format.is_srgb(), params, bound: Vec::new() }
     }
 
     /// Draws `frame` (linear radiance, tone-mapped with `exposure` stops;
     /// or a G-buffer texture, per `mode`) into `target`.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
-        &self,
+        &mut self,
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         frame: &wgpu::Texture,
         target: &wgpu::TextureView,
@@ -81,23 +94,29 @@ impl PresentPass {
             mode: mode as u32,
             _pad1: 0,
         };
-        let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("present params"),
-            contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let frame_view = frame.create_view(&Default::default());
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("present"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&frame_view) },
-            ],
-        });
+        queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+        let index = match self.bound.iter().position(|(t, _)| t == frame) {
+            Some(i) => i,
+            None => {
+                if self.bound.len() == BOUND_TEXTURES {
+                    self.bound.remove(0);
+                }
+                let frame_view = frame.create_view(&Default::default());
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("present"),
+                    layout: &self.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: self.params.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&frame_view) },
+                    ],
+                });
+                self.bound.push((frame.clone(), bind_group));
+                self.bound.len() - 1
+            }
+        };
         let mut pass = crate::binding::color_pass(encoder, "present", target, true);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(0, &self.bound[index].1, &[]);
         pass.draw(0..3, 0..1);
     }
 }
