@@ -36,6 +36,7 @@ pub mod medium;
 pub mod output;
 pub mod photon;
 pub mod progress;
+pub mod progressive;
 pub mod render;
 pub mod sampling;
 pub mod scene;

@@ -157,7 +157,6 @@ pub struct GpuRenderer {
     camera: hikari_core::camera::Camera,
     /// The scene's bounds (for the depth range of a moved camera).
     bounds: (Vec3, Vec3),
-    volume_radius: f32,
     /// The photons-as-points debug view, made when first drawn.
     points: std::cell::OnceCell<crate::points::PointsPass>,
 }
@@ -298,7 +297,6 @@ impl GpuRenderer {
         let scene_buffers = SceneBuffers::upload(device, scene);
         let global_photons = traced.indirect();
         let bounds = scene.accel.bounds();
-        let volume_radius = settings.volume_radius;
         let clip_from_world = clip_from_world(&scene.camera, bounds);
         let media = GpuMedia::new(
             device,
@@ -372,7 +370,6 @@ impl GpuRenderer {
             camera_position: scene.camera.position,
             camera: scene.camera.clone(),
             bounds,
-            volume_radius,
             points: std::cell::OnceCell::new(),
             ctx,
         }
@@ -468,7 +465,7 @@ impl GpuRenderer {
     fn volume_params(&self) -> VolumeParams {
         VolumeParams {
             clip_from_world: self.clip_from_world.to_cols_array_2d(),
-            radius: self.volume_radius,
+            radius: self.settings.volume_radius,
             power_unit: self.power_unit,
             _pad0: 0,
             _pad1: 0,

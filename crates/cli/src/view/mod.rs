@@ -564,6 +564,10 @@ impl Viewer {
                 let (times, timestamps) = session.renderer.render_timed()?;
                 self.readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
                 self.readouts.timestamps = timestamps;
+                // What the LOD kept, read back with the timing (a stall every 2 s, not every frame).
+                let (global, caustic) = session.renderer.drawn_photons()?;
+                let volume = if self.readouts.has_media { session.renderer.drawn_volume_photons()? } else { 0 };
+                self.readouts.drawn = Some([global, caustic, volume]);
             } else {
                 session.renderer.render()?;
             }

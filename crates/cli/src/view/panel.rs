@@ -42,6 +42,8 @@ pub struct Readouts {
     pub photon_sets: u64,
     pub photons_per_set: u64,
     pub stored: [usize; 3],
+    /// Photons the last timed frame drew (after LOD), per map.
+    pub drawn: Option<[u32; 3]>,
     /// (pass, milliseconds) of the last timed frame, and whether from GPU timestamps.
     pub passes: Vec<(&'static str, f64)>,
     pub timestamps: bool,
@@ -147,6 +149,9 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
         "photons: {} per set; stored {} global, {} caustic, {} volume",
         r.photons_per_set, r.stored[0], r.stored[1], r.stored[2]
     ));
+    if let Some([g, c, v]) = r.drawn {
+        ui.label(format!("drawn: {g} global, {c} caustic, {v} volume"));
+    }
     ui.label(format!("tracing: {:.1} sets/s, {:.1} ms per set", r.sets_per_second, r.trace_ms));
     if let Some(ms) = r.edit_latency_ms {
         ui.label(format!("scene edit to screen: {ms:.0} ms (mean)"));

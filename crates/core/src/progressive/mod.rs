@@ -1,0 +1,87 @@
+//! Progressive photon mapping: passes of independent photon sets, each
+//! estimated with a radius that shrinks by Knaus & Zwicker's schedule, and
+//! the running mean of their images, which converges to the true image as
+//! passes are added (docs/progressive.md). Pass 1 is the seed's single-pass
+//! method. `photon-cpu` and the GPU renderer run the same passes: pass i
+//! traces with seed + (i − 1) and estimates at the radii `radii(i)`.
+
+pub mod metric;
+pub mod schedule;
+
+use crate::render::Image;
+use glam::Vec3;
+pub use metric::{ImageError, compare};
+pub use schedule::{DEFAULT_ALPHA, RadiusSchedule};
+
+/// The schedules of the three maps (global, caustic, volume).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Schedules {
+    pub global: RadiusSchedule,
+    pub caustic: RadiusSchedule,
+    pub volume: RadiusSchedule,
+}
+
+impl Schedules {
+    /// Every map shrinks from its own first radius with the same α.
+    pub fn new([global, caustic, volume]: [f32; 3], alpha: f32) -> Self {
+        Schedules {
+            global: RadiusSchedule::disc(global, alpha),
+            caustic: RadiusSchedule::disc(caustic, alpha),
+            volume: RadiusSchedule::disc(volume, alpha),
+        }
+    }
+
+    /// The radii of pass `pass` (from 1): global, caustic, volume.
+    pub fn radii(&self, pass: u32) -> [f32; 3] {
+        [self.global.radius(pass), self.caustic.radius(pass), self.volume.radius(pass)]
+    }
+}
+
+/// The seed of pass `pass` (from 1): pass 1 uses the render's own seed, so
+/// one pass is exactly the single-pass render.
+pub fn pass_seed(seed: u64, pass: u32) -> u64 {
+    seed.wrapping_add(pass.saturating_sub(1) as u64)
+}
+
+/// The running mean of the passes' images, summed in f64 (a million passes
+/// of f32 sums would lose the small ones).
+#[derive(Clone, Debug)]
+pub struct ImageMean {
+    width: u32,
+    height: u32,
+    sums: Vec<[f64; 3]>,
+    passes: u32,
+}
+
+impl ImageMean {
+    pub fn new(width: u32, height: u32) -> Self {
+        ImageMean { width, height, sums: vec![[0.0; 3]; (width * height) as usize], passes: 0 }
+    }
+
+    pub fn add(&mut self, image: &Image) {
+        assert_eq!((image.width, image.height), (self.width, self.height), "a pass of another size");
+        for (sum, p) in self.sums.iter_mut().zip(&image.pixels) {
+            for c in 0..3 {
+                sum[c] += p[c] as f64;
+            }
+        }
+        self.passes += 1;
+    }
+
+    pub fn passes(&self) -> u32 {
+        self.passes
+    }
+
+    /// The mean so far (black before the first pass).
+    pub fn mean(&self) -> Image {
+        let mut image = Image::new(self.width, self.height);
+        let n = self.passes.max(1) as f64;
+        for (p, s) in image.pixels.iter_mut().zip(&self.sums) {
+            *p = Vec3::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32);
+        }
+        image
+    }
+}
+
+#[cfg(test)]
+mod tests;
