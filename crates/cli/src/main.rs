@@ -1,6 +1,7 @@
 //! `hikari`: the command-line renderer.
 
 mod bench_cmd;
+mod passes;
 mod progress_bar;
 mod render_cmd;
 mod view;

@@ -1,5 +1,7 @@
 //! `hikari render`: load a scene, trace photons, render, write the image.
 
+use crate::passes::renderers::{CpuPasses, GpuPasses, PathPasses};
+use crate::passes::{self, PassPlan, read_reference};
 use crate::progress_bar::TerminalProgress;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
@@ -7,11 +9,20 @@ use hikari_core::lod::LodSettings;
 use hikari_core::output::write_image;
 use hikari_core::photon::TracedPhotons;
 use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules};
 use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::{Scene, builtin};
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::{Duration, Instant};
+
+/// Returns a `UsageError` (exit code 2) with a formatted message.
+macro_rules! usage {
+    ($($arg:tt)*) => {
+        return Err(UsageError(format!($($arg)*)).into())
+    };
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum RendererKind {
@@ -97,9 +108,41 @@ pub struct RenderArgs {
     /// LOD (gpu): number of photon groups A, 1 to 1000.
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub lod_groups: u32,
+    /// Progressive photon mapping (docs/progressive.md): render up to this
+    /// many passes, each with a fresh photon set and smaller radii, and
+    /// average them, 1 to 1,000,000 [default: 1, the seed's method; no
+    /// limit with --time]. With --renderer path, passes of --spp samples.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub passes: Option<u32>,
+    /// Stop the passes after the first that ends past this many seconds.
+    #[arg(long, value_parser = parse_seconds)]
+    pub time: Option<f64>,
+    /// The radius schedule's α in (0, 1): r² shrinks by (i + α)/(i + 1)
+    /// after pass i; smaller shrinks faster.
+    #[arg(long, default_value_t = DEFAULT_ALPHA, value_parser = parse_alpha)]
+    pub alpha: f32,
+    /// With passes: write the image so far every this many seconds.
+    #[arg(long, value_parser = parse_seconds)]
+    pub checkpoint: Option<f64>,
+    /// An image of the same size (e.g. a long path-traced EXR): print the
+    /// relative RMSE and mean ratio against it at each checkpoint and at the end.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// A duration in seconds: finite and positive, at most a year.
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    let t: f64 = text.parse().map_err(|_| format!("`{text}` is not a number of seconds"))?;
+    if t > 0.0 && t <= 3.2e7 { Ok(t) } else { Err(format!("{t} s: must be more than 0 and at most a year")) }
+}
+
+/// Knaus & Zwicker's α: strictly between 0 and 1.
+fn parse_alpha(text: &str) -> Result<f32, String> {
+    let a: f32 = text.parse().map_err(|_| format!("`{text}` is not a number"))?;
+    if a > 0.0 && a < 1.0 { Ok(a) } else { Err(format!("{a}: α must lie strictly between 0 and 1")) }
 }
 
 /// An animation time in seconds: finite, in [0, 10⁶].
@@ -267,6 +310,88 @@ fn render_photons(
     Ok(result)
 }
 
+/// Renders in passes (`--passes`, `--time`, `--reference`) with `kind`; the
+/// GPU falls back to photon-cpu as the single pass does.
+fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Result<(Image, u64)> {
+    let reference = match &args.reference {
+        None => None,
+        Some(path) => {
+            let image = read_reference(path).map_err(|e| UsageError(format!("{e:#}")))?;
+            let (w, h) = (scene.camera.width, scene.camera.height);
+            if (image.width, image.height) != (w, h) {
+                usage!("--reference {}: {}x{}, but the render is {w}x{h}", path.display(), image.width, image.height);
+            }
+            Some((path.clone(), image))
+        }
+    };
+    if args.checkpoint.is_some() && args.passes.is_none_or(|n| n == 1) && args.time.is_none() {
+        usage!("--checkpoint needs --passes (more than 1) or --time");
+    }
+    let plan = PassPlan {
+        passes: args.passes.unwrap_or(if args.time.is_some() { u32::MAX } else { 1 }),
+        time: args.time.map(Duration::from_secs_f64),
+        checkpoint: args.checkpoint.map(Duration::from_secs_f64),
+        reference,
+        output: args.output.clone(),
+        exposure: args.exposure,
+        quiet: args.quiet,
+    };
+    let (w, h) = (scene.camera.width, scene.camera.height);
+    if kind == RendererKind::Path {
+        let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
+        eprintln!("path tracing in passes of {} spp", settings.spp);
+        let mut passes = PathPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
+        let (image, _) = passes::run(&mut passes, &plan)?;
+        return Ok((image, passes.nonfinite));
+    }
+    let settings = photon_cpu::PhotonCpuSettings {
+        radius: args.radius,
+        caustic_radius: args.caustic_radius,
+        spp: args.spp.unwrap_or(4),
+        seed: args.seed,
+        area_light_samples: args.area_light_samples,
+        normal_test: args.normal_test,
+        volume_radius: args.volume_radius,
+        ..Default::default()
+    };
+    let (global, caustic) = settings.estimate_params(scene);
+    let volume = args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene));
+    let schedules = Schedules::new([global.radius, caustic.radius, volume], args.alpha);
+    eprintln!(
+        "progressive: {} photon paths per pass, α = {}; first radii {:.4} (global), {:.4} (caustic){}",
+        args.photons,
+        args.alpha,
+        global.radius,
+        caustic.radius,
+        if scene.media.is_empty() { String::new() } else { format!(", {volume:.4} (volume)") }
+    );
+    if kind == RendererKind::Gpu {
+        let gpu_settings = gpu_settings(args, scene, &settings);
+        let expected = expected_map_sizes(scene, args.photons, args.seed);
+        if let Some(ctx) = open_gpu(scene, &gpu_settings, expected) {
+            let adapter = ctx.describe();
+            let first = trace_photons(
+                scene,
+                &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() },
+                &Silent,
+            );
+            let run = GpuPasses::new(ctx, scene, &first, gpu_settings, args.photons, args.seed, schedules)
+                .and_then(|mut passes| passes::run(&mut passes, &plan).map(|(image, _)| (image, passes.nonfinite)));
+            match run {
+                Ok(result) => {
+                    eprintln!("gpu: {adapter}, passes splatted and averaged on the GPU");
+                    return Ok(result);
+                }
+                Err(e) => eprintln!("gpu: {e:#}: rendering the passes with photon-cpu instead"),
+            }
+        }
+    }
+    let mut passes =
+        CpuPasses { scene, settings, photons: args.photons, schedules, mean: ImageMean::new(w, h), nonfinite: 0 };
+    let (image, _) = passes::run(&mut passes, &plan)?;
+    Ok((image, passes.nonfinite))
+}
+
 /// A bad flag or scene: the CLI exits with code 2 (as clap does for its own
 /// parse errors) and writes nothing.
 #[derive(Debug)]
@@ -279,12 +404,6 @@ impl std::fmt::Display for UsageError {
 }
 
 impl std::error::Error for UsageError {}
-
-macro_rules! usage {
-    ($($arg:tt)*) => {
-        return Err(UsageError(format!($($arg)*)).into())
-    };
-}
 
 /// Radii outside [1e-5, 0.5] scene diagonals: below, the estimate's 1/r²
 /// overflows or no photon is ever found; above, every photon covers every
@@ -351,7 +470,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
+    let progressive = args.passes.is_some_and(|n| n > 1) || args.time.is_some() || args.reference.is_some();
     let (image, nonfinite) = match renderer {
+        _ if progressive => render_in_passes(args, renderer, &scene)?,
         RendererKind::Path => {
             let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
             let result = path::render(&scene, &settings, &progress);

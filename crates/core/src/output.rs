@@ -1,5 +1,5 @@
 //! Writing images: `.png` (tone-mapped 8-bit sRGB) or `.exr` (linear float
-//! RGB). Files are written under a temporary name in the same folder and
+//! RGB); reading `.exr` back (references to compare with). Files are written under a temporary name in the same folder and
 //! renamed into place, so a failed write never leaves a half file.
 
 use crate::render::Image;
@@ -64,6 +64,24 @@ pub fn write_image(path: &Path, image: &Image, exposure: f32) -> Result<(), Outp
     })
 }
 
+/// Reads an `.exr` file as linear float RGB. Other types are refused: a
+/// tone-mapped PNG cannot be turned back into radiance.
+pub fn read_exr(path: &Path) -> Result<Image, String> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    if ext.as_deref() != Some("exr") {
+        return Err("not an .exr file (a tone-mapped PNG is not radiance)".into());
+    }
+    let decoded = ::image::open(path).map_err(|e| e.to_string())?.to_rgb32f();
+    let mut image = Image::new(decoded.width(), decoded.height());
+    for (p, q) in image.pixels.iter_mut().zip(decoded.pixels()) {
+        *p = glam::Vec3::from(q.0);
+    }
+    if image.pixels.iter().any(|p| !p.is_finite()) {
+        return Err("it has non-finite pixels".into());
+    }
+    Ok(image)
+}
+
 fn temporary_name(path: &Path) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
@@ -89,6 +107,10 @@ mod tests {
         let exr = ::image::open(dir.join("a.exr")).unwrap().to_rgb32f();
         assert_eq!(exr.get_pixel(0, 0).0, [1.0, 0.5, 0.0]);
         assert_eq!(exr.get_pixel(1, 0).0, [0.0, 0.0, 2.0]);
+        let back = read_exr(&dir.join("a.exr")).unwrap();
+        assert_eq!(back.pixels, img.pixels);
+        assert!(read_exr(&dir.join("a.png")).unwrap_err().contains("PNG"));
+        assert!(read_exr(&dir.join("missing.exr")).is_err());
         assert!(matches!(write_image(&dir.join("a.jpg"), &img, 0.0), Err(OutputError::UnsupportedExtension { .. })));
         // A failed write leaves nothing behind.
         assert!(write_image(&dir.join("missing-dir/a.png"), &img, 0.0).is_err());

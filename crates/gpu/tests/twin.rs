@@ -6,6 +6,7 @@ use glam::Vec3;
 use hikari_core::estimate::{FixedRadius, fixed_radius_radiance};
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
+use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_seed};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
 use hikari_gpu::test_support::test_context;
@@ -26,17 +27,37 @@ fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats,
 }
 
 fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
+    twin_pass(scene, photons, normal_test, 1)
+}
+
+/// Pass `pass` of progressive photon mapping (docs/progressive.md): the
+/// renderer is built with pass 1's photons and radii, then given pass
+/// `pass`'s photons and radii (`set_photons`), as `render --passes` does;
+/// pass 1 is the seed's single pass.
+fn twin_pass(scene: Scene, photons: u64, normal_test: bool, pass: u32) -> Option<(TwinStats, TwinStats)> {
     let ctx = test_context("twin");
     // Splats add in the radiance format: f32, or f16 where the adapter
     // cannot blend f32 (Mesa's GL), whose running sums round to 2^-11 at
     // every add (measured there: worst pixel 1.6% on cornell-box, 3.2% on
     // cornell-caustic, at 20,000 photons).
     let tolerance = if ctx.float32_blend { 1e-4 } else { 1e-2 };
-    let traced = trace_photons(&scene, &TraceSettings { photons, seed: 11, ..Default::default() }, &Silent);
-    let cpu_settings = PhotonCpuSettings { normal_test, ..Default::default() };
+    let trace = |pass| {
+        let seed = pass_seed(11, pass);
+        trace_photons(&scene, &TraceSettings { photons, seed, ..Default::default() }, &Silent)
+    };
+    let first_settings = PhotonCpuSettings { normal_test, ..Default::default() };
+    let (global, caustic) = first_settings.estimate_params(&scene);
+    let schedules = Schedules::new([global.radius, caustic.radius, global.radius], DEFAULT_ALPHA);
+    let mut gpu = GpuRenderer::new(ctx, &scene, &trace(1), GpuSettings::new(global, caustic)).expect("GPU renderer");
+    let traced = trace(pass);
+    let [r_global, r_caustic, _] = schedules.radii(pass);
+    if pass > 1 {
+        gpu.settings.global.radius = r_global;
+        gpu.settings.caustic.radius = r_caustic;
+        gpu.set_photons(&scene, &traced).expect("the pass's photons");
+    }
+    let cpu_settings = PhotonCpuSettings { radius: Some(r_global), caustic_radius: Some(r_caustic), ..first_settings };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
-    let settings = GpuSettings::new(cpu.global_params, cpu.caustic_params);
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
     gpu.render().expect("GPU frame");
     let t = &gpu.targets;
     let position = gpu.read(&t.gbuffer.position).unwrap();
@@ -136,4 +157,18 @@ fn gpu_splat_equals_cpu_estimate_with_photons_around_the_eye() {
     .unwrap();
     let Some((indirect, _)) = twin_scene(scene, 20_000, false) else { return };
     assert_twin("eye among photons", &indirect, 2000);
+}
+
+/// Progressive passes: pass i of the GPU splat is photon-cpu's estimate at
+/// r_i on pass i's photons, pixel by pixel (the radii shrink to 86% and 71%
+/// of the first by passes 3 and 10).
+#[test]
+fn gpu_passes_equal_cpu_estimates_at_their_radii() {
+    for pass in [3, 10] {
+        let mut scene = Scene::load("cornell-caustic").unwrap();
+        scene.camera = scene.camera.with_resolution(64, 64).unwrap();
+        let (global, caustic) = twin_pass(scene, 20_000, false, pass).expect("a twin");
+        assert_twin(&format!("cornell-caustic pass {pass}, global map"), &global, 2000);
+        assert_twin(&format!("cornell-caustic pass {pass}, caustic map"), &caustic, 20);
+    }
 }

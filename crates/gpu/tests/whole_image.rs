@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec3};
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
+use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_seed, photon_cpu_pass};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
@@ -76,24 +77,53 @@ fn compare(scene_name: &str) -> Option<(f64, usize, Option<(f64, usize)>)> {
     compare_scene(scene_name, Scene::load(scene_name).unwrap())
 }
 
-fn compare_scene(scene_name: &str, mut scene: Scene) -> Option<(f64, usize, Option<(f64, usize)>)> {
+fn compare_scene(scene_name: &str, scene: Scene) -> Option<(f64, usize, Option<(f64, usize)>)> {
+    compare_passes(scene_name, scene, 50_000, 1)
+}
+
+/// The mean of `passes` progressive passes of `photons` paths each
+/// (docs/progressive.md) on the GPU (accumulated there) and on the CPU.
+fn compare_passes(
+    scene_name: &str,
+    mut scene: Scene,
+    photons: u64,
+    passes: u32,
+) -> Option<(f64, usize, Option<(f64, usize)>)> {
     let ctx = test_context(scene_name);
     scene.camera = scene.camera.with_resolution(SIZE, SIZE).unwrap();
-    let traced = trace_photons(&scene, &TraceSettings { photons: 50_000, seed: 5, ..Default::default() }, &Silent);
+    let trace = |pass| {
+        let seed = pass_seed(5, pass);
+        trace_photons(&scene, &TraceSettings { photons, seed, ..Default::default() }, &Silent)
+    };
     // One sample at the pixel centre, as the rasterizer sees it; many shadow
     // rays per area light so the CPU's direct light is nearly noise-free.
-    let cpu_settings = PhotonCpuSettings { spp: 1, area_light_samples: 64, ..Default::default() };
-    let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
-    let (cpu_image, _) = cpu.render(&Silent);
-    let settings = GpuSettings {
-        area_light_samples: 16,
-        shadow_map_size: 1024,
-        ..GpuSettings::new(cpu.global_params, cpu.caustic_params)
-    };
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
-    gpu.render().expect("GPU frame");
-    let (gpu_image, nonfinite) = gpu.read_image().unwrap();
-    assert_eq!(nonfinite, 0);
+    let cpu_settings = PhotonCpuSettings { spp: 1, area_light_samples: 64, seed: 5, ..Default::default() };
+    let (global, caustic) = cpu_settings.estimate_params(&scene);
+    let schedules = Schedules::new([global.radius, caustic.radius, global.radius], DEFAULT_ALPHA);
+    let mut cpu_mean = ImageMean::new(SIZE, SIZE);
+    for pass in 1..=passes {
+        cpu_mean.add(&photon_cpu_pass(&scene, &cpu_settings, photons, &schedules, pass).0);
+    }
+    let cpu_image = cpu_mean.mean();
+    let settings = GpuSettings { area_light_samples: 16, shadow_map_size: 1024, ..GpuSettings::new(global, caustic) };
+    let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &trace(1), settings).expect("GPU renderer");
+    let mut gpu_mean = hikari_gpu::accumulate::AccumulatePass::new(&ctx.device, gpu.resolved());
+    for pass in 1..=passes {
+        if pass > 1 {
+            let [r_global, r_caustic, _] = schedules.radii(pass);
+            (gpu.settings.global.radius, gpu.settings.caustic.radius) = (r_global, r_caustic);
+            gpu.set_photons(&scene, &trace(pass)).expect("the pass's photons");
+        }
+        gpu.render().expect("GPU frame");
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        gpu_mean.record(&ctx.queue, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+    }
+    let mut gpu_image = hikari_core::render::Image::new(SIZE, SIZE);
+    for (p, v) in gpu_image.pixels.iter_mut().zip(gpu.read(&gpu_mean.mean).unwrap()) {
+        assert!(v.is_finite());
+        *p = v.truncate();
+    }
     let albedo = gpu.read(&gpu.targets.gbuffer.albedo).unwrap();
     let mask = comparison_mask(&scene, &albedo);
     let (mut sum, mut count) = (0.0f64, 0usize);
@@ -151,6 +181,19 @@ fn gpu_image_matches_photon_cpu_on_cornell_caustic() {
     let (specular_mean, specular_count) = specular.expect("the glass ball is in view");
     eprintln!("cornell-caustic glass: {specular_count} pixels, mean relative difference {:.3}%", specular_mean * 100.0);
     assert!(specular_count > 100);
+    assert!(specular_mean < 0.05, "glass pixels: mean relative difference {specular_mean}");
+}
+
+/// Progressive passes: the mean of 6 passes accumulated on the GPU matches
+/// photon-cpu's mean of the same passes as closely as one frame does.
+#[test]
+fn progressive_gpu_image_matches_photon_cpu_on_cornell_caustic() {
+    let mut scene = Scene::load("cornell-caustic").unwrap();
+    scene.camera = scene.camera.with_resolution(SIZE, SIZE).unwrap();
+    let Some((mean, count, specular)) = compare_passes("cornell-caustic passes", scene, 20_000, 6) else { return };
+    assert!(count > 2000, "only {count} pixels compared");
+    assert!(mean < 0.02, "mean relative difference {mean}");
+    let (specular_mean, _) = specular.expect("the glass ball is in view");
     assert!(specular_mean < 0.05, "glass pixels: mean relative difference {specular_mean}");
 }
 

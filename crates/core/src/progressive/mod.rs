@@ -85,3 +85,29 @@ impl ImageMean {
 
 #[cfg(test)]
 mod tests;
+
+/// Pass `pass` of `photon-cpu`: a fresh set of `photons` paths traced with
+/// `pass_seed`, estimated at the schedules' radii (pixels sampled with the
+/// same seed). Returns the image and its non-finite samples dropped.
+pub fn photon_cpu_pass(
+    scene: &crate::scene::Scene,
+    settings: &crate::render::photon_cpu::PhotonCpuSettings,
+    photons: u64,
+    schedules: &Schedules,
+    pass: u32,
+) -> (Image, u64) {
+    use crate::photon::{TraceSettings, trace_photons};
+    use crate::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+    let seed = pass_seed(settings.seed, pass);
+    let silent = crate::progress::Silent;
+    let traced = trace_photons(scene, &TraceSettings { photons, seed, ..Default::default() }, &silent);
+    let [global, caustic, volume] = schedules.radii(pass);
+    let settings = PhotonCpuSettings {
+        radius: Some(global),
+        caustic_radius: Some(caustic),
+        volume_radius: Some(volume),
+        seed,
+        ..settings.clone()
+    };
+    PhotonCpuRenderer::new(scene, &traced, &settings).render(&silent)
+}

@@ -424,13 +424,17 @@ impl SpecularPass {
         }
     }
 
-    /// Gathers from new photon maps from the next frame on (the same radii):
+    /// Gathers from new photon maps, at the radii of `inputs`, from the next frame on:
     /// a new grid buffer and bind group, nothing else rebuilt.
     pub fn set_photons(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, inputs: &SpecularInputs) {
         let (words, grid_params) = PackedGrids::new(inputs);
         self.grid = padded_buffer(device, "photon grids", bytemuck::cast_slice(&words), wgpu::BufferUsages::STORAGE);
         self.params = SpecularParams {
             power_unit: grid_params.power_unit,
+            // The radii too: progressive passes and the viewer's sliders change them.
+            global_radius: grid_params.global_radius,
+            caustic_radius: grid_params.caustic_radius,
+            volume_radius: grid_params.volume_radius,
             global_buckets: grid_params.global_buckets,
             global_start_offset: grid_params.global_start_offset,
             global_photon_offset: grid_params.global_photon_offset,

@@ -1,0 +1,170 @@
+//! `hikari render --passes N` / `--time SECONDS`: progressive rendering
+//! (docs/progressive.md). Each renderer renders pass after pass into its
+//! running mean; this loop stops at the pass count, the time limit or
+//! Ctrl-C (the image so far is then written), writes checkpoints, and
+//! compares with a reference image.
+
+pub mod renderers;
+
+use anyhow::{Result, anyhow};
+use hikari_core::output::write_image;
+use hikari_core::progressive::compare;
+use hikari_core::render::Image;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// One renderer, pass by pass.
+pub trait PassRenderer {
+    /// Renders pass `pass` (from 1) and adds it to the mean.
+    fn render_pass(&mut self, pass: u32) -> Result<()>;
+    /// The mean of the passes so far.
+    fn mean(&mut self) -> Result<Image>;
+    /// The global map's radius in pass `pass`, for the progress bar (None: no radius).
+    fn radius(&self, pass: u32) -> Option<f32>;
+}
+
+/// When to stop and what to report.
+pub struct PassPlan {
+    /// At most this many passes.
+    pub passes: u32,
+    /// Stop after the first pass that ends past this.
+    pub time: Option<Duration>,
+    /// Write the image so far (and compare it) this often.
+    pub checkpoint: Option<Duration>,
+    /// A reference image to compare with, and its path.
+    pub reference: Option<(PathBuf, Image)>,
+    pub output: PathBuf,
+    pub exposure: f32,
+    pub quiet: bool,
+}
+
+/// Set by Ctrl-C: the loop ends after the pass under way. A second Ctrl-C
+/// ends the process at once (no file is half written: images are written
+/// to a temporary name and renamed).
+fn interrupted() -> Arc<AtomicBool> {
+    static FLAG: std::sync::OnceLock<Arc<AtomicBool>> = std::sync::OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag = Arc::new(AtomicBool::new(false));
+        let seen = flag.clone();
+        let installed = ctrlc::set_handler(move || {
+            if seen.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!("\nCtrl-C: finishing this pass, then writing the image (Ctrl-C again to quit now)");
+        });
+        if let Err(e) = installed {
+            eprintln!("note: Ctrl-C will not stop the render gracefully ({e})");
+        }
+        flag
+    })
+    .clone()
+}
+
+/// Prints the error of `image` against the plan's reference, if any.
+fn report(plan: &PassPlan, image: &Image, pass: u32, seconds: f64) -> Result<()> {
+    let Some((path, reference)) = &plan.reference else { return Ok(()) };
+    let e = compare(image, reference).map_err(|e| anyhow!("--reference {}: {e}", path.display()))?;
+    println!("pass {pass}, {seconds:.2} s: relative RMSE {:.5}, mean ratio {:.5}", e.relative_rmse, e.mean_ratio);
+    Ok(())
+}
+
+/// Runs the passes; returns the mean and the number of passes rendered.
+pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u32)> {
+    let stop = interrupted();
+    let bar = if plan.quiet {
+        ProgressBar::with_draw_target(Some(plan.passes as u64), ProgressDrawTarget::hidden())
+    } else if plan.passes == u32::MAX {
+        ProgressBar::new_spinner()
+    } else {
+        ProgressBar::new(plan.passes as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{msg:>28} [{bar:30}] {pos}/{len} passes {elapsed_precise} eta {eta}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    let start = Instant::now();
+    let mut last_checkpoint = start;
+    let mut pass = 0;
+    let why = loop {
+        pass += 1;
+        renderer.render_pass(pass)?;
+        bar.inc(1);
+        let next = renderer.radius(pass + 1).map_or(String::new(), |r| format!("next radius {r:.5}"));
+        bar.set_message(next);
+        let elapsed = start.elapsed();
+        if pass >= plan.passes {
+            break "the pass count";
+        }
+        if plan.time.is_some_and(|t| elapsed >= t) {
+            break "the time limit";
+        }
+        if stop.load(Ordering::SeqCst) {
+            break "Ctrl-C";
+        }
+        if plan.checkpoint.is_some_and(|c| last_checkpoint.elapsed() >= c) {
+            last_checkpoint = Instant::now();
+            let image = renderer.mean()?;
+            write_image(&plan.output, &image, plan.exposure)?;
+            bar.suspend(|| report(plan, &image, pass, elapsed.as_secs_f64()))?;
+        }
+    };
+    bar.finish_and_clear();
+    let image = renderer.mean()?;
+    let seconds = start.elapsed().as_secs_f64();
+    eprintln!("{pass} passes in {seconds:.2} s (stopped by {why})");
+    report(plan, &image, pass, seconds)?;
+    Ok((image, pass))
+}
+
+/// Reads a reference image: linear float RGB from an EXR file.
+pub fn read_reference(path: &Path) -> Result<Image> {
+    hikari_core::output::read_exr(path).map_err(|e| anyhow!("--reference {}: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Passes whose images are the pass number: the mean of n passes is (n + 1) / 2.
+    struct Counting(u32);
+
+    impl PassRenderer for Counting {
+        fn render_pass(&mut self, pass: u32) -> Result<()> {
+            assert_eq!(pass, self.0 + 1, "passes come in order");
+            self.0 = pass;
+            Ok(())
+        }
+        fn mean(&mut self) -> Result<Image> {
+            let mut image = Image::new(1, 1);
+            image.pixels[0] = glam::Vec3::splat((self.0 + 1) as f32 / 2.0);
+            Ok(image)
+        }
+        fn radius(&self, _: u32) -> Option<f32> {
+            None
+        }
+    }
+
+    fn plan(passes: u32, time: Option<Duration>) -> PassPlan {
+        PassPlan {
+            passes,
+            time,
+            checkpoint: None,
+            reference: None,
+            output: std::env::temp_dir().join("hikari-passes-test.exr"),
+            exposure: 0.0,
+            quiet: true,
+        }
+    }
+
+    #[test]
+    fn stops_at_the_pass_count_or_the_time_limit() {
+        let (image, passes) = run(&mut Counting(0), &plan(5, None)).unwrap();
+        assert_eq!((passes, image.pixels[0].x), (5, 3.0));
+        let (_, passes) = run(&mut Counting(0), &plan(u32::MAX, Some(Duration::ZERO))).unwrap();
+        assert_eq!(passes, 1, "a time limit still renders one pass");
+    }
+}

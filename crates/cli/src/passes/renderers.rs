@@ -1,0 +1,144 @@
+//! The three renderers, pass by pass. Pass i traces with seed + i − 1 (the
+//! photon renderers) or samples pixels with it (the path tracer), so pass 1
+//! is the single-pass render and every pass is independent of the others.
+
+use super::PassRenderer;
+use anyhow::Result;
+use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::progressive::{ImageMean, Schedules, pass_seed, photon_cpu_pass};
+use hikari_core::render::{Image, path, photon_cpu};
+use hikari_core::scene::Scene;
+use hikari_gpu::accumulate::AccumulatePass;
+use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
+
+fn trace(scene: &Scene, photons: u64, seed: u64, pass: u32) -> TracedPhotons {
+    trace_photons(scene, &TraceSettings { photons, seed: pass_seed(seed, pass), ..Default::default() }, &Silent)
+}
+
+/// `photon-cpu`: each pass estimates its own photons at the schedule's radii.
+pub struct CpuPasses<'a> {
+    pub scene: &'a Scene,
+    pub settings: photon_cpu::PhotonCpuSettings,
+    pub photons: u64,
+    pub schedules: Schedules,
+    pub mean: ImageMean,
+    /// Non-finite samples dropped, over all passes.
+    pub nonfinite: u64,
+}
+
+impl PassRenderer for CpuPasses<'_> {
+    fn render_pass(&mut self, pass: u32) -> Result<()> {
+        let (image, nonfinite) = photon_cpu_pass(self.scene, &self.settings, self.photons, &self.schedules, pass);
+        self.nonfinite += nonfinite;
+        self.mean.add(&image);
+        Ok(())
+    }
+
+    fn mean(&mut self) -> Result<Image> {
+        Ok(self.mean.mean())
+    }
+
+    fn radius(&self, pass: u32) -> Option<f32> {
+        Some(self.schedules.global.radius(pass))
+    }
+}
+
+/// The path tracer: each pass is `spp` more samples per pixel.
+pub struct PathPasses<'a> {
+    pub scene: &'a Scene,
+    pub settings: path::PathSettings,
+    pub mean: ImageMean,
+    pub nonfinite: u64,
+}
+
+impl PassRenderer for PathPasses<'_> {
+    fn render_pass(&mut self, pass: u32) -> Result<()> {
+        let settings = path::PathSettings { seed: pass_seed(self.settings.seed, pass), ..self.settings.clone() };
+        let (image, nonfinite) = path::render(self.scene, &settings, &Silent);
+        self.nonfinite += nonfinite;
+        self.mean.add(&image);
+        Ok(())
+    }
+
+    fn mean(&mut self) -> Result<Image> {
+        Ok(self.mean.mean())
+    }
+
+    fn radius(&self, _: u32) -> Option<f32> {
+        None
+    }
+}
+
+/// The GPU renderer: each pass uploads its photons (the specular pass's
+/// grids rebuilt at the pass's radii), splats them at those radii and adds
+/// the frame to a running mean on the GPU; nothing is read back but the
+/// mean, at checkpoints and at the end.
+pub struct GpuPasses<'a> {
+    scene: &'a Scene,
+    renderer: GpuRenderer,
+    mean: AccumulatePass,
+    photons: u64,
+    seed: u64,
+    schedules: Schedules,
+    /// Pass 1's photons, which the renderer was built with.
+    first_built: bool,
+    pub nonfinite: u64,
+}
+
+impl<'a> GpuPasses<'a> {
+    /// A renderer of `scene` built with pass 1's photons `first` (traced
+    /// with `seed`) at the schedule's first radii.
+    pub fn new(
+        ctx: GpuContext,
+        scene: &'a Scene,
+        first: &TracedPhotons,
+        mut settings: GpuSettings,
+        photons: u64,
+        seed: u64,
+        schedules: Schedules,
+    ) -> Result<Self> {
+        [settings.global.radius, settings.caustic.radius, settings.volume_radius] = schedules.radii(1);
+        let renderer = GpuRenderer::new(ctx, scene, first, settings)?;
+        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
+        Ok(GpuPasses { scene, renderer, mean, photons, seed, schedules, first_built: true, nonfinite: 0 })
+    }
+}
+
+impl PassRenderer for GpuPasses<'_> {
+    fn render_pass(&mut self, pass: u32) -> Result<()> {
+        let built = std::mem::take(&mut self.first_built);
+        if !(built && pass == 1) {
+            let traced = trace(self.scene, self.photons, self.seed, pass);
+            let s = &mut self.renderer.settings;
+            [s.global.radius, s.caustic.radius, s.volume_radius] = self.schedules.radii(pass);
+            self.renderer.set_photons(self.scene, &traced)?;
+        }
+        self.renderer.render()?;
+        let ctx = &self.renderer.ctx;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.mean.record(&ctx.queue, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn mean(&mut self) -> Result<Image> {
+        let values = self.renderer.read(&self.mean.mean)?;
+        let t = &self.renderer.targets.gbuffer;
+        let mut image = Image::new(t.width, t.height);
+        self.nonfinite = 0;
+        for (pixel, value) in image.pixels.iter_mut().zip(values) {
+            let v = value.truncate();
+            if v.is_finite() {
+                *pixel = v;
+            } else {
+                self.nonfinite += 1;
+            }
+        }
+        Ok(image)
+    }
+
+    fn radius(&self, pass: u32) -> Option<f32> {
+        Some(self.schedules.global.radius(pass))
+    }
+}
