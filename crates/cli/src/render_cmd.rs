@@ -115,14 +115,14 @@ pub struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub passes: Option<u32>,
     /// Stop the passes after the first that ends past this many seconds.
-    #[arg(long, value_parser = parse_seconds)]
+    #[arg(long, value_parser = parse_seconds, allow_negative_numbers = true)]
     pub time: Option<f64>,
     /// The radius schedule's α in (0, 1): r² shrinks by (i + α)/(i + 1)
     /// after pass i; smaller shrinks faster.
     #[arg(long, default_value_t = DEFAULT_ALPHA, value_parser = parse_alpha)]
     pub alpha: f32,
     /// With passes: write the image so far every this many seconds.
-    #[arg(long, value_parser = parse_seconds)]
+    #[arg(long, value_parser = parse_seconds, allow_negative_numbers = true)]
     pub checkpoint: Option<f64>,
     /// An image of the same size (e.g. a long path-traced EXR): print the
     /// relative RMSE and mean ratio against it at each checkpoint and at the end.
@@ -168,6 +168,20 @@ pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 /// Most photon paths `--photons` accepts: about 6 GB of photon maps in the
 /// built-in scenes (3 stored photons of 20 bytes per path).
 pub const MAX_PHOTONS: u64 = 100_000_000;
+
+/// photon-cpu's settings for these arguments (also the GPU's radii).
+fn cpu_settings(args: &RenderArgs) -> photon_cpu::PhotonCpuSettings {
+    photon_cpu::PhotonCpuSettings {
+        radius: args.radius,
+        caustic_radius: args.caustic_radius,
+        spp: args.spp.unwrap_or(4),
+        seed: args.seed,
+        area_light_samples: args.area_light_samples,
+        normal_test: args.normal_test,
+        volume_radius: args.volume_radius,
+        ..Default::default()
+    }
+}
 
 /// The GPU renderer's settings for these arguments.
 fn gpu_settings(args: &RenderArgs, scene: &Scene, settings: &photon_cpu::PhotonCpuSettings) -> GpuSettings {
@@ -250,16 +264,7 @@ fn render_photons(
     scene: &Scene,
     progress: &TerminalProgress,
 ) -> Result<(Image, u64)> {
-    let settings = photon_cpu::PhotonCpuSettings {
-        radius: args.radius,
-        caustic_radius: args.caustic_radius,
-        spp: args.spp.unwrap_or(4),
-        seed: args.seed,
-        area_light_samples: args.area_light_samples,
-        normal_test: args.normal_test,
-        volume_radius: args.volume_radius,
-        ..Default::default()
-    };
+    let settings = cpu_settings(args);
     let gpu_settings = gpu_settings(args, scene, &settings);
     let needs_estimate = renderer == RendererKind::Gpu || args.photons > 2_000_000;
     let expected = if needs_estimate { expected_map_sizes(scene, args.photons, args.seed) } else { [0; 3] };
@@ -344,16 +349,7 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
         let (image, _) = passes::run(&mut passes, &plan)?;
         return Ok((image, passes.nonfinite));
     }
-    let settings = photon_cpu::PhotonCpuSettings {
-        radius: args.radius,
-        caustic_radius: args.caustic_radius,
-        spp: args.spp.unwrap_or(4),
-        seed: args.seed,
-        area_light_samples: args.area_light_samples,
-        normal_test: args.normal_test,
-        volume_radius: args.volume_radius,
-        ..Default::default()
-    };
+    let settings = cpu_settings(args);
     let (global, caustic) = settings.estimate_params(scene);
     let volume = args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene));
     let schedules = Schedules::new([global.radius, caustic.radius, volume], args.alpha);
@@ -470,7 +466,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
-    let progressive = args.passes.is_some_and(|n| n > 1) || args.time.is_some() || args.reference.is_some();
+    let progressive = args.passes.is_some_and(|n| n > 1)
+        || args.time.is_some()
+        || args.reference.is_some()
+        || args.checkpoint.is_some();
     let (image, nonfinite) = match renderer {
         _ if progressive => render_in_passes(args, renderer, &scene)?,
         RendererKind::Path => {

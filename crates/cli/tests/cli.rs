@@ -205,3 +205,86 @@ fn the_gl_backend_renders_or_falls_back_with_the_reason() {
     );
     assert!(dir.join("out.png").is_file());
 }
+
+/// Progressive passes (docs/progressive.md): a pass count, a time limit,
+/// checkpoints compared with a reference, and the errors of each flag.
+#[test]
+fn renders_in_passes_and_compares_with_a_reference() {
+    let dir = scratch_dir("passes");
+    let small = ["cornell-box", "--resolution", "32x32", "--photons", "5000", "-q"];
+    let ok = |args: &[&str]| {
+        let out = hikari(&[&["render"], &small[..], args].concat(), &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        (String::from_utf8_lossy(&out.stdout).into_owned(), stderr(&out))
+    };
+    ok(&["--renderer", "path", "--spp", "256", "-o", "ref.exr"]);
+    let (_, err) = ok(&["--renderer", "photon-cpu", "--passes", "4", "-o", "four.exr"]);
+    assert!(err.contains("4 passes in") && err.contains("stopped by the pass count"), "{err}");
+    assert!(dir.join("four.exr").is_file());
+    // The GPU renderer (or photon-cpu after a line saying why): the same passes.
+    let (_, err) = ok(&["--passes", "3", "-o", "gpu.png"]);
+    assert!(err.contains("3 passes in"), "{err}");
+    let (text, _) = ok(&["--renderer", "photon-cpu", "--passes", "3", "--reference", "ref.exr", "-o", "cpu.png"]);
+    let rmse: f64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("pass 3, ")?.split("relative RMSE ").nth(1)?.split(',').next()?.parse().ok())
+        .expect("the error against the reference");
+    assert!(rmse > 0.0 && rmse < 0.5, "{text}");
+    // A time limit without a pass count: passes until it runs out, checkpoints on the way.
+    let (text, err) = ok(&[
+        "--renderer",
+        "photon-cpu",
+        "--time",
+        "1.5",
+        "--checkpoint",
+        "0.3",
+        "--reference",
+        "ref.exr",
+        "-o",
+        "t.exr",
+    ]);
+    assert!(err.contains("stopped by the time limit"), "{err}");
+    assert!(text.lines().filter(|l| l.contains("relative RMSE")).count() >= 3, "checkpoints: {text}");
+    // Bad input: exit 2, nothing written (in a folder of its own, holding the reference).
+    let bad = scratch_dir("passes-bad");
+    let out = hikari(
+        &["render", "cornell-box", "--resolution", "16x16", "--renderer", "path", "-q", "-o", "ref16.exr"],
+        &bad,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    for (args, words) in [
+        (&["--passes", "2", "--alpha", "1"][..], &["--alpha"][..]),
+        (&["--passes", "0"], &["--passes"]),
+        (&["--time", "-1"], &["--time"]),
+        (&["--passes", "2", "--reference", "missing.exr"], &["missing.exr"]),
+        (&["--passes", "2", "--reference", "ref16.exr"], &["ref16.exr", "16x16", "32x32"]),
+        (&["--passes", "2", "--reference", "shown.png"], &["shown.png", "exr"]),
+        (&["--checkpoint", "1"], &["--checkpoint"]),
+    ] {
+        let out = hikari(&[&["render"], &small[..], args, &["-o", "bad.png"]].concat(), &bad);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_fails_with(&out, &bad, words);
+    }
+}
+
+/// Ctrl-C ends a progressive render after the pass under way and writes
+/// the image so far.
+#[test]
+fn ctrl_c_writes_the_passes_so_far() {
+    let dir = scratch_dir("ctrlc");
+    let child = Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(["render", "cornell-box", "--resolution", "32x32", "--photons", "5000", "--renderer", "photon-cpu"])
+        .args(["--passes", "1000000", "-q", "-o", "so-far.exr"])
+        .current_dir(&dir)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let sent = Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(sent.success());
+    let out = child.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("stopped by Ctrl-C"), "{err}");
+    assert!(dir.join("so-far.exr").is_file());
+}
