@@ -14,6 +14,12 @@ pub struct Camera {
     pub fov_y: f32,
     pub width: u32,
     pub height: u32,
+    /// A sub-pixel offset (pixels, each component in [−0.5, 0.5]) of every
+    /// sample: the ray "through pixel p" goes through p + jitter, and the
+    /// projection moves the image by −jitter to match. Progressive GPU
+    /// passes change it each pass, so their mean covers each pixel's square
+    /// as the CPU's samples do (antialiasing); zero otherwise.
+    pub jitter: Vec2,
     forward: Vec3,
     right: Vec3,
     true_up: Vec3,
@@ -51,6 +57,7 @@ impl Camera {
             fov_y,
             width,
             height,
+            jitter: Vec2::ZERO,
             forward,
             right,
             true_up: right.cross(forward),
@@ -68,6 +75,7 @@ impl Camera {
 
     /// Primary ray through continuous pixel coordinates `pixel`.
     pub fn ray(&self, pixel: Vec2) -> Ray {
+        let pixel = pixel + self.jitter;
         let x = (2.0 * pixel.x / self.width as f32 - 1.0) * self.tan_half_fov * self.aspect();
         let y = (1.0 - 2.0 * pixel.y / self.height as f32) * self.tan_half_fov;
         Ray::new(self.position, (self.forward + self.right * x + self.true_up * y).normalize())
@@ -90,8 +98,11 @@ impl Camera {
 
     /// Perspective projection to wgpu clip space (depth 0 at `near`, 1 at
     /// `far`), matching `ray`: the ray through a pixel centre projects there.
+    /// With a `jitter`, the image moves by −jitter pixels, so the pixel
+    /// centre p sees what p + jitter sees unjittered, as `ray` does.
     pub fn clip_from_view(&self, near: f32, far: f32) -> Mat4 {
-        clip_from_view(self.fov_y.to_radians(), self.aspect(), near, far)
+        let shift = Vec3::new(-2.0 * self.jitter.x / self.width as f32, 2.0 * self.jitter.y / self.height as f32, 0.0);
+        Mat4::from_translation(shift) * clip_from_view(self.fov_y.to_radians(), self.aspect(), near, far)
     }
 }
 
@@ -140,7 +151,16 @@ mod tests {
 
     #[test]
     fn projection_matches_primary_rays() {
-        let cam = Camera::new(Vec3::new(0.3, 0.2, 4.0), Vec3::new(0.1, -0.1, 0.0), Vec3::Y, 40.0, 64, 48).unwrap();
+        let mut cam = Camera::new(Vec3::new(0.3, 0.2, 4.0), Vec3::new(0.1, -0.1, 0.0), Vec3::Y, 40.0, 64, 48).unwrap();
+        projection_matches(&cam);
+        // Jittered: the ray through p goes through p + jitter, and projects back to p.
+        let straight = cam.ray(Vec2::new(10.75, 40.25));
+        cam.jitter = Vec2::new(0.25, -0.25);
+        assert!((cam.ray(Vec2::new(10.5, 40.5)).dir - straight.dir).length() < 1e-6);
+        projection_matches(&cam);
+    }
+
+    fn projection_matches(cam: &Camera) {
         let clip_from_world = cam.clip_from_view(0.1, 100.0) * cam.view_from_world();
         for pixel in [Vec2::new(0.5, 0.5), Vec2::new(10.5, 40.5), Vec2::new(63.5, 0.5)] {
             let p = cam.ray(pixel).at(3.7);

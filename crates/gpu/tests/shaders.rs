@@ -133,9 +133,9 @@ fn shared_structs_match_wgsl_layouts() {
             volume_start_offset,
             volume_photon_offset,
             volume_min,
-            _pad0,
+            jitter_x,
             volume_max,
-            _pad1
+            jitter_y
         ]
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
@@ -172,8 +172,7 @@ fn shared_structs_match_wgsl_layouts() {
             region_triangles,
             phases,
             image_size,
-            _pad0,
-            _pad1
+            jitter
         ]
     );
     assert_layout!(volume, "RegionTriangle", hikari_gpu::media::RegionTriangle, [a, b, c, sigma_t]);

@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
-use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_seed, photon_cpu_pass};
+use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_jitter, pass_seed, photon_cpu_pass};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
@@ -100,9 +100,15 @@ fn compare_passes(
     let cpu_settings = PhotonCpuSettings { spp: 1, area_light_samples: 64, seed: 5, ..Default::default() };
     let (global, caustic) = cpu_settings.estimate_params(&scene);
     let schedules = Schedules::new([global.radius, caustic.radius, global.radius], DEFAULT_ALPHA);
+    // Both sample each pixel once per pass, at the pass's jitter.
+    let jittered = |pass| {
+        let mut s = scene.clone();
+        s.camera.jitter = pass_jitter(pass);
+        s
+    };
     let mut cpu_mean = ImageMean::new(SIZE, SIZE);
     for pass in 1..=passes {
-        cpu_mean.add(&photon_cpu_pass(&scene, &cpu_settings, photons, &schedules, pass).0);
+        cpu_mean.add(&photon_cpu_pass(&jittered(pass), &cpu_settings, photons, &schedules, pass).0);
     }
     let cpu_image = cpu_mean.mean();
     let settings = GpuSettings { area_light_samples: 16, shadow_map_size: 1024, ..GpuSettings::new(global, caustic) };
@@ -113,6 +119,7 @@ fn compare_passes(
             let [r_global, r_caustic, _] = schedules.radii(pass);
             (gpu.settings.global.radius, gpu.settings.caustic.radius) = (r_global, r_caustic);
             gpu.set_photons(&scene, &trace(pass)).expect("the pass's photons");
+            gpu.set_camera(&jittered(pass).camera).unwrap();
         }
         gpu.render().expect("GPU frame");
         let mut encoder = ctx.device.create_command_encoder(&Default::default());

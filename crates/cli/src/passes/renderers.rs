@@ -6,7 +6,7 @@ use super::PassRenderer;
 use anyhow::Result;
 use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::progress::Silent;
-use hikari_core::progressive::{ImageMean, Schedules, pass_seed, photon_cpu_pass};
+use hikari_core::progressive::{ImageMean, Schedules, pass_jitter, pass_seed, photon_cpu_pass};
 use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::Scene;
 use hikari_gpu::accumulate::AccumulatePass;
@@ -71,9 +71,10 @@ impl PassRenderer for PathPasses<'_> {
 }
 
 /// The GPU renderer: each pass uploads its photons (the specular pass's
-/// grids rebuilt at the pass's radii), splats them at those radii and adds
-/// the frame to a running mean on the GPU; nothing is read back but the
-/// mean, at checkpoints and at the end.
+/// grids rebuilt at the pass's radii), splats them at those radii from a
+/// camera jittered within the pixel (`pass_jitter`) and adds the frame to a
+/// running mean on the GPU; nothing is read back but the mean, at
+/// checkpoints and at the end.
 pub struct GpuPasses<'a> {
     scene: &'a Scene,
     renderer: GpuRenderer,
@@ -113,6 +114,10 @@ impl PassRenderer for GpuPasses<'_> {
             let s = &mut self.renderer.settings;
             [s.global.radius, s.caustic.radius, s.volume_radius] = self.schedules.radii(pass);
             self.renderer.set_photons(self.scene, &traced)?;
+            // One sample per pixel a pass: each pass samples another point of the pixel.
+            let mut camera = self.renderer.camera().clone();
+            camera.jitter = pass_jitter(pass);
+            self.renderer.set_camera(&camera)?;
         }
         self.renderer.render()?;
         let ctx = &self.renderer.ctx;

@@ -9,7 +9,7 @@ pub mod metric;
 pub mod schedule;
 
 use crate::render::Image;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 pub use metric::{ImageError, compare};
 pub use schedule::{DEFAULT_ALPHA, RadiusSchedule};
 
@@ -41,6 +41,18 @@ impl Schedules {
 /// one pass is exactly the single-pass render.
 pub fn pass_seed(seed: u64, pass: u32) -> u64 {
     seed.wrapping_add(pass.saturating_sub(1) as u64)
+}
+
+/// The sub-pixel jitter (`Camera::jitter`) of pass `pass` (from 1) for a
+/// renderer that samples each pixel once (the GPU's rasterization): pass 1
+/// at the centre (the single-pass image), then Roberts' R2 low-discrepancy
+/// sequence, so the mean of n passes covers each pixel's square evenly, as
+/// the CPU's jittered samples do, and edges and small highlights converge
+/// to their pixel averages instead of to one point sample.
+pub fn pass_jitter(pass: u32) -> Vec2 {
+    const G: [f64; 2] = [0.754_877_666_246_692_7, 0.569_840_290_998_053_2];
+    let k = pass.saturating_sub(1) as f64;
+    Vec2::new(((0.5 + k * G[0]).fract() - 0.5) as f32, ((0.5 + k * G[1]).fract() - 0.5) as f32)
 }
 
 /// The running mean of the passes' images, summed in f64 (a million passes

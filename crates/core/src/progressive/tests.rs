@@ -109,3 +109,18 @@ fn the_running_mean_is_the_mean() {
     assert_eq!(mean.passes(), 3);
     assert_eq!(mean.mean().pixels, vec![Vec3::splat(3.0), Vec3::new(3.0, 0.0, -3.0)]);
 }
+
+#[test]
+fn pass_jitters_cover_the_pixel_evenly() {
+    assert_eq!(pass_jitter(1), Vec2::ZERO);
+    let jitters: Vec<Vec2> = (1..=256).map(pass_jitter).collect();
+    assert!(jitters.iter().all(|j| j.abs().max_element() <= 0.5));
+    // Every eighth of the square in x and in y gets 32 ± 3 of 256.
+    for axis in 0..2 {
+        for bin in 0..8 {
+            let lo = -0.5 + bin as f32 / 8.0;
+            let n = jitters.iter().filter(|j| j[axis] >= lo && j[axis] < lo + 0.125).count();
+            assert!((29..=35).contains(&n), "axis {axis} bin {bin}: {n}");
+        }
+    }
+}

@@ -25,8 +25,8 @@ struct MediaParams {
     // Per phase slot: x = kind (0 Schlick, 1 Henyey–Greenstein), y = k or g.
     phases: array<vec4<f32>, 4>,
     image_size: vec2<f32>,
-    _pad0: u32,
-    _pad1: u32,
+    // The camera's sub-pixel jitter (hikari_core::camera::Camera::jitter).
+    jitter: vec2<f32>,
 }
 
 // A triangle of a region mesh, wound with its normal out of the medium, and
@@ -60,8 +60,9 @@ fn view_ray(gbuffer_pos: vec4<f32>, frag_xy: vec2<f32>) -> vec4<f32> {
         return vec4<f32>(d / l, l);
     }
     let size = media.image_size;
-    let x = (2.0 * frag_xy.x / size.x - 1.0) * media.tan_half_fov * media.aspect;
-    let y = (1.0 - 2.0 * frag_xy.y / size.y) * media.tan_half_fov;
+    let p = frag_xy + media.jitter;
+    let x = (2.0 * p.x / size.x - 1.0) * media.tan_half_fov * media.aspect;
+    let y = (1.0 - 2.0 * p.y / size.y) * media.tan_half_fov;
     return vec4<f32>(normalize(media.forward + media.right * x + media.up * y), media.max_distance);
 }
 

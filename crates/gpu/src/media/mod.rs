@@ -35,8 +35,8 @@ pub struct MediaParams {
     pub region_triangles: u32,
     pub phases: [[f32; 4]; 4],
     pub image_size: [f32; 2],
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// The camera's sub-pixel jitter (`Camera::jitter`).
+    pub jitter: [f32; 2],
 }
 
 /// Mirrors `RegionTriangle` in media.wgsl.
@@ -66,6 +66,7 @@ impl MediaParams {
             right: right.to_array(),
             aspect: camera.width as f32 / camera.height as f32,
             up: up.to_array(),
+            jitter: camera.jitter.to_array(),
             ..*self
         }
     }
@@ -95,8 +96,7 @@ impl MediaParams {
             region_triangles: triangles,
             phases,
             image_size: [camera.width as f32, camera.height as f32],
-            _pad0: 0,
-            _pad1: 0,
+            jitter: camera.jitter.to_array(),
         }
     }
 }

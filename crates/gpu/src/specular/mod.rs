@@ -71,9 +71,10 @@ pub struct SpecularParams {
     pub volume_photon_offset: u32,
     /// Bounds of the volume photons' positions.
     pub volume_min: [f32; 3],
-    pub _pad0: u32,
+    /// The camera's sub-pixel jitter (`Camera::jitter`), x then y.
+    pub jitter_x: f32,
     pub volume_max: [f32; 3],
-    pub _pad1: u32,
+    pub jitter_y: f32,
 }
 
 /// Mirrors `SliceParams` in specular.wgsl: which share of the photon
@@ -350,6 +351,8 @@ impl SpecularPass {
             width,
             height,
             normal_test: inputs.global.normal_test as u32,
+            jitter_x: scene.camera.jitter.x,
+            jitter_y: scene.camera.jitter.y,
             ..grid_params
         };
         let storage_usage = wgpu::BufferUsages::STORAGE;
@@ -491,6 +494,8 @@ impl SpecularPass {
             aspect: camera.aspect(),
             camera_up: up.to_array(),
             camera_forward: forward.to_array(),
+            jitter_x: camera.jitter.x,
+            jitter_y: camera.jitter.y,
             ..self.params
         };
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));

@@ -42,9 +42,10 @@ struct SpecularParams {
     volume_photon_offset: u32,
     // Bounds of the volume photons' positions.
     volume_min: vec3<f32>,
-    _pad0: u32,
+    // The camera's sub-pixel jitter (hikari_core::camera::Camera::jitter).
+    jitter_x: f32,
     volume_max: vec3<f32>,
-    _pad1: u32,
+    jitter_y: f32,
 }
 
 struct FlatNode {
@@ -409,7 +410,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     // The primary ray through the pixel centre, as Camera::ray builds it.
-    let px = vec2<f32>(f32(id.x) + 0.5, f32(id.y) + 0.5);
+    let px = vec2<f32>(f32(id.x) + 0.5 + params.jitter_x, f32(id.y) + 0.5 + params.jitter_y);
     let sx = (2.0 * px.x / f32(params.width) - 1.0) * params.tan_half_fov * params.aspect;
     let sy = (1.0 - 2.0 * px.y / f32(params.height)) * params.tan_half_fov;
     let primary = normalize(params.camera_forward + params.camera_right * sx + params.camera_up * sy);
