@@ -48,8 +48,9 @@ use anyhow::{Result, anyhow};
 use clap::Args;
 use clock::AnimationClock;
 use frame_stats::FrameStats;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use hikari_core::output::write_image;
+use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_jitter};
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
@@ -208,6 +209,7 @@ fn controls_for(scene: &Scene, args: &ViewArgs) -> Controls {
         mode: PresentMode::Radiance,
         photons: args.photons,
         trace_every_frame: args.trace_every_frame,
+        progressive: true,
         playing: true,
         lights: rest.lights,
         offsets: rest.offsets,
@@ -505,7 +507,8 @@ impl Viewer {
             || c.lod != a.lod
             || c.global_radius != a.global_radius
             || c.caustic_radius != a.caustic_radius
-            || c.volume_radius != a.volume_radius;
+            || c.volume_radius != a.volume_radius
+            || c.progressive != a.progressive;
         if restart {
             let settings = &mut session.renderer.settings;
             settings.terms = c.terms;
@@ -529,6 +532,19 @@ impl Viewer {
         let mut fresh = false;
         if let Some(set) = new_set {
             let same_scene = self.shown.as_ref().is_some_and(|s| s.pose == set.pose);
+            // The frame this set draws is pass k of the mean (k = 1 after any
+            // change): progressive radii and a sub-pixel jitter for pass k, so
+            // the mean converges as `render --passes` does (docs/progressive.md).
+            let pass = if same_scene { session.mean.count() + 1 } else { 1 };
+            let progressive = self.controls.progressive;
+            let c = &self.controls;
+            let schedules = Schedules::new([c.global_radius, c.caustic_radius, c.volume_radius], DEFAULT_ALPHA);
+            let [global, caustic, volume] = schedules.radii(if progressive { pass } else { 1 });
+            let settings = &mut session.renderer.settings;
+            (settings.global.radius, settings.caustic.radius, settings.volume_radius) = (global, caustic, volume);
+            let mut camera = session.renderer.camera().clone();
+            camera.jitter = if progressive { pass_jitter(pass) } else { Vec2::ZERO };
+            session.renderer.set_camera(&camera)?;
             let applied = if same_scene {
                 session.renderer.set_photons(&set.scene, &set.traced)
             } else {

@@ -25,6 +25,9 @@ pub struct Controls {
     /// Photon paths per set (chosen by the budget while `trace_every_frame`).
     pub photons: u64,
     pub trace_every_frame: bool,
+    /// While still, frames shrink the radii and jitter the pixel samples
+    /// pass by pass (progressive photon mapping), so the mean converges.
+    pub progressive: bool,
     /// Whether the scene's animations play.
     pub playing: bool,
     /// The lights as edited (before their animations), and an offset per
@@ -195,6 +198,7 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
         egui::Slider::new(&mut c.photons, 1_000..=10_000_000).logarithmic(true).text("photons per set"),
     );
     ui.checkbox(&mut c.trace_every_frame, "trace every frame (photons to keep up)");
+    ui.checkbox(&mut c.progressive, "converge: shrink radii while still");
     ui.add(egui::Slider::new(&mut c.exposure, -8.0..=8.0).text("exposure (stops)"));
     let mut lod_on = c.lod.is_some();
     ui.checkbox(&mut lod_on, "level of detail");
