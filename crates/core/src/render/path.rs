@@ -7,7 +7,7 @@
 
 use super::{Image, render_pixels};
 use crate::geometry::Ray;
-use crate::material::{Event, Material, Rgb, dielectric_split, mean, reflect};
+use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
 use crate::medium::{Flight, Phase};
 use crate::progress::Progress;
 use crate::sampling::{Rng, cosine_hemisphere, local_to_world, power_heuristic};
@@ -42,7 +42,7 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
     let mut l = Rgb::ZERO;
     let mut beta = Rgb::ONE;
     let mut previous = Previous::Specular;
-    for _ in 0..settings.max_depth {
+    for bounce in 0..settings.max_depth {
         let hit = scene.accel.intersect(&ray);
         let media = &scene.media;
         if !media.is_empty() {
@@ -95,28 +95,41 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
                 }
             }
             Material::Diffuse { .. } | Material::Mirror { .. } => {
-                let albedo = material.diffuse_albedo();
-                let p_diffuse = mean(albedo);
-                if p_diffuse > 0.0 {
+                let (albedo, specular) = (material.diffuse_albedo(), material.mirror_reflectance());
+                let (p_d, p_s) = (mean(albedo), mean(specular));
+                if p_d + p_s <= 0.0 {
+                    break; // black
+                }
+                // Diffuse or mirror, chosen ∝ their reflectances but never
+                // absorbed here (the photon tracer's roulette at the albedo
+                // ends 30–75% of paths at their first bounce); the
+                // throughput's roulette below ends paths instead.
+                let p_diffuse = p_d / (p_d + p_s);
+                if p_d > 0.0 {
                     l += beta * next_event(scene, hit.point, ns, albedo, p_diffuse, rng);
                 }
-                // The material's own roulette picks the event and ends paths.
-                let (event, factor) = material.roulette(rng.next_f32());
-                beta *= factor;
-                match event {
-                    Event::Absorbed => break,
-                    Event::Diffuse => {
-                        let dir = local_to_world(cosine_hemisphere(rng.next_2d()), ns);
-                        previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
-                        dir
-                    }
-                    Event::Specular => {
-                        previous = Previous::Specular;
-                        reflect(ray.dir, ns)
-                    }
+                if rng.next_f32() < p_diffuse {
+                    beta *= albedo / p_diffuse;
+                    let dir = local_to_world(cosine_hemisphere(rng.next_2d()), ns);
+                    previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
+                    dir
+                } else {
+                    beta *= specular / (1.0 - p_diffuse);
+                    previous = Previous::Specular;
+                    reflect(ray.dir, ns)
                 }
             }
         };
+        // Russian roulette on the throughput from the third vertex on
+        // (pbrt's and Mitsuba's rule): a path survives with probability
+        // max(β), at most 0.95, and carries 1/that if it does.
+        if bounce >= 2 {
+            let survive = beta.max_element().min(0.95);
+            if rng.next_f32() >= survive {
+                break;
+            }
+            beta /= survive;
+        }
         let transmits = matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
         if next_dir.dot(ng) <= 0.0 && !transmits {
             break;
