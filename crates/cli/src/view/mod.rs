@@ -378,6 +378,8 @@ impl Viewer {
         let (mut global, mut caustic) = PhotonCpuSettings::default().estimate_params(&scene);
         global.radius = self.applied.global_radius;
         caustic.radius = self.applied.caustic_radius;
+        // Converging frames use the normal test, as `render --passes` does.
+        (global.normal_test, caustic.normal_test) = (self.applied.progressive, self.applied.progressive);
         let settings = GpuSettings {
             volume_radius: self.applied.volume_radius,
             volume_slices: self.applied.volume_slices,
@@ -519,6 +521,9 @@ impl Viewer {
             settings.global.radius = c.global_radius;
             settings.caustic.radius = c.caustic_radius;
             settings.volume_radius = c.volume_radius;
+            let test_changed = settings.global.normal_test != c.progressive;
+            (settings.global.normal_test, settings.caustic.normal_test) = (c.progressive, c.progressive);
+            let radii_changed = radii_changed || test_changed;
             if radii_changed && new_set.is_none() {
                 // The specular pass's grids are cells of the radii.
                 let shown = self.shown.as_ref().expect("a photon set is drawn");
@@ -542,6 +547,7 @@ impl Viewer {
             let [global, caustic, volume] = schedules.radii(if progressive { pass } else { 1 });
             let settings = &mut session.renderer.settings;
             (settings.global.radius, settings.caustic.radius, settings.volume_radius) = (global, caustic, volume);
+            (settings.global.normal_test, settings.caustic.normal_test) = (progressive, progressive);
             let mut camera = session.renderer.camera().clone();
             camera.jitter = if progressive { pass_jitter(pass) } else { Vec2::ZERO };
             session.renderer.set_camera(&camera)?;

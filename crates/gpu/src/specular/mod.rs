@@ -434,7 +434,9 @@ impl SpecularPass {
         self.grid = padded_buffer(device, "photon grids", bytemuck::cast_slice(&words), wgpu::BufferUsages::STORAGE);
         self.params = SpecularParams {
             power_unit: grid_params.power_unit,
-            // The radii too: progressive passes and the viewer's sliders change them.
+            // The radii and the normal test too: progressive passes and the
+            // viewer's sliders change them.
+            normal_test: inputs.global.normal_test as u32,
             global_radius: grid_params.global_radius,
             caustic_radius: grid_params.caustic_radius,
             volume_radius: grid_params.volume_radius,
