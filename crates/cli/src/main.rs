@@ -27,10 +27,12 @@ enum Command {
     /// Look around a scene in a window (the GPU renderer, live).
     #[command(after_help = "Controls: left drag orbits; middle or shift + left drag pans; the wheel zooms; \
 right drag turns in place and W/A/S/D/Q/E fly (the wheel sets the speed while the right button is held); \
-Home resets the camera; C prints it as a [camera] table; T prints per-pass GPU times; F12 writes \
-hikari-view-N.png and .exr; F1 hides the panel; Escape quits.\n\nWhile the camera stands still, fresh photon \
-sets are traced in the background and the window shows the running mean of their frames. Saving the scene \
-file reloads it.")]
+Home resets the camera; C prints it as a [camera] table; T prints per-pass GPU times; Space pauses \
+the scene's animations; F12 writes hikari-view-N.png and .exr; F1 hides the panel; Escape quits.\n\n\
+Photons are traced in the background for the scene as it stands now (its animations, the panel's edits \
+of lights and named objects); a frame never waits for them. While nothing moves, the window shows the \
+running mean of fresh photon sets as progressive passes (shrinking radii, docs/progressive.md), so it \
+converges as you look. Saving the scene file reloads it.")]
     View(view::ViewArgs),
     /// List the built-in scenes.
     Scenes,
