@@ -18,6 +18,7 @@ pub mod gbuffer;
 pub mod lod;
 pub mod media;
 pub mod memory;
+pub mod photons;
 pub mod points;
 pub mod readback;
 pub mod renderer;

@@ -8,13 +8,14 @@ use crate::gbuffer::{GBuffer, GBufferBinding, GBufferParams, GBufferPass};
 use crate::lod::{LodOutput, LodPass};
 use crate::media::GpuMedia;
 use crate::memory::FrameSize;
+use crate::photons::PhotonBuffer;
 use crate::readback::read_rgba;
 use crate::resolve::ResolvePass;
 use crate::scene_upload::SceneBuffers;
 use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
-use crate::splat::{PhotonBuffer, SplatBinding, SplatParams, SplatPass};
+use crate::splat::{SplatBinding, SplatParams, SplatPass};
 use crate::volume::{VolumeParams, VolumePass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
@@ -691,10 +692,10 @@ impl GpuRenderer {
     }
 
     /// The global map's splat instances of the last frame, in draw order.
-    pub fn global_survivors(&self) -> Result<Vec<crate::lod::LodPhoton>, GpuError> {
+    pub fn global_survivors(&self) -> Result<Vec<crate::photons::LodPhoton>, GpuError> {
         let drawn = crate::readback::read_u32s(&self.ctx, &self.global_lod.draw_args, 4)?[1] as u64;
         let words = crate::readback::read_u32s(&self.ctx, &self.global_lod.survivors, drawn.max(1) * 6)?;
-        Ok(bytemuck::cast_slice::<u32, crate::lod::LodPhoton>(&words)[..drawn as usize].to_vec())
+        Ok(bytemuck::cast_slice::<u32, crate::photons::LodPhoton>(&words)[..drawn as usize].to_vec())
     }
 
     /// Volume photons drawn in the last frame.

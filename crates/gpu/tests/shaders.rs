@@ -4,7 +4,8 @@
 use hikari_core::photon::Photon;
 use hikari_gpu::direct::DirectParams;
 use hikari_gpu::gbuffer::GBufferParams;
-use hikari_gpu::lod::{LodParams, LodPhoton};
+use hikari_gpu::lod::LodParams;
+use hikari_gpu::photons::LodPhoton;
 use hikari_gpu::scene_upload::{GpuSurface, GpuVertex};
 use hikari_gpu::shadow::ShadowViewParams;
 use hikari_gpu::shadow::light_samples::{GpuLight, GpuLightSample};
@@ -203,7 +204,7 @@ fn vertex_attribute_offsets_match_rust_structs() {
         (0, 12, 16)
     );
     assert_eq!(
-        offsets(&hikari_gpu::splat::PHOTON_ATTRIBUTES),
+        offsets(&hikari_gpu::photons::PHOTON_ATTRIBUTES),
         [
             offset_of!(LodPhoton, position_x),
             offset_of!(LodPhoton, power_rgb9e5),

@@ -4,7 +4,7 @@
 //! draw, so culled photons cost no rasterization and every run draws the
 //! same instances in the same order.
 
-use crate::splat::PhotonBuffer;
+use crate::photons::{LodPhoton, PhotonBuffer};
 use bytemuck::{Pod, Zeroable};
 use hikari_core::lod::LodSettings;
 use wgpu::util::DeviceExt;
@@ -27,19 +27,6 @@ pub struct LodParams {
     pub _pad0: u32,
     pub _pad1: u32,
     pub _pad2: u32,
-}
-
-/// A splat instance: the stored photon and its power scale. Mirrors
-/// `LodPhoton` in lod.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct LodPhoton {
-    pub position_x: f32,
-    pub position_y: f32,
-    pub position_z: f32,
-    pub power_rgb9e5: u32,
-    pub direction_and_class: u32,
-    pub scale: f32,
 }
 
 /// The instances and indirect arguments of one photon map's splat.

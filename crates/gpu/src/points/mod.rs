@@ -62,7 +62,7 @@ impl PointsPass {
                 module: &module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[Some(crate::splat::photon_instances())],
+                buffers: &[Some(crate::photons::photon_instances())],
             },
             primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::PointList, ..Default::default() },
             depth_stencil: Some(wgpu::DepthStencilState {

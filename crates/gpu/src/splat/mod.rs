@@ -3,8 +3,6 @@
 
 use crate::gbuffer::GBuffer;
 use bytemuck::{Pod, Zeroable};
-use hikari_core::photon::Photon;
-use wgpu::util::DeviceExt;
 
 /// Mirrors `SplatParams` in splat.wgsl.
 #[repr(C)]
@@ -17,29 +15,11 @@ pub struct SplatParams {
     pub _pad: u32,
 }
 
-/// `LodPhoton` (the stored photon and its LOD scale) as per-instance
-/// attributes, offsets written by hand (a test checks them against the struct).
-pub const PHOTON_ATTRIBUTES: [wgpu::VertexAttribute; 4] = [
-    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
-    wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 12, shader_location: 1 },
-    wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 16, shader_location: 2 },
-    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32, offset: 20, shader_location: 3 },
-];
-
 /// The photon footprint vertex shader shared with the volume splat.
 pub const FOOTPRINT_WGSL: &str = include_str!("footprint.wgsl");
 
 pub fn shader_source() -> String {
     format!("{}\n{FOOTPRINT_WGSL}\n{}", crate::ESTIMATE_WGSL, include_str!("splat.wgsl"))
-}
-
-/// The per-instance photon stream of the splats.
-pub fn photon_instances() -> wgpu::VertexBufferLayout<'static> {
-    wgpu::VertexBufferLayout {
-        array_stride: std::mem::size_of::<crate::lod::LodPhoton>() as u64,
-        step_mode: wgpu::VertexStepMode::Instance,
-        attributes: &PHOTON_ATTRIBUTES,
-    }
 }
 
 /// A render pipeline (`vs_main`, `fs_main`) that adds its fragments into a
@@ -87,29 +67,6 @@ pub fn additive_pipeline(
     })
 }
 
-/// Photons uploaded once per photon map, drawn every frame.
-pub struct PhotonBuffer {
-    pub buffer: wgpu::Buffer,
-    pub count: u32,
-}
-
-impl PhotonBuffer {
-    pub fn upload(device: &wgpu::Device, photons: &[Photon], label: &str) -> Self {
-        // wgpu refuses empty buffers: keep one zeroed photon, draw none.
-        let zero =
-            [Photon::new(glam::Vec3::ZERO, glam::Vec3::ZERO, glam::Vec3::Y, hikari_core::photon::PathClass::Indirect)];
-        let data = if photons.is_empty() { &zero[..] } else { photons };
-        PhotonBuffer {
-            buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::cast_slice(data),
-                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE,
-            }),
-            count: photons.len() as u32,
-        }
-    }
-}
-
 /// One map's splat state (its uniforms and bind group), kept between frames.
 pub struct SplatBinding {
     uniforms: wgpu::Buffer,
@@ -139,8 +96,14 @@ impl SplatPass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "splat", &layout);
-        let pipeline =
-            additive_pipeline(device, &pipeline_layout, &module, target_format, &[Some(photon_instances())], "splat");
+        let pipeline = additive_pipeline(
+            device,
+            &pipeline_layout,
+            &module,
+            target_format,
+            &[Some(crate::photons::photon_instances())],
+            "splat",
+        );
         SplatPass { pipeline, layout }
     }
 

@@ -84,7 +84,7 @@ impl VolumePass {
             source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "volume splat", &layout);
-        let instances = [Some(crate::splat::photon_instances())];
+        let instances = [Some(crate::photons::photon_instances())];
         let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &instances, "volume");
         VolumePass { pipeline, bind_group, uniforms }
     }
