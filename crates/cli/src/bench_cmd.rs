@@ -4,7 +4,8 @@
 //! the static rows; the dynamic rows (what the viewer does) time a camera
 //! that moves every frame, photons re-traced on the CPU every frame, and a
 //! light that moves every frame (the scene posed, its BVH rebuilt, its
-//! photons re-traced and uploaded with the moved scene).
+//! photons re-traced and uploaded with the moved scene), photons re-traced
+//! by the GPU tracer every frame; and the tracing rates of both tracers.
 
 use anyhow::{Context, Result};
 use clap::Args;
@@ -14,6 +15,7 @@ use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::PhotonCpuSettings;
 use hikari_core::scene::Scene;
 use hikari_gpu::renderer::{SEED_CORNELL_LOD, Stage};
+use hikari_gpu::trace::GpuTracer;
 use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
 use std::time::Instant;
 
@@ -25,6 +27,9 @@ pub struct BenchArgs {
     /// Also run 1920×1080 with 1,000,000 photons (meant for real GPUs).
     #[arg(long)]
     pub large: bool,
+    /// Only the photon-tracing rates (CPU and GPU tracers).
+    #[arg(long)]
+    pub tracing_only: bool,
 }
 
 struct Row {
@@ -47,6 +52,9 @@ enum Motion {
     Orbit,
     /// A new photon set is traced (all cores) and uploaded every frame.
     Retrace,
+    /// A new photon set is traced by the GPU tracer, read back and uploaded
+    /// every frame.
+    RetraceOnGpu,
     /// The first light orbits (`orbiting_light`), 1/60 s further every
     /// frame: pose, trace, `set_scene`, render.
     MovingLight,
@@ -151,6 +159,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             lod: None,
             motion: Motion::Retrace,
         },
+        Row {
+            label: "cornell-box, 100,000 photons re-traced on the GPU every frame",
+            scene: "cornell-box",
+            size: (512, 512),
+            photons: 100_000,
+            volume: false,
+            lod: None,
+            motion: Motion::RetraceOnGpu,
+        },
         moving_light_row(
             "cornell-box, moving light, 20,000 photons re-traced every frame",
             "cornell-box",
@@ -171,6 +188,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         ),
     ];
     if args.large {
+        rows.push(Row {
+            label: "cornell-box 1920x1080, 1,000,000 photons re-traced on the GPU every frame",
+            scene: "cornell-box",
+            size: (1920, 1080),
+            photons: 1_000_000,
+            volume: false,
+            lod: None,
+            motion: Motion::RetraceOnGpu,
+        });
         rows.push(Row {
             label: "cornell-box 1920x1080, 1,000,000 photons, LOD off",
             scene: "cornell-box",
@@ -204,11 +230,55 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     // A row the adapter cannot run (media without f32 blending, a size over
     // its limits) is reported and the table goes on.
-    for row in rows {
-        if let Err(e) = bench_row(ctx.clone(), &row, args.frames) {
+    for row in rows.iter().filter(|_| !args.tracing_only) {
+        if let Err(e) = bench_row(ctx.clone(), row, args.frames) {
             println!("{}: not run on this adapter: {e:#}", row.label);
         }
     }
+    println!("photon tracing, million photon paths per second (best of 3):");
+    let sizes: &[u64] = if args.large { &[200_000, 1_000_000, 4_000_000] } else { &[200_000] };
+    for name in ["cornell-box", "cornell-caustic", "fog-stage"] {
+        for &photons in sizes {
+            if let Err(e) = bench_tracing(&ctx, name, photons) {
+                println!("{name}, {photons} paths: not run on this adapter: {e:#}");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The CPU tracer (all cores) against the GPU tracer, with and without
+/// reading the maps back.
+fn bench_tracing(ctx: &GpuContext, name: &str, photons: u64) -> Result<()> {
+    let scene = Scene::load(name)?;
+    let settings = TraceSettings { photons, seed: 1, ..Default::default() };
+    let best = |f: &mut dyn FnMut() -> Result<()>| -> Result<f64> {
+        let mut best = f64::INFINITY;
+        for _ in 0..3 {
+            let start = Instant::now();
+            f()?;
+            best = best.min(start.elapsed().as_secs_f64());
+        }
+        Ok(photons as f64 / best / 1e6)
+    };
+    let cpu = best(&mut || {
+        trace_photons(&scene, &settings, &Silent);
+        Ok(())
+    })?;
+    let mut tracer = GpuTracer::new(ctx, &scene)?;
+    // Warm-up: pipelines compiled, batch buffers sized.
+    tracer.trace(ctx, &settings)?;
+    let on_gpu = best(&mut || {
+        tracer.trace_on_gpu(ctx, &settings)?;
+        Ok(())
+    })?;
+    let with_readback = best(&mut || {
+        tracer.trace(ctx, &settings)?;
+        Ok(())
+    })?;
+    println!(
+        "    {name}, {photons} paths: CPU {cpu:.2}, GPU {on_gpu:.2} (maps left on the GPU), GPU {with_readback:.2} (maps read back)"
+    );
     Ok(())
 }
 
@@ -234,6 +304,7 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
     let mut renderer = GpuRenderer::new(ctx, &scene, &traced, settings)?;
     renderer.render()?;
     let mut tracing = 0.0;
+    let mut gpu_tracer = None;
     let mut global_count = traced.indirect().len();
     let start = Instant::now();
     for k in 0..frames {
@@ -251,6 +322,18 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
                 let trace_start = Instant::now();
                 let settings = TraceSettings { photons: row.photons, seed: 2 + k as u64, ..Default::default() };
                 let fresh = trace_photons(&scene, &settings, &Silent);
+                tracing += trace_start.elapsed().as_secs_f64();
+                renderer.set_photons(&scene, &fresh)?;
+                global_count = fresh.indirect().len();
+            }
+            Motion::RetraceOnGpu => {
+                let trace_start = Instant::now();
+                let settings = TraceSettings { photons: row.photons, seed: 2 + k as u64, ..Default::default() };
+                let tracer = gpu_tracer.get_or_insert_with(|| GpuTracer::new(&renderer.ctx, &scene));
+                let fresh = match tracer {
+                    Ok(tracer) => tracer.trace(&renderer.ctx, &settings)?.0,
+                    Err(e) => anyhow::bail!("the GPU tracer: {e}"),
+                };
                 tracing += trace_start.elapsed().as_secs_f64();
                 renderer.set_photons(&scene, &fresh)?;
                 global_count = fresh.indirect().len();
@@ -289,9 +372,12 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         breakdown.iter().map(|(stage, t): &(Stage, f64)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
     let how = if timestamps { "GPU timestamps" } else { "wall-clock, separate submits" };
     println!("    per pass ({how}): {}", parts.join(", "));
-    if matches!(row.motion, Motion::Retrace | Motion::MovingLight) {
-        let what = if row.motion == Motion::MovingLight { "posing and tracing" } else { "tracing" };
-        println!("    {what} {:.2} ms of each frame (CPU, all cores)", tracing / frames as f64 * 1e3);
+    let per_frame = tracing / frames as f64 * 1e3;
+    match row.motion {
+        Motion::Retrace => println!("    tracing {per_frame:.2} ms of each frame (CPU, all cores)"),
+        Motion::MovingLight => println!("    posing and tracing {per_frame:.2} ms of each frame (CPU, all cores)"),
+        Motion::RetraceOnGpu => println!("    tracing and reading back {per_frame:.2} ms of each frame (GPU tracer)"),
+        _ => {}
     }
     Ok((renderer, drawn))
 }

@@ -4,6 +4,7 @@ mod bench_cmd;
 mod passes;
 mod progress_bar;
 mod render_cmd;
+mod tracing;
 mod view;
 
 use clap::{Parser, Subcommand};

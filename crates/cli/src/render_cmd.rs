@@ -3,6 +3,7 @@
 use crate::passes::renderers::{CpuPasses, GpuPasses, PathPasses};
 use crate::passes::{self, PassPlan, read_reference};
 use crate::progress_bar::TerminalProgress;
+use crate::tracing::{PhotonTracer, TraceDevice};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use hikari_core::lod::LodSettings;
@@ -10,7 +11,7 @@ use hikari_core::output::write_image;
 use hikari_core::photon::TracedPhotons;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
-use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules};
+use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_trace_settings};
 use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::{Scene, builtin};
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
@@ -46,6 +47,10 @@ pub struct RenderArgs {
     pub output: PathBuf,
     #[arg(long, value_enum, default_value_t = RendererKind::Gpu)]
     pub renderer: RendererKind,
+    /// Where photons are traced: auto is the GPU on a hardware adapter and
+    /// the CPU on a software one (lavapipe, llvmpipe) or without an adapter.
+    #[arg(long, value_enum, default_value_t = TraceDevice::Auto)]
+    pub trace: TraceDevice,
     /// Photon paths emitted from the lights (1 to 100,000,000; the memory
     /// the maps will take is printed above 2,000,000).
     #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=MAX_PHOTONS))]
@@ -284,12 +289,14 @@ fn render_photons(
         RendererKind::Gpu => open_gpu(scene, &gpu_settings, expected),
         _ => None,
     };
+    let mut tracer = PhotonTracer::choose(args.trace, gpu.as_ref(), scene);
     let trace_start = Instant::now();
     let traced =
-        trace_photons(scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, progress);
+        tracer.trace(scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, progress);
     let trace_time = trace_start.elapsed().as_secs_f64();
     eprintln!(
-        "photons: {} emitted, {} stored in the global map, {} in the caustic map, {} in the volume map; {:.2} M paths/s ({:.2} s)",
+        "photons (traced on the {}): {} emitted, {} stored in the global map, {} in the caustic map, {} in the volume map; {:.2} M paths/s ({:.2} s)",
+        tracer.device(),
         traced.stats.emitted,
         traced.global.len(),
         traced.caustic.len(),
@@ -375,24 +382,32 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
         let expected = expected_map_sizes(scene, args.photons, args.seed);
         if let Some(ctx) = open_gpu(scene, &gpu_settings, expected) {
             let adapter = ctx.describe();
-            let first = trace_photons(
-                scene,
-                &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() },
-                &Silent,
-            );
-            let run = GpuPasses::new(ctx, scene, &first, gpu_settings, args.photons, args.seed, schedules)
+            let mut tracer = PhotonTracer::choose(args.trace, Some(&ctx), scene);
+            let device = tracer.device();
+            let first = tracer.trace(scene, &pass_trace_settings(args.photons, args.seed, 1), &Silent);
+            let run = GpuPasses::new(ctx, scene, &first, gpu_settings, args.photons, args.seed, schedules, tracer)
                 .and_then(|mut passes| passes::run(&mut passes, &plan).map(|(image, _)| (image, passes.nonfinite)));
             match run {
                 Ok(result) => {
-                    eprintln!("gpu: {adapter}, passes splatted and averaged on the GPU");
+                    eprintln!(
+                        "gpu: {adapter}, photons traced on the {device}, passes splatted and averaged on the GPU"
+                    );
                     return Ok(result);
                 }
                 Err(e) => eprintln!("gpu: {e:#}: rendering the passes with photon-cpu instead"),
             }
         }
     }
-    let mut passes =
-        CpuPasses { scene, settings, photons: args.photons, schedules, mean: ImageMean::new(w, h), nonfinite: 0 };
+    let tracer = PhotonTracer::choose(args.trace, None, scene);
+    let mut passes = CpuPasses {
+        scene,
+        settings,
+        photons: args.photons,
+        schedules,
+        mean: ImageMean::new(w, h),
+        nonfinite: 0,
+        tracer,
+    };
     let (image, _) = passes::run(&mut passes, &plan)?;
     Ok((image, passes.nonfinite))
 }

@@ -288,3 +288,30 @@ fn ctrl_c_writes_the_passes_so_far() {
     assert!(err.contains("stopped by Ctrl-C"), "{err}");
     assert!(dir.join("so-far.exr").is_file());
 }
+
+/// `--trace gpu` traces on the GPU tracer and renders what `--trace cpu`
+/// renders (the same photons up to rounding); `auto` picks the CPU on this
+/// software adapter; region media fall back to the CPU, saying why.
+#[test]
+fn traces_photons_on_the_gpu_or_the_cpu() {
+    let dir = scratch_dir("trace");
+    let render = |trace: &str, scene: &str, out: &str| {
+        let args = ["render", scene, "--trace", trace, "--resolution", "24x24", "--photons", "4000", "-o", out, "-q"];
+        let out = hikari(&args, &dir);
+        assert!(out.status.success(), "{}", stderr(&out));
+        stderr(&out)
+    };
+    let gpu = render("gpu", "cornell-caustic", "gpu.exr");
+    assert!(gpu.contains("traced on the gpu"), "{gpu}");
+    let cpu = render("cpu", "cornell-caustic", "cpu.exr");
+    assert!(cpu.contains("traced on the cpu"), "{cpu}");
+    let read = |name: &str| hikari_core::output::read_exr(&dir.join(name)).unwrap();
+    let error = hikari_core::progressive::compare(&read("gpu.exr"), &read("cpu.exr")).unwrap();
+    assert!(error.relative_rmse < 1e-3, "{error:?}");
+    let auto = render("auto", "cornell-caustic", "auto.png");
+    assert!(auto.contains("traced on the cpu"), "lavapipe is a software adapter: {auto}");
+    let layered = render("gpu", "fog-stage-layered", "layered.png");
+    assert!(layered.contains("region") && layered.contains("on the CPU instead"), "{layered}");
+    let bad = hikari(&["render", "--trace", "tpu"], &dir);
+    assert_eq!(bad.status.code(), Some(2));
+}

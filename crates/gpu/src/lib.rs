@@ -27,20 +27,13 @@ pub mod scene_upload;
 pub mod shadow;
 pub mod specular;
 pub mod splat;
+pub mod trace;
 pub mod volume;
+pub mod wgsl;
 
 pub use context::{GpuContext, GpuError};
 pub use renderer::{GpuRenderer, GpuSettings};
 
-/// `loop_iteration()` for the passes whose loops the host bounds exactly
-/// (the shared WGSL calls it in every loop; the specular pass counts).
-pub const UNCOUNTED_LOOPS_WGSL: &str = "fn loop_iteration() -> bool { return true; }\n";
-
-/// `vs_fullscreen`: one triangle over the screen (`binding::fullscreen_pipeline`).
-pub const FULLSCREEN_WGSL: &str = include_str!("fullscreen.wgsl");
-
-/// The WGSL mirror of `hikari_core::estimate`, prepended to the shaders that use it.
-pub const ESTIMATE_WGSL: &str = include_str!("estimate.wgsl");
 pub mod photon_grid;
 pub mod present;
 #[doc(hidden)]

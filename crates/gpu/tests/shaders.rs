@@ -14,18 +14,20 @@ use std::mem::{offset_of, size_of};
 
 fn shaders() -> Vec<(&'static str, String)> {
     vec![
-        ("gbuffer.wgsl", hikari_gpu::gbuffer::SHADER.to_string()),
+        ("gbuffer.wgsl", hikari_gpu::gbuffer::shader_source()),
         ("gbuffer.wgsl + gbuffer_storage.wgsl", hikari_gpu::gbuffer::storage_shader_source()),
         ("present.wgsl", hikari_gpu::present::shader_source()),
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
-        ("estimate.wgsl", hikari_gpu::ESTIMATE_WGSL.to_string()),
+        ("estimate.wgsl", hikari_gpu::wgsl::compose(&[&hikari_gpu::wgsl::ESTIMATE])),
         ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
         ("direct.wgsl", hikari_gpu::direct::shader_source()),
-        ("lod.wgsl", hikari_gpu::lod::SHADER.to_string()),
+        ("lod.wgsl", hikari_gpu::lod::shader_source()),
         ("specular.wgsl", hikari_gpu::specular::shader_source()),
         ("resolve.wgsl", hikari_gpu::resolve::shader_source()),
         ("optical_depth.wgsl", hikari_gpu::media::optical_depth_shader_source()),
         ("volume.wgsl", hikari_gpu::volume::shader_source()),
+        ("trace.wgsl", hikari_gpu::trace::trace_shader_source()),
+        ("compact.wgsl", hikari_gpu::trace::compact_shader_source()),
     ]
 }
 
@@ -73,7 +75,7 @@ macro_rules! assert_layout {
 
 #[test]
 fn shared_structs_match_wgsl_layouts() {
-    let gbuffer = hikari_gpu::gbuffer::SHADER.to_string();
+    let gbuffer = hikari_gpu::gbuffer::shader_source();
     assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
     assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
     let splat = hikari_gpu::splat::shader_source();
@@ -177,7 +179,69 @@ fn shared_structs_match_wgsl_layouts() {
         ]
     );
     assert_layout!(volume, "RegionTriangle", hikari_gpu::media::RegionTriangle, [a, b, c, sigma_t]);
-    let lod = hikari_gpu::lod::SHADER.to_string();
+    use hikari_gpu::trace::{CompactParams, PhotonRecord, TraceLight, TraceMedium, TraceParams};
+    let trace = hikari_gpu::trace::trace_shader_source();
+    assert_layout!(
+        trace,
+        "TraceParams",
+        TraceParams,
+        [
+            mixed_seed,
+            increment,
+            first_path,
+            paths,
+            max_bounces,
+            light_count,
+            epsilon,
+            record_capacity,
+            iteration_budget,
+            sigma_t,
+            medium_count,
+            albedo_factor,
+            lambda
+        ]
+    );
+    assert_layout!(
+        trace,
+        "TraceLight",
+        TraceLight,
+        [
+            origin,
+            kind,
+            axis,
+            radius,
+            edge_v,
+            cos_cutoff,
+            normal,
+            cutoff,
+            power,
+            falloff_start,
+            probability,
+            _pad0,
+            _pad1,
+            _pad2
+        ]
+    );
+    assert_layout!(trace, "TraceMedium", TraceMedium, [share, phase_kind, phase_parameter, phase_slot]);
+    let record_fields = |source: &String| {
+        assert_layout!(
+            source,
+            "PhotonRecord",
+            PhotonRecord,
+            [path, tag, position_x, position_y, position_z, power_rgb9e5, direction_and_class, _pad]
+        );
+    };
+    record_fields(&trace);
+    let compact = hikari_gpu::trace::compact_shader_source();
+    record_fields(&compact);
+    assert_layout!(compact, "CompactParams", CompactParams, [elements, paths, record_capacity, workgroups]);
+    assert_layout!(
+        trace,
+        "FlatShading",
+        hikari_core::geometry::FlatShading,
+        [geometric_normal, has_vertex_normals, vertex_normals]
+    );
+    let lod = hikari_gpu::lod::shader_source();
     assert_layout!(
         lod,
         "LodParams",

@@ -3,18 +3,17 @@
 //! is the single-pass render and every pass is independent of the others.
 
 use super::PassRenderer;
+use crate::tracing::PhotonTracer;
 use anyhow::Result;
-use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
+use hikari_core::photon::TracedPhotons;
 use hikari_core::progress::Silent;
-use hikari_core::progressive::{ImageMean, Schedules, pass_jitter, pass_seed, photon_cpu_pass};
+use hikari_core::progressive::{
+    ImageMean, Schedules, pass_jitter, pass_seed, pass_trace_settings, photon_cpu_estimate_pass,
+};
 use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::Scene;
 use hikari_gpu::accumulate::AccumulatePass;
 use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
-
-fn trace(scene: &Scene, photons: u64, seed: u64, pass: u32) -> TracedPhotons {
-    trace_photons(scene, &TraceSettings { photons, seed: pass_seed(seed, pass), ..Default::default() }, &Silent)
-}
 
 /// `photon-cpu`: each pass estimates its own photons at the schedule's radii.
 pub struct CpuPasses<'a> {
@@ -25,11 +24,14 @@ pub struct CpuPasses<'a> {
     pub mean: ImageMean,
     /// Non-finite samples dropped, over all passes.
     pub nonfinite: u64,
+    pub tracer: PhotonTracer,
 }
 
 impl PassRenderer for CpuPasses<'_> {
     fn render_pass(&mut self, pass: u32) -> Result<()> {
-        let (image, nonfinite) = photon_cpu_pass(self.scene, &self.settings, self.photons, &self.schedules, pass);
+        let settings = pass_trace_settings(self.photons, self.settings.seed, pass);
+        let traced = self.tracer.trace(self.scene, &settings, &Silent);
+        let (image, nonfinite) = photon_cpu_estimate_pass(self.scene, &self.settings, &traced, &self.schedules, pass);
         self.nonfinite += nonfinite;
         self.mean.add(&image);
         Ok(())
@@ -84,12 +86,14 @@ pub struct GpuPasses<'a> {
     schedules: Schedules,
     /// Pass 1's photons, which the renderer was built with.
     first_built: bool,
+    tracer: PhotonTracer,
     pub nonfinite: u64,
 }
 
 impl<'a> GpuPasses<'a> {
     /// A renderer of `scene` built with pass 1's photons `first` (traced
-    /// with `seed`) at the schedule's first radii.
+    /// with `seed`) at the schedule's first radii; later passes trace with `tracer`.
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: GpuContext,
         scene: &'a Scene,
@@ -98,11 +102,12 @@ impl<'a> GpuPasses<'a> {
         photons: u64,
         seed: u64,
         schedules: Schedules,
+        tracer: PhotonTracer,
     ) -> Result<Self> {
         [settings.global.radius, settings.caustic.radius, settings.volume_radius] = schedules.radii(1);
         let renderer = GpuRenderer::new(ctx, scene, first, settings)?;
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        Ok(GpuPasses { scene, renderer, mean, photons, seed, schedules, first_built: true, nonfinite: 0 })
+        Ok(GpuPasses { scene, renderer, mean, photons, seed, schedules, first_built: true, tracer, nonfinite: 0 })
     }
 }
 
@@ -110,7 +115,7 @@ impl PassRenderer for GpuPasses<'_> {
     fn render_pass(&mut self, pass: u32) -> Result<()> {
         let built = std::mem::take(&mut self.first_built);
         if !(built && pass == 1) {
-            let traced = trace(self.scene, self.photons, self.seed, pass);
+            let traced = self.tracer.trace(self.scene, &pass_trace_settings(self.photons, self.seed, pass), &Silent);
             let s = &mut self.renderer.settings;
             [s.global.radius, s.caustic.radius, s.volume_radius] = self.schedules.radii(pass);
             self.renderer.set_photons(self.scene, &traced)?;

@@ -3,6 +3,7 @@
 //! `FlatBvh::intersect` is the CPU mirror of the WGSL traversal.
 
 use super::{Accel, Ray};
+use bytemuck::Zeroable;
 use glam::{Vec3, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
 use std::time::Duration;
@@ -31,9 +32,25 @@ pub struct FlatPrim {
     pub _pad: u32,
 }
 
+/// What a hit on a primitive needs beyond its distance, in the same order as
+/// `FlatBvh::prims`: the unit geometric normal exactly as `Accel` computes it
+/// (so CPU and GPU photon paths see the same bits), and the vertex normals
+/// of smooth triangles. Spheres compute their normal from the hit point.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FlatShading {
+    pub geometric_normal: [f32; 3],
+    /// 1 when `vertex_normals` hold the triangle's smooth normals.
+    pub has_vertex_normals: u32,
+    /// n0, n1, n2 (w unused).
+    pub vertex_normals: [[f32; 4]; 3],
+}
+
 pub struct FlatBvh {
     pub nodes: Vec<FlatNode>,
     pub prims: Vec<FlatPrim>,
+    /// Per primitive, in `prims` order.
+    pub shading: Vec<FlatShading>,
     pub epsilon: f32,
 }
 
@@ -57,6 +74,18 @@ impl FlatBvh {
                 _pad: 0,
             })
             .collect();
+        let mut shading: Vec<FlatShading> = accel
+            .triangles()
+            .map(|(t, _)| {
+                let normals = t.normals.map_or([Vec3::ZERO; 3], |n| n.0);
+                FlatShading {
+                    geometric_normal: t.geometric_normal().normalize().to_array(),
+                    has_vertex_normals: t.normals.is_some() as u32,
+                    vertex_normals: normals.map(|n| n.extend(0.0).to_array()),
+                }
+            })
+            .collect();
+        shading.extend(accel.spheres().map(|_| FlatShading::zeroed()));
         prims.extend(accel.spheres().map(|(s, surface)| FlatPrim {
             a: s.center.to_array(),
             is_sphere: 1,
@@ -66,7 +95,7 @@ impl FlatBvh {
             _pad: 0,
         }));
         if prims.is_empty() {
-            return FlatBvh { nodes: Vec::new(), prims, epsilon: accel.epsilon };
+            return FlatBvh { nodes: Vec::new(), prims, shading, epsilon: accel.epsilon };
         }
         let bounds: Vec<Bounds> = prims
             .iter()
@@ -92,7 +121,8 @@ impl FlatBvh {
             })
             .collect();
         let ordered = bvh.primitive_indices.iter().map(|&i| prims[i as usize]).collect();
-        FlatBvh { nodes, prims: ordered, epsilon: accel.epsilon }
+        let ordered_shading = bvh.primitive_indices.iter().map(|&i| shading[i as usize]).collect();
+        FlatBvh { nodes, prims: ordered, shading: ordered_shading, epsilon: accel.epsilon }
     }
 
     /// Closest hit: (t, primitive index in `prims`). The WGSL traversal

@@ -8,7 +8,7 @@ mod shapes;
 
 pub use accel::{Accel, Hit};
 pub(crate) use bvh_build::build_cwbvh;
-pub use flat_bvh::{FlatBvh, FlatNode, FlatPrim};
+pub use flat_bvh::{FlatBvh, FlatNode, FlatPrim, FlatShading};
 pub use shapes::{Sphere, Triangle, TriangleNormals};
 
 use glam::Vec3;

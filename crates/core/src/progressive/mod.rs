@@ -108,11 +108,29 @@ pub fn photon_cpu_pass(
     schedules: &Schedules,
     pass: u32,
 ) -> (Image, u64) {
-    use crate::photon::{TraceSettings, trace_photons};
+    let silent = crate::progress::Silent;
+    let traced = crate::photon::trace_photons(scene, &pass_trace_settings(photons, settings.seed, pass), &silent);
+    photon_cpu_estimate_pass(scene, settings, &traced, schedules, pass)
+}
+
+/// What pass `pass` of a run seeded with `seed` traces: `photons` paths
+/// with `pass_seed`.
+pub fn pass_trace_settings(photons: u64, seed: u64, pass: u32) -> crate::photon::TraceSettings {
+    crate::photon::TraceSettings { photons, seed: pass_seed(seed, pass), ..Default::default() }
+}
+
+/// `photon_cpu_pass` with the pass's photons `traced` given (traced with
+/// `pass_trace_settings`, on whichever device).
+pub fn photon_cpu_estimate_pass(
+    scene: &crate::scene::Scene,
+    settings: &crate::render::photon_cpu::PhotonCpuSettings,
+    traced: &crate::photon::TracedPhotons,
+    schedules: &Schedules,
+    pass: u32,
+) -> (Image, u64) {
     use crate::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
     let seed = pass_seed(settings.seed, pass);
     let silent = crate::progress::Silent;
-    let traced = trace_photons(scene, &TraceSettings { photons, seed, ..Default::default() }, &silent);
     let [global, caustic, volume] = schedules.radii(pass);
     let settings = PhotonCpuSettings {
         radius: Some(global),
@@ -121,5 +139,5 @@ pub fn photon_cpu_pass(
         seed,
         ..settings.clone()
     };
-    PhotonCpuRenderer::new(scene, &traced, &settings).render(&silent)
+    PhotonCpuRenderer::new(scene, traced, &settings).render(&silent)
 }

@@ -24,10 +24,16 @@ fn mix64(mut z: u64) -> u64 {
 impl Rng {
     /// A stream for work item `index` of a run seeded with `seed`.
     pub fn for_item(seed: u64, index: u64) -> Self {
-        let mut rng = Rng { state: 0, increment: (mix64(seed ^ 0x9e3779b97f4a7c15) << 1) | 1 };
-        rng.state = mix64(index.wrapping_add(mix64(seed)));
+        let (mixed_seed, increment) = Rng::seed_constants(seed);
+        let mut rng = Rng { state: mix64(index.wrapping_add(mixed_seed)), increment };
         rng.next_u32();
         rng
+    }
+
+    /// What every stream of a run shares: mix64(seed) and the PCG increment.
+    /// The GPU tracer (random.wgsl) takes these and does the rest per path.
+    pub fn seed_constants(seed: u64) -> (u64, u64) {
+        (mix64(seed), (mix64(seed ^ 0x9e3779b97f4a7c15) << 1) | 1)
     }
 
     pub fn next_u32(&mut self) -> u32 {

@@ -6,8 +6,6 @@
 // `shadow_maps`, and `light_transmittance(x, sample_position)` (the media's
 // transmittance between them; 1 where media are not drawn).
 
-const PI_D: f32 = 3.14159265358979323846;
-
 struct DirectParams {
     light_count: u32,
     shadow_size: u32,
@@ -46,17 +44,6 @@ struct ShadowView {
     light_position: vec4<f32>,
 }
 
-// Mirrors hikari_core::light::spot_falloff (Mitsuba's convention).
-fn spot_falloff(theta: f32, cutoff: f32, falloff_start: f32) -> f32 {
-    if (theta >= cutoff) {
-        return 0.0;
-    }
-    if (theta <= falloff_start) {
-        return 1.0;
-    }
-    return (cutoff - theta) / (cutoff - falloff_start);
-}
-
 // Irradiance ∫ L cos θ dω at x (normal n) from light l, ignoring occlusion.
 fn unshadowed_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let to_light = l.position - x;
@@ -77,7 +64,7 @@ fn unshadowed_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             if (d2 <= r2) {
                 return vec3<f32>(0.0);
             }
-            return l.emission * PI_D * (r2 / d2) * cos_x;
+            return l.emission * PI * (r2 / d2) * cos_x;
         }
         default: {
             // Lambert's polygon formula: E = L/2 Σ θ_i (γ_i · n) over the edges
@@ -160,5 +147,5 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
         }
         sum += e * (seen / f32(l.sample_count));
     }
-    return albedo / PI_D * sum;
+    return albedo / PI * sum;
 }

@@ -8,17 +8,16 @@ use bytemuck::{Pod, Zeroable};
 use wgpu::util::DeviceExt;
 
 /// Light evaluation shared with the specular pass; needs the includer's bindings.
-pub const LIGHT_EVAL_WGSL: &str = include_str!("light_eval.wgsl");
+pub static LIGHT_EVAL: crate::wgsl::Module = crate::wgsl::Module {
+    name: "light_eval.wgsl",
+    source: include_str!("light_eval.wgsl"),
+    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::SPOT],
+};
 
 pub fn shader_source() -> String {
-    format!(
-        "{}\n{}\n{}\n{}\n{}",
-        crate::UNCOUNTED_LOOPS_WGSL,
-        crate::FULLSCREEN_WGSL,
-        crate::media::MEDIA_WGSL,
-        LIGHT_EVAL_WGSL,
-        include_str!("direct.wgsl")
-    )
+    use crate::wgsl::{FULLSCREEN, Module, UNCOUNTED_LOOPS, compose};
+    static DIRECT: Module = Module { name: "direct.wgsl", source: include_str!("direct.wgsl"), requires: &[] };
+    compose(&[&UNCOUNTED_LOOPS, &FULLSCREEN, &crate::media::MEDIA, &LIGHT_EVAL, &DIRECT])
 }
 
 /// Loop iterations one pixel of the direct pass runs at most: per light,

@@ -7,14 +7,6 @@ struct GBufferParams {
     _pad: f32,
 }
 
-struct Surface {
-    albedo: vec3<f32>,
-    kind: u32,
-    emission: vec3<f32>,
-    ior: f32,
-    specular: vec3<f32>,
-    _pad: u32,
-}
 
 @group(0) @binding(0) var<uniform> params: GBufferParams;
 @group(0) @binding(1) var<storage, read> surfaces: array<Surface>;

@@ -15,11 +15,16 @@ pub struct GBufferParams {
 
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-pub const SHADER: &str = include_str!("gbuffer.wgsl");
+pub fn shader_source() -> String {
+    use crate::wgsl::{Module, SURFACE, compose};
+    static GBUFFER: Module =
+        Module { name: "gbuffer.wgsl", source: include_str!("gbuffer.wgsl"), requires: &[&SURFACE] };
+    compose(&[&GBUFFER])
+}
 
 /// gbuffer.wgsl with the storage path's fragment entry point.
 pub fn storage_shader_source() -> String {
-    format!("{SHADER}\n{}", include_str!("gbuffer_storage.wgsl"))
+    format!("{}\n{}", shader_source(), include_str!("gbuffer_storage.wgsl"))
 }
 
 /// `GpuVertex` as vertex attributes, offsets written by hand (a test checks
@@ -106,7 +111,7 @@ enum Mode {
 impl GBufferPass {
     /// With `storage`, the storage path (`GpuContext::gbuffer_storage`).
     pub fn new(device: &wgpu::Device, storage: bool) -> Self {
-        let source = if storage { storage_shader_source() } else { SHADER.to_string() };
+        let source = if storage { storage_shader_source() } else { shader_source() };
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gbuffer.wgsl"),
             source: wgpu::ShaderSource::Wgsl(source.into()),

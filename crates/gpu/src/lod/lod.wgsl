@@ -44,9 +44,6 @@ struct DrawIndirect {
 // Survivors per workgroup, then (after `scan`) each workgroup's first slot.
 @group(0) @binding(4) var<storage, read_write> group_sums: array<u32>;
 
-const WORKGROUP: u32 = 256u;
-var<workgroup> shared_sums: array<u32, 256>;
-
 fn smoothstep_lod(e0: f32, e1: f32, x: f32) -> f32 {
     if (e0 == e1) {
         return select(1.0, 0.0, x < e0);
@@ -96,62 +93,25 @@ fn scale_of(i: u32) -> f32 {
     return power_scale(detail_level(distance(photon_position(i), params.eye)), group_of(i));
 }
 
-// Exclusive prefix sum of `value` over the workgroup (Hillis–Steele), and the
-// workgroup's total in shared_sums[WORKGROUP - 1]. Called in uniform control flow.
-fn workgroup_exclusive_prefix(lid: u32, value: u32) -> u32 {
-    shared_sums[lid] = value;
-    workgroupBarrier();
-    for (var offset = 1u; offset < WORKGROUP; offset *= 2u) {
-        var add = 0u;
-        if (lid >= offset) {
-            add = shared_sums[lid - offset];
-        }
-        workgroupBarrier();
-        shared_sums[lid] += add;
-        workgroupBarrier();
-    }
-    return shared_sums[lid] - value;
-}
-
-// The count and scatter dispatches are two-dimensional (x up to 65,535
-// workgroups, the portable limit), so a map may hold more than 16.7 M
-// photons; workgroups past the last are idle. Uniform per workgroup.
-fn group_index(wid: vec3<u32>, groups: vec3<u32>) -> u32 {
-    return wid.y * groups.x + wid.x;
-}
-
 @compute @workgroup_size(256)
 fn count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
     let g = group_index(wid, groups);
     if (g >= params.workgroups) {
         return;
     }
-    let keep = u32(scale_of(g * WORKGROUP + lid) > 0.0);
+    let keep = u32(scale_of(g * SCAN_WORKGROUP + lid) > 0.0);
     workgroup_exclusive_prefix(lid, keep);
     if (lid == 0u) {
-        group_sums[g] = shared_sums[WORKGROUP - 1u];
+        group_sums[g] = shared_sums[SCAN_WORKGROUP - 1u];
     }
 }
 
 // One workgroup turns the per-workgroup counts into first slots.
 @compute @workgroup_size(256)
 fn scan(@builtin(local_invocation_index) lid: u32) {
-    let n = params.workgroups;
-    let chunk = (n + WORKGROUP - 1u) / WORKGROUP;
-    let start = min(lid * chunk, n);
-    let end = min(start + chunk, n);
-    var partial = 0u;
-    for (var i = start; i < end; i++) {
-        partial += group_sums[i];
-    }
-    var running = workgroup_exclusive_prefix(lid, partial);
-    for (var i = start; i < end; i++) {
-        let c = group_sums[i];
-        group_sums[i] = running;
-        running += c;
-    }
-    if (lid == WORKGROUP - 1u) {
-        draw.instance_count = shared_sums[WORKGROUP - 1u];
+    let total = scan_group_sums(lid, params.workgroups);
+    if (lid == SCAN_WORKGROUP - 1u) {
+        draw.instance_count = total;
     }
 }
 
@@ -161,7 +121,7 @@ fn scatter(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) group
     if (g >= params.workgroups) {
         return;
     }
-    let i = g * WORKGROUP + lid;
+    let i = g * SCAN_WORKGROUP + lid;
     let scale = scale_of(i);
     let keep = u32(scale > 0.0);
     let slot = group_sums[g] + workgroup_exclusive_prefix(lid, keep);

@@ -9,9 +9,14 @@ use bytemuck::{Pod, Zeroable};
 use hikari_core::lod::LodSettings;
 use wgpu::util::DeviceExt;
 
-pub const SHADER: &str = include_str!("lod.wgsl");
-/// Matches `WORKGROUP` in lod.wgsl.
-const WORKGROUP: u32 = 256;
+pub fn shader_source() -> String {
+    use crate::wgsl::{Module, PREFIX_SUM, compose};
+    static LOD: Module = Module { name: "lod.wgsl", source: include_str!("lod.wgsl"), requires: &[&PREFIX_SUM] };
+    compose(&[&LOD])
+}
+
+/// Matches `SCAN_WORKGROUP` in prefix_sum.wgsl.
+const WORKGROUP: u32 = crate::wgsl::SCAN_WORKGROUP;
 
 /// Mirrors `LodParams` in lod.wgsl.
 #[repr(C)]
@@ -60,7 +65,7 @@ impl LodPass {
     pub fn new(device: &wgpu::Device) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("lod.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         use crate::binding::{storage, uniform};
         let entry = |b, ty| crate::binding::entry(b, wgpu::ShaderStages::COMPUTE, ty);

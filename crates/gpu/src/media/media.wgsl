@@ -5,8 +5,6 @@
 // Prepended to the shaders that use media; the includer declares `media`
 // and `regions` (view_depth.wgsl adds the optical depth along view rays).
 
-const PI_M: f32 = 3.14159265358979323846;
-
 struct MediaParams {
     camera_position: vec3<f32>,
     // Length of view rays that hit nothing (photon-cpu's: twice the scene diagonal).
@@ -44,11 +42,11 @@ fn phase_eval(slot: u32, mu: f32) -> f32 {
     if (p.x == 0.0) {
         let k = p.y;
         let d = 1.0 - k * mu;
-        return (1.0 - k * k) / (4.0 * PI_M * d * d);
+        return (1.0 - k * k) / (4.0 * PI * d * d);
     }
     let g = p.y;
     let d = 1.0 + g * g - 2.0 * g * mu;
-    return (1.0 - g * g) / (4.0 * PI_M * d * sqrt(d));
+    return (1.0 - g * g) / (4.0 * PI * d * sqrt(d));
 }
 
 // The view ray through a pixel: unit direction (xyz) and the distance to the

@@ -11,12 +11,20 @@ use hikari_core::scene::Scene;
 use wgpu::util::DeviceExt;
 
 /// Structs and functions shared by every shader that sees media.
-pub const MEDIA_WGSL: &str = include_str!("media.wgsl");
+pub static MEDIA: crate::wgsl::Module = crate::wgsl::Module {
+    name: "media.wgsl",
+    source: include_str!("media.wgsl"),
+    requires: &[&crate::wgsl::CONSTANTS],
+};
 /// The optical depth along view rays from the slices.
-pub const VIEW_DEPTH_WGSL: &str = include_str!("view_depth.wgsl");
+pub static VIEW_DEPTH: crate::wgsl::Module =
+    crate::wgsl::Module { name: "view_depth.wgsl", source: include_str!("view_depth.wgsl"), requires: &[&MEDIA] };
 
 pub fn optical_depth_shader_source() -> String {
-    format!("{}{MEDIA_WGSL}\n{}", crate::UNCOUNTED_LOOPS_WGSL, include_str!("optical_depth.wgsl"))
+    use crate::wgsl::{Module, UNCOUNTED_LOOPS, compose};
+    static OPTICAL_DEPTH: Module =
+        Module { name: "optical_depth.wgsl", source: include_str!("optical_depth.wgsl"), requires: &[] };
+    compose(&[&UNCOUNTED_LOOPS, &MEDIA, &OPTICAL_DEPTH])
 }
 
 /// Mirrors `MediaParams` in media.wgsl.

@@ -8,7 +8,9 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
 pub fn shader_source() -> String {
-    format!("{}\n{}", crate::ESTIMATE_WGSL, include_str!("points.wgsl"))
+    use crate::wgsl::{ESTIMATE, Module, compose};
+    static POINTS: Module = Module { name: "points.wgsl", source: include_str!("points.wgsl"), requires: &[] };
+    compose(&[&ESTIMATE, &POINTS])
 }
 
 /// What the points' colours show.

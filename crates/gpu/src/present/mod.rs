@@ -6,7 +6,9 @@ use bytemuck::{Pod, Zeroable};
 
 /// present.wgsl after the shared fullscreen triangle.
 pub fn shader_source() -> String {
-    format!("{}\n{}", crate::FULLSCREEN_WGSL, include_str!("present.wgsl"))
+    use crate::wgsl::{FULLSCREEN, Module, compose};
+    static PRESENT: Module = Module { name: "present.wgsl", source: include_str!("present.wgsl"), requires: &[] };
+    compose(&[&FULLSCREEN, &PRESENT])
 }
 
 /// Mirrors `PresentParams` in present.wgsl.

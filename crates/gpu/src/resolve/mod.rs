@@ -2,13 +2,9 @@
 //! `Rgba32Float` image (the only texture read back for output).
 
 pub fn shader_source() -> String {
-    format!(
-        "{}\n{}\n{}\n{}",
-        crate::UNCOUNTED_LOOPS_WGSL,
-        crate::media::MEDIA_WGSL,
-        crate::media::VIEW_DEPTH_WGSL,
-        include_str!("resolve.wgsl")
-    )
+    use crate::wgsl::{Module, UNCOUNTED_LOOPS, compose};
+    static RESOLVE: Module = Module { name: "resolve.wgsl", source: include_str!("resolve.wgsl"), requires: &[] };
+    compose(&[&UNCOUNTED_LOOPS, &crate::media::MEDIA, &crate::media::VIEW_DEPTH, &RESOLVE])
 }
 const WORKGROUP: u32 = 8;
 

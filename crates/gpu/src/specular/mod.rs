@@ -30,14 +30,20 @@ pub fn has_specular_surfaces(scene: &Scene) -> bool {
 }
 
 pub fn shader_source() -> String {
-    format!(
-        "{}\n{}\n{}\n{}\n{}",
-        crate::ESTIMATE_WGSL,
-        crate::media::MEDIA_WGSL,
-        crate::direct::LIGHT_EVAL_WGSL,
-        include_str!("loop_budget.wgsl"),
-        include_str!("specular.wgsl")
-    )
+    use crate::wgsl::{BVH, ESTIMATE, Module, OPTICS, compose};
+    static LOOP_BUDGET: Module =
+        Module { name: "loop_budget.wgsl", source: include_str!("loop_budget.wgsl"), requires: &[] };
+    static SPECULAR: Module = Module { name: "specular.wgsl", source: include_str!("specular.wgsl"), requires: &[] };
+    compose(&[
+        &ESTIMATE,
+        &crate::media::MEDIA,
+        &crate::direct::LIGHT_EVAL,
+        &LOOP_BUDGET,
+        &BVH,
+        &OPTICS,
+        &crate::wgsl::SURFACE,
+        &SPECULAR,
+    ])
 }
 
 /// Mirrors `SpecularParams` in specular.wgsl.

@@ -6,8 +6,8 @@
 // direct light (light_eval.wgsl) and fixed-radius gathers over both photon
 // maps (estimate.wgsl). In media every segment of the path is attenuated
 // and adds the in-scattering along it from the volume map, as photon-cpu's
-// recursion does. Prepended with estimate.wgsl, media.wgsl,
-// light_eval.wgsl and loop_budget.wgsl.
+// recursion does. Composed with estimate.wgsl, media.wgsl,
+// light_eval.wgsl, loop_budget.wgsl, bvh.wgsl and optics.wgsl.
 //
 // The photon gathers can be split over several dispatches ("slices"):
 // slice k reads photons k, k + S, k + 2S, … of every cell, adding to the
@@ -48,30 +48,6 @@ struct SpecularParams {
     jitter_y: f32,
 }
 
-struct FlatNode {
-    min: vec3<f32>,
-    prim_count: u32,
-    max: vec3<f32>,
-    first: u32,
-}
-
-struct FlatPrim {
-    a: vec3<f32>,
-    is_sphere: u32,
-    b: vec3<f32>,
-    surface: u32,
-    c: vec3<f32>,
-    _pad: u32,
-}
-
-struct Surface {
-    albedo: vec3<f32>,
-    kind: u32,
-    emission: vec3<f32>,
-    ior: f32,
-    specular: vec3<f32>,
-    _pad: u32,
-}
 
 @group(0) @binding(0) var<uniform> params: SpecularParams;
 @group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
@@ -101,123 +77,6 @@ struct SliceParams {
     count: u32,
     iteration_budget: u32,
     _pad: u32,
-}
-
-const NO_HIT: f32 = 3.0e38;
-
-// Zero components become ±1e-20 so the slab test never sees 0·∞
-// (as hikari_core::geometry::FlatBvh::intersect).
-fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
-    let s = select(d, sign(d + vec3<f32>(1.0e-30)) * 1.0e-20, abs(d) < vec3<f32>(1.0e-20));
-    return 1.0 / s;
-}
-
-fn slab_hit(o: vec3<f32>, inv: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, t_max: f32) -> bool {
-    let t0 = (lo - o) * inv;
-    let t1 = (hi - o) * inv;
-    let near = max(max(max(min(t0.x, t1.x), min(t0.y, t1.y)), min(t0.z, t1.z)), 0.0);
-    let far = min(min(min(max(t0.x, t1.x), max(t0.y, t1.y)), max(t0.z, t1.z)), t_max);
-    return near <= far;
-}
-
-// Nearest hit in (epsilon, t_max), as hikari_core's Triangle/Sphere::intersect.
-fn intersect_prim(p: FlatPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32) -> f32 {
-    let eps = params.epsilon;
-    if (p.is_sphere != 0u) {
-        let radius = p.b.x;
-        let oc = o - p.a;
-        let a = dot(d, d);
-        let half_b = dot(oc, d);
-        let closest = oc - d * (half_b / a);
-        let disc = radius * radius - dot(closest, closest);
-        if (disc < 0.0) {
-            return NO_HIT;
-        }
-        let root = sqrt(a * disc);
-        let q = -half_b - select(-root, root, half_b >= 0.0);
-        var t0 = q / a;
-        var t1 = select(q / a, (dot(oc, oc) - radius * radius) / q, q != 0.0);
-        if (t0 > t1) {
-            let tmp = t0;
-            t0 = t1;
-            t1 = tmp;
-        }
-        if (t0 > eps && t0 < t_max) {
-            return t0;
-        }
-        if (t1 > eps && t1 < t_max) {
-            return t1;
-        }
-        return NO_HIT;
-    }
-    let e1 = p.b;
-    let e2 = p.c;
-    let pv = cross(d, e2);
-    let det = dot(e1, pv);
-    if (abs(det) < 1.0e-12) {
-        return NO_HIT;
-    }
-    let inv = 1.0 / det;
-    let s = o - p.a;
-    let b1 = dot(s, pv) * inv;
-    if (b1 < 0.0 || b1 > 1.0) {
-        return NO_HIT;
-    }
-    let qv = cross(s, e1);
-    let b2 = dot(d, qv) * inv;
-    if (b2 < 0.0 || b1 + b2 > 1.0) {
-        return NO_HIT;
-    }
-    let t = dot(e2, qv) * inv;
-    if (t > eps && t < t_max) {
-        return t;
-    }
-    return NO_HIT;
-}
-
-struct Hit {
-    t: f32,
-    prim: u32,
-}
-
-// Closest hit by stack traversal of the flat BVH (FlatBvh::intersect).
-fn trace(o: vec3<f32>, d: vec3<f32>) -> Hit {
-    var hit = Hit(NO_HIT, 0u);
-    if (arrayLength(&nodes) == 0u) {
-        return hit;
-    }
-    let inv = safe_inverse(d);
-    var stack: array<u32, 64>;
-    var top = 1u;
-    stack[0] = 0u;
-    while (top > 0u) {
-        if (!loop_iteration()) {
-            break;
-        }
-        top -= 1u;
-        let node = nodes[stack[top]];
-        if (!slab_hit(o, inv, node.min, node.max, hit.t)) {
-            continue;
-        }
-        if (node.prim_count == 0u) {
-            if (top + 2u <= 64u) {
-                stack[top] = node.first;
-                stack[top + 1u] = node.first + 1u;
-                top += 2u;
-            }
-            continue;
-        }
-        for (var i = node.first; i < node.first + node.prim_count; i++) {
-            if (!loop_iteration()) {
-                break;
-            }
-            let t = intersect_prim(prims[i], o, d, hit.t);
-            if (t < hit.t) {
-                hit = Hit(t, i);
-            }
-        }
-    }
-    return hit;
 }
 
 // The spatial hash of photon_grid.rs.
@@ -379,7 +238,7 @@ fn volume_along(o: vec3<f32>, d: vec3<f32>, len: f32) -> vec3<f32> {
             t_next.z += t_delta.z;
         }
     }
-    let norm = 1.0 / (4.0 / 3.0 * PI_M * r * r * r);
+    let norm = 1.0 / (4.0 / 3.0 * PI * r * r * r);
     return sum * norm * params.power_unit;
 }
 
@@ -425,7 +284,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         top -= 1u;
         let b = stack[top];
-        let hit = trace(b.origin, b.dir);
+        let hit = trace_bvh(b.origin, b.dir, params.epsilon);
         // Media along this segment (photon-cpu's `radiance`): a ray that
         // hits nothing still crosses `max_distance` of them. The segment from
         // the eye (depth 0) is the raster passes' (volume splat, resolve).
@@ -476,17 +335,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     // hikari_core::material::dielectric_split
                     let eta = select(s.ior, 1.0 / s.ior, front);
                     let cos_i = -dot(b.dir, n);
-                    let sin2_t = eta * eta * max(1.0 - cos_i * cos_i, 0.0);
-                    var reflectance = 1.0;
-                    var cos_t = 0.0;
-                    if (sin2_t < 1.0) {
-                        cos_t = sqrt(1.0 - sin2_t);
-                        let r_par = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-                        let r_perp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-                        reflectance = 0.5 * (r_par * r_par + r_perp * r_perp);
-                    }
+                    let fresnel = fresnel_dielectric(cos_i, eta);
+                    let reflectance = fresnel.x;
                     if (reflectance < 1.0 && top < STACK) {
-                        let refracted = normalize(eta * b.dir + (eta * cos_i - cos_t) * n);
+                        let refracted = refract_direction(b.dir, n, eta, cos_i, fresnel.y);
                         stack[top] = Branch(x, b.depth + 1u, refracted, weight * (1.0 - reflectance));
                         top += 1u;
                     }

@@ -16,10 +16,16 @@ pub struct SplatParams {
 }
 
 /// The photon footprint vertex shader shared with the volume splat.
-pub const FOOTPRINT_WGSL: &str = include_str!("footprint.wgsl");
+pub static FOOTPRINT: crate::wgsl::Module = crate::wgsl::Module {
+    name: "footprint.wgsl",
+    source: include_str!("footprint.wgsl"),
+    requires: &[&crate::wgsl::PHOTON_ENCODING],
+};
 
 pub fn shader_source() -> String {
-    format!("{}\n{FOOTPRINT_WGSL}\n{}", crate::ESTIMATE_WGSL, include_str!("splat.wgsl"))
+    use crate::wgsl::{ESTIMATE, Module, compose};
+    static SPLAT: Module = Module { name: "splat.wgsl", source: include_str!("splat.wgsl"), requires: &[] };
+    compose(&[&ESTIMATE, &FOOTPRINT, &SPLAT])
 }
 
 /// A render pipeline (`vs_main`, `fs_main`) that adds its fragments into a

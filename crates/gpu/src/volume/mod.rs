@@ -22,15 +22,16 @@ pub struct VolumeParams {
 }
 
 pub fn shader_source() -> String {
-    format!(
-        "{}\n{}\n{}\n{}\n{}\n{}",
-        crate::UNCOUNTED_LOOPS_WGSL,
-        crate::ESTIMATE_WGSL,
-        crate::splat::FOOTPRINT_WGSL,
-        crate::media::MEDIA_WGSL,
-        crate::media::VIEW_DEPTH_WGSL,
-        include_str!("volume.wgsl")
-    )
+    use crate::wgsl::{ESTIMATE, Module, UNCOUNTED_LOOPS, compose};
+    static VOLUME: Module = Module { name: "volume.wgsl", source: include_str!("volume.wgsl"), requires: &[] };
+    compose(&[
+        &UNCOUNTED_LOOPS,
+        &ESTIMATE,
+        &crate::splat::FOOTPRINT,
+        &crate::media::MEDIA,
+        &crate::media::VIEW_DEPTH,
+        &VOLUME,
+    ])
 }
 
 pub struct VolumePass {

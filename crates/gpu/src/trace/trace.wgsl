@@ -1,0 +1,361 @@
+// Photon tracing on the GPU (METHOD.md §2): one invocation per photon path,
+// step for step hikari_core::photon::trace's `trace_one`, drawing from the
+// same per-path random stream (random.wgsl), so a path takes the CPU's
+// decisions wherever float rounding does not tip one.
+//
+// A stored photon goes to `records` at a slot taken by an atomic counter,
+// tagged with its path, map and sequence number within the path; the path
+// also writes how many photons it stored in each map. compact.wgsl then
+// puts every photon at its place in path order, so the maps do not depend
+// on the order in which invocations ran.
+
+struct TraceParams {
+    mixed_seed: vec2<u32>,
+    increment: vec2<u32>,
+    // Index of this dispatch's first path (a u64).
+    first_path: vec2<u32>,
+    paths: u32,
+    max_bounces: u32,
+    light_count: u32,
+    epsilon: f32,
+    record_capacity: u32,
+    iteration_budget: u32,
+    // The media filling the scene (0 media: none): Σ σ_t, and the albedo
+    // roulette's per-channel factor and scattering probability Λ.
+    sigma_t: vec3<f32>,
+    medium_count: u32,
+    albedo_factor: vec3<f32>,
+    lambda: f32,
+}
+
+// A light as the tracer emits from it (trace::TraceLight).
+struct TraceLight {
+    // Point or spot position, sphere centre, or quad corner.
+    origin: vec3<f32>,
+    // 0 point, 1 spot, 2 sphere, 3 quad.
+    kind: u32,
+    // Spot axis, or the quad's edge_u.
+    axis: vec3<f32>,
+    radius: f32,
+    edge_v: vec3<f32>,
+    cos_cutoff: f32,
+    // The quad's unit normal, normalised on the host as Light::emit does.
+    normal: vec3<f32>,
+    cutoff: f32,
+    // Each photon's starting power in power units: Φ_l / (p_l n) / unit.
+    power: vec3<f32>,
+    falloff_start: f32,
+    probability: f32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// A medium filling the scene, in the order of hikari_core's Media entries.
+struct TraceMedium {
+    // mean σ_s of this medium over mean σ_s of all (choose_scatterer).
+    share: f32,
+    phase_kind: f32,
+    phase_parameter: f32,
+    phase_slot: u32,
+}
+
+struct FlatShading {
+    geometric_normal: vec3<f32>,
+    has_vertex_normals: u32,
+    vertex_normals: array<vec4<f32>, 3>,
+}
+
+
+@group(0) @binding(0) var<uniform> params: TraceParams;
+@group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
+@group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;
+@group(0) @binding(3) var<storage, read> shading: array<FlatShading>;
+@group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(5) var<storage, read> lights: array<TraceLight>;
+@group(0) @binding(6) var<storage, read> media: array<TraceMedium>;
+@group(0) @binding(7) var<storage, read_write> records: array<PhotonRecord>;
+// Photons stored per path: global map, then caustic, then volume (each `paths` long).
+@group(0) @binding(8) var<storage, read_write> counts: array<u32>;
+// [records taken (may pass the capacity), paths truncated, paths over the
+// loop budget, most loop iterations one path ran].
+@group(0) @binding(9) var<storage, read_write> status: array<atomic<u32>, 4>;
+
+const GLOBAL_MAP: u32 = 0u;
+const CAUSTIC_MAP: u32 = 1u;
+const VOLUME_MAP: u32 = 2u;
+
+override WORKGROUP_SIZE: u32 = 64u;
+
+var<private> iterations_spent: u32 = 0u;
+var<private> over_budget: bool = false;
+var<private> path_index: u32;
+var<private> stored: array<u32, 3>;
+
+// Loop accounting (capabilities::loop_budget): a path that would run past
+// the budget stops and is counted, and the host falls back to the CPU.
+fn loop_iteration() -> bool {
+    iterations_spent += 1u;
+    if (iterations_spent > params.iteration_budget) {
+        over_budget = true;
+    }
+    return !over_budget;
+}
+
+fn mean(c: vec3<f32>) -> f32 {
+    return (c.x + c.y + c.z) / 3.0;
+}
+
+// material::reflect, written out (WGSL's reflect may round differently).
+fn mirror(dir: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return dir - 2.0 * dot(dir, n) * n;
+}
+
+fn store(map: u32, bounces: u32, x: vec3<f32>, power: vec3<f32>, dir: vec3<f32>, top_bits: u32) {
+    let sequence = stored[map];
+    stored[map] = sequence + 1u;
+    let slot = atomicAdd(&status[0], 1u);
+    if (slot < params.record_capacity) {
+        records[slot] = PhotonRecord(
+            path_index,
+            map | (min(bounces, 255u) << 8u) | (sequence << 16u),
+            x.x,
+            x.y,
+            x.z,
+            encode_rgb9e5(power),
+            encode_octahedral_15(dir) | (top_bits << 30u),
+            0u,
+        );
+    }
+}
+
+// The surface-map store of trace.rs: class by the path so far.
+fn store_surface(x: vec3<f32>, power: vec3<f32>, dir: vec3<f32>, diffuse_bounces: u32, specular_bounces: u32) {
+    var path_class = 2u;
+    if (diffuse_bounces == 0u) {
+        path_class = select(1u, 0u, specular_bounces == 0u);
+    }
+    store(GLOBAL_MAP, diffuse_bounces, x, power, dir, path_class);
+    if (path_class == 1u) {
+        store(CAUSTIC_MAP, diffuse_bounces, x, power, dir, path_class);
+    }
+}
+
+fn choose_light(xi: f32) -> u32 {
+    var acc = 0.0;
+    var index = params.light_count - 1u;
+    for (var i = 0u; i < params.light_count; i++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        acc += lights[i].probability;
+        if (xi < acc) {
+            index = i;
+            break;
+        }
+    }
+    return index;
+}
+
+struct Ray {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+// Light::emit.
+fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
+    switch l.kind {
+        case 0u: {
+            return Ray(l.origin, uniform_sphere(rng_next_2d(rng)));
+        }
+        case 1u: {
+            // sample_spot_direction: uniform in the cutoff cone, accepted by falloff.
+            var w = vec3<f32>(0.0, 0.0, 1.0);
+            loop {
+                if (!loop_iteration()) {
+                    break;
+                }
+                w = uniform_cone(rng_next_2d(rng), l.cos_cutoff);
+                let f = spot_falloff(acos(clamp(w.z, -1.0, 1.0)), l.cutoff, l.falloff_start);
+                if (rng_next_f32(rng) < f) {
+                    break;
+                }
+            }
+            return Ray(l.origin, local_to_world(w, l.axis));
+        }
+        case 2u: {
+            let n = uniform_sphere(rng_next_2d(rng));
+            let dir = local_to_world(cosine_hemisphere(rng_next_2d(rng)), n);
+            return Ray(l.origin + n * l.radius, dir);
+        }
+        default: {
+            let u = rng_next_2d(rng);
+            let dir = local_to_world(cosine_hemisphere(rng_next_2d(rng)), l.normal);
+            return Ray(l.origin + l.axis * u.x + l.edge_v * u.y, dir);
+        }
+    }
+}
+
+// Accel::intersect's normals at a hit on primitive `index` at x: the
+// geometric one, and the shading one on its side.
+struct HitNormals {
+    geometric: vec3<f32>,
+    shading: vec3<f32>,
+}
+
+fn hit_normals(index: u32, o: vec3<f32>, d: vec3<f32>, x: vec3<f32>) -> HitNormals {
+    let p = prims[index];
+    if (p.is_sphere != 0u) {
+        let n = unit((x - p.a) / p.b.x);
+        return HitNormals(n, n);
+    }
+    let s = shading[index];
+    let ng = s.geometric_normal;
+    if (s.has_vertex_normals == 0u) {
+        return HitNormals(ng, ng);
+    }
+    // The barycentrics of the hit, as Triangle::intersect computes them.
+    let pv = cross(d, p.c);
+    let inv = 1.0 / dot(p.b, pv);
+    let sv = o - p.a;
+    let b1 = dot(sv, pv) * inv;
+    let b2 = dot(d, cross(sv, p.b)) * inv;
+    let blend = s.vertex_normals[0].xyz * (1.0 - b1 - b2) + s.vertex_normals[1].xyz * b1 + s.vertex_normals[2].xyz * b2;
+    let len = length(blend);
+    var ns = ng;
+    // Finite and non-zero (NaN fails both comparisons).
+    if (len > 0.0 && len < 3.0e38) {
+        ns = blend / len;
+    }
+    return HitNormals(ng, select(ns, -ns, dot(ns, ng) < 0.0));
+}
+
+@compute @workgroup_size(WORKGROUP_SIZE)
+fn trace_paths(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let path = gid.y * groups.x * WORKGROUP_SIZE + gid.x;
+    if (path >= params.paths) {
+        return;
+    }
+    path_index = path;
+    var rng = rng_for_item(params.mixed_seed, params.increment, add_u64(params.first_path, vec2<u32>(path, 0u)));
+    trace_one(&rng);
+    counts[path] = stored[GLOBAL_MAP];
+    counts[params.paths + path] = stored[CAUSTIC_MAP];
+    counts[2u * params.paths + path] = stored[VOLUME_MAP];
+    if (over_budget) {
+        atomicAdd(&status[2], 1u);
+    }
+    atomicMax(&status[3], iterations_spent);
+}
+
+fn trace_one(rng: ptr<function, Rng>) {
+    let light = lights[choose_light(rng_next_f32(rng))];
+    var ray = emit(light, rng);
+    var power = light.power;
+    var diffuse_bounces = 0u;
+    var specular_bounces = 0u;
+    for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
+        if (!loop_iteration()) {
+            return;
+        }
+        let hit = trace_bvh(ray.origin, ray.dir, params.epsilon);
+        // Free flight through the media filling the scene (eq. 5.10–5.12;
+        // Media::sample_flight with one piece).
+        if (params.medium_count > 0u) {
+            let xi = rng_next_f32(rng);
+            let sigma_bar = mean(params.sigma_t);
+            let target_depth = -log(1.0 - xi);
+            if (sigma_bar > 0.0 && sigma_bar * hit.t > target_depth) {
+                let distance = target_depth / sigma_bar;
+                let weight = exp(-(params.sigma_t * distance - vec3<f32>(target_depth))) * params.sigma_t / sigma_bar;
+                if (rng_next_f32(rng) >= params.lambda) {
+                    return;
+                }
+                power *= weight * params.albedo_factor;
+                let x = ray.origin + ray.dir * distance;
+                let m = media[choose_scatterer(rng_next_f32(rng))];
+                store(VOLUME_MAP, diffuse_bounces, x, power, ray.dir, m.phase_slot);
+                diffuse_bounces += 1u;
+                ray = Ray(x, phase_sample(m.phase_kind, m.phase_parameter, ray.dir, rng_next_2d(rng)));
+                continue;
+            }
+            if (sigma_bar > 0.0) {
+                power *= exp(-(params.sigma_t * hit.t - vec3<f32>(sigma_bar * hit.t)));
+            }
+        }
+        if (hit.t >= NO_HIT) {
+            return;
+        }
+        let x = ray.origin + ray.dir * hit.t;
+        let normals = hit_normals(hit.prim, ray.origin, ray.dir, x);
+        let s = surfaces[prims[hit.prim].surface];
+        // Normals on the side the photon arrives from.
+        let facing = select(-1.0, 1.0, dot(ray.dir, normals.geometric) < 0.0);
+        let ng = normals.geometric * facing;
+        let ns = normals.shading * facing;
+        var next_dir: vec3<f32>;
+        if (s.kind == 3u) {
+            return;
+        } else if (s.kind == 2u) {
+            // dielectric_split about the outward geometric normal.
+            let entering = dot(ray.dir, normals.geometric) < 0.0;
+            let n = select(-normals.geometric, normals.geometric, entering);
+            let eta = select(s.ior, 1.0 / s.ior, entering);
+            let cos_i = -dot(ray.dir, n);
+            let fresnel = fresnel_dielectric(cos_i, eta);
+            specular_bounces += 1u;
+            next_dir = mirror(ray.dir, n);
+            if (fresnel.x < 1.0) {
+                if (rng_next_f32(rng) >= fresnel.x) {
+                    next_dir = refract_direction(ray.dir, n, eta, cos_i, fresnel.y);
+                }
+            }
+        } else {
+            let rho_d = select(vec3<f32>(0.0), s.albedo, s.kind == 0u);
+            let rho_s = select(s.albedo, s.specular, s.kind == 0u);
+            if (max(max(rho_d.x, rho_d.y), rho_d.z) > 0.0) {
+                store_surface(x, power, ray.dir, diffuse_bounces, specular_bounces);
+            }
+            // Material::roulette.
+            let xi = rng_next_f32(rng);
+            let p_d = mean(rho_d);
+            let p_s = mean(rho_s);
+            if (xi < p_d) {
+                power *= rho_d / p_d;
+                diffuse_bounces += 1u;
+                next_dir = local_to_world(cosine_hemisphere(rng_next_2d(rng)), ns);
+            } else if (xi < p_d + p_s) {
+                power *= rho_s / p_s;
+                specular_bounces += 1u;
+                next_dir = mirror(ray.dir, ns);
+            } else {
+                return;
+            }
+        }
+        // A shading normal can send the path below the true surface: end it there.
+        let leaves_front = dot(next_dir, ng) > 0.0;
+        let is_transmission = s.kind == 2u && dot(next_dir, ng) < 0.0;
+        if (!leaves_front && !is_transmission) {
+            return;
+        }
+        ray = Ray(x, next_dir);
+    }
+    atomicAdd(&status[1], 1u);
+}
+
+// Media::choose_scatterer among the media filling the scene.
+fn choose_scatterer(xi: f32) -> u32 {
+    var acc = 0.0;
+    var last = 0u;
+    for (var i = 0u; i < params.medium_count; i++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        acc += media[i].share;
+        last = i;
+        if (xi < acc) {
+            break;
+        }
+    }
+    return last;
+}

@@ -1,0 +1,3 @@
+// Constants every shader shares.
+
+const PI: f32 = 3.14159265358979323846;

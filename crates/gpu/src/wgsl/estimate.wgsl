@@ -1,0 +1,12 @@
+// The radiance estimate, mirrored from hikari_core::estimate; `twin` tests
+// pin both sides together.
+
+// w(d_p) of eq. 4.1 with the optional normal test (estimate::photon_accepted).
+fn photon_accepted(d2: f32, photon_dir: vec3<f32>, normal: vec3<f32>, radius: f32, normal_test: bool) -> bool {
+    return d2 <= radius * radius && !(normal_test && dot(photon_dir, normal) >= 0.0);
+}
+
+// f_r / (π r²) for a Lambertian surface (estimate::radiance_per_power).
+fn radiance_per_power(albedo: vec3<f32>, radius: f32) -> vec3<f32> {
+    return albedo * (1.0 / (PI * PI * radius * radius));
+}
