@@ -15,6 +15,7 @@ use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::PhotonCpuSettings;
 use hikari_core::scene::Scene;
 use hikari_gpu::renderer::{SEED_CORNELL_LOD, Stage};
+use hikari_gpu::tiled::Estimator;
 use hikari_gpu::trace::GpuTracer;
 use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
 use std::time::Instant;
@@ -42,6 +43,7 @@ struct Row {
     volume: bool,
     lod: Option<LodSettings>,
     motion: Motion,
+    estimator: Estimator,
 }
 
 /// What changes between the timed frames.
@@ -72,7 +74,16 @@ fn orbiting_light(mut scene: Scene) -> Scene {
 
 /// A dynamic row: `scene` at `size` with `photons` re-traced every frame as its light moves.
 fn moving_light_row(label: &'static str, scene: &'static str, size: (u32, u32), photons: u64) -> Row {
-    Row { label, scene, size, photons, volume: false, lod: None, motion: Motion::MovingLight }
+    Row {
+        label,
+        scene,
+        size,
+        photons,
+        volume: false,
+        lod: None,
+        motion: Motion::MovingLight,
+        estimator: Estimator::Raster,
+    }
 }
 
 /// The seed's fog-scene LOD settings, in scene units as given (its scene's
@@ -95,6 +106,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: None,
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "cornell-box, 10,000 photons, LOD n=20 f=7 (scaled)",
@@ -104,6 +116,37 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: Some(SEED_CORNELL_LOD),
             motion: Motion::Still,
+            estimator: Estimator::Raster,
+        },
+        Row {
+            label: "cornell-box, 10,000 photons, LOD off, tiled estimator",
+            scene: "cornell-box",
+            size: (512, 512),
+            photons: 10_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Still,
+            estimator: Estimator::Tiled,
+        },
+        Row {
+            label: "cornell-caustic, 200,000 photons, LOD off",
+            scene: "cornell-caustic",
+            size: (512, 512),
+            photons: 200_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Still,
+            estimator: Estimator::Raster,
+        },
+        Row {
+            label: "cornell-caustic, 200,000 photons, LOD off, tiled estimator",
+            scene: "cornell-caustic",
+            size: (512, 512),
+            photons: 200_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Still,
+            estimator: Estimator::Tiled,
         },
         Row {
             label: "cornell-box, 2,000 photons, LOD off",
@@ -113,6 +156,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: None,
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "fog-stage, 50,000 volume photons, LOD off",
@@ -122,6 +166,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: true,
             lod: None,
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "fog-stage, 50,000 volume photons, LOD n=25 f=3",
@@ -131,6 +176,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: true,
             lod: Some(SEED_FOG_LOD),
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "fog-stage, 25,000 volume photons, LOD n=0 f=20",
@@ -140,6 +186,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: true,
             lod: Some(SEED_FOG_LOD_FAR),
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "cornell-box, 10,000 photons, camera moving every frame",
@@ -149,6 +196,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: None,
             motion: Motion::Orbit,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "cornell-box, 10,000 photons re-traced every frame",
@@ -158,6 +206,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: None,
             motion: Motion::Retrace,
+            estimator: Estimator::Raster,
         },
         Row {
             label: "cornell-box, 100,000 photons re-traced on the GPU every frame",
@@ -167,6 +216,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: None,
             motion: Motion::RetraceOnGpu,
+            estimator: Estimator::Raster,
         },
         moving_light_row(
             "cornell-box, moving light, 20,000 photons re-traced every frame",
@@ -189,14 +239,31 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     ];
     if args.large {
         rows.push(Row {
-            label: "cornell-box 1920x1080, 1,000,000 photons re-traced on the GPU every frame",
+            label: "cornell-box 1920x1080, 1,000,000 photons, LOD off, tiled estimator",
             scene: "cornell-box",
             size: (1920, 1080),
             photons: 1_000_000,
             volume: false,
             lod: None,
-            motion: Motion::RetraceOnGpu,
+            motion: Motion::Still,
+            estimator: Estimator::Tiled,
         });
+        for estimator in [Estimator::Raster, Estimator::Tiled] {
+            rows.push(Row {
+                label: if estimator == Estimator::Tiled {
+                    "cornell-box 1920x1080, 1,000,000 photons re-traced on the GPU every frame, tiled estimator"
+                } else {
+                    "cornell-box 1920x1080, 1,000,000 photons re-traced on the GPU every frame (raster)"
+                },
+                scene: "cornell-box",
+                size: (1920, 1080),
+                photons: 1_000_000,
+                volume: false,
+                lod: None,
+                motion: Motion::RetraceOnGpu,
+                estimator,
+            });
+        }
         rows.push(Row {
             label: "cornell-box 1920x1080, 1,000,000 photons, LOD off",
             scene: "cornell-box",
@@ -205,6 +272,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: false,
             lod: None,
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         });
         rows.push(Row {
             label: "fog-stage 1920x1080, 1,000,000 volume photons, LOD off",
@@ -214,6 +282,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             volume: true,
             lod: None,
             motion: Motion::Still,
+            estimator: Estimator::Raster,
         });
         for scene in ["cornell-box", "cornell-caustic"] {
             rows.push(moving_light_row(
@@ -297,6 +366,7 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
     };
     let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
     let settings = GpuSettings {
+        estimator: row.estimator,
         lod: row.lod,
         volume_radius: hikari_core::render::photon_cpu::default_radius(&scene),
         ..GpuSettings::new(global, caustic)

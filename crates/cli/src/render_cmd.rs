@@ -14,6 +14,7 @@ use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_trace_settings};
 use hikari_core::render::{Image, path, photon_cpu};
 use hikari_core::scene::{Scene, builtin};
+use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -37,6 +38,24 @@ pub enum RendererKind {
     Path,
 }
 
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum EstimatorChoice {
+    /// `Estimator::for_adapter`: tiled on hardware GPUs, raster on software adapters.
+    Auto,
+    Raster,
+    Tiled,
+}
+
+impl EstimatorChoice {
+    pub fn on(self, ctx: &GpuContext) -> Estimator {
+        match self {
+            EstimatorChoice::Auto => Estimator::for_adapter(ctx),
+            EstimatorChoice::Raster => Estimator::Raster,
+            EstimatorChoice::Tiled => Estimator::Tiled,
+        }
+    }
+}
+
 #[derive(Args, Debug)]
 pub struct RenderArgs {
     /// A built-in scene name (see `hikari scenes`) or a path to a .toml scene file.
@@ -51,6 +70,12 @@ pub struct RenderArgs {
     /// the CPU on a software one (lavapipe, llvmpipe) or without an adapter.
     #[arg(long, value_enum, default_value_t = TraceDevice::Auto)]
     pub trace: TraceDevice,
+    /// How the GPU renderer estimates the global and caustic maps: raster
+    /// (the seed's photon splat), tiled (a compute-shader gather over
+    /// screen tiles), or auto: tiled on hardware GPUs, raster on software
+    /// adapters.
+    #[arg(long, value_enum, default_value_t = EstimatorChoice::Auto)]
+    pub estimator: EstimatorChoice,
     /// Photon paths emitted from the lights (1 to 100,000,000; the memory
     /// the maps will take is printed above 2,000,000).
     #[arg(long, default_value_t = 200_000, value_parser = clap::value_parser!(u64).range(1..=MAX_PHOTONS))]
@@ -244,7 +269,7 @@ fn render_on_gpu(
     traced: &TracedPhotons,
     settings: GpuSettings,
 ) -> Result<(Image, u64), GpuError> {
-    let adapter = ctx.describe();
+    let adapter = format!("{}, {:?} estimator", ctx.describe(), settings.estimator);
     if !ctx.float32_blend {
         eprintln!(
             "note: {adapter} cannot blend 32-bit float targets; photon splats accumulate in 16-bit floats (about 3 significant digits)"
@@ -307,6 +332,7 @@ fn render_photons(
     let (global, caustic) = settings.estimate_params(scene);
     eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
     if let Some(ctx) = gpu {
+        let gpu_settings = GpuSettings { estimator: args.estimator.on(&ctx), ..gpu_settings };
         match render_on_gpu(ctx, scene, &traced, gpu_settings) {
             Ok(result) => return Ok(result),
             Err(e) => eprintln!("gpu: {e}: rendering with photon-cpu instead"),
@@ -385,12 +411,14 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             let mut tracer = PhotonTracer::choose(args.trace, Some(&ctx), scene);
             let device = tracer.device();
             let first = tracer.trace(scene, &pass_trace_settings(args.photons, args.seed, 1), &Silent);
+            let gpu_settings = GpuSettings { estimator: args.estimator.on(&ctx), ..gpu_settings };
+            let estimator = gpu_settings.estimator;
             let run = GpuPasses::new(ctx, scene, &first, gpu_settings, args.photons, args.seed, schedules, tracer)
                 .and_then(|mut passes| passes::run(&mut passes, &plan).map(|(image, _)| (image, passes.nonfinite)));
             match run {
                 Ok(result) => {
                     eprintln!(
-                        "gpu: {adapter}, photons traced on the {device}, passes splatted and averaged on the GPU"
+                        "gpu: {adapter}, photons traced on the {device}, passes estimated ({estimator:?}) and averaged on the GPU"
                     );
                     return Ok(result);
                 }

@@ -38,3 +38,4 @@ pub mod photon_grid;
 pub mod present;
 #[doc(hidden)]
 pub mod test_support;
+pub mod tiled;

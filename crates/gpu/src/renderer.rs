@@ -16,6 +16,7 @@ use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
 use crate::splat::{SplatBinding, SplatParams, SplatPass};
+use crate::tiled::{Estimator, TiledBinding, TiledPass};
 use crate::volume::{VolumeParams, VolumePass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
@@ -23,6 +24,7 @@ use hikari_core::lod::LodSettings;
 use hikari_core::photon::TracedPhotons;
 use hikari_core::render::Image;
 use hikari_core::scene::Scene;
+use std::cell::{OnceCell, RefCell};
 
 /// Settings shared with `photon-cpu`, so both estimate the same thing, plus
 /// the shadow-map settings of the direct-light pass.
@@ -46,6 +48,8 @@ pub struct GpuSettings {
     pub volume_slices: u32,
     /// The terms the frame holds (all by default; the viewer toggles them).
     pub terms: crate::resolve::Terms,
+    /// How the global and caustic maps are estimated (raster splat by default).
+    pub estimator: Estimator,
 }
 
 impl GpuSettings {
@@ -61,6 +65,7 @@ impl GpuSettings {
             volume_radius: global.radius,
             volume_slices: 8,
             terms: crate::resolve::Terms::ALL,
+            estimator: Estimator::Raster,
         }
     }
 }
@@ -160,6 +165,11 @@ pub struct GpuRenderer {
     bounds: (Vec3, Vec3),
     /// The photons-as-points debug view, made when first drawn.
     points: std::cell::OnceCell<crate::points::PointsPass>,
+    /// The tiled estimator, made when first used, and its per-map state
+    /// (dropped with the photons it binds; sized to what frames needed).
+    tiled_pass: OnceCell<TiledPass>,
+    global_tiled: RefCell<Option<TiledBinding>>,
+    caustic_tiled: RefCell<Option<TiledBinding>>,
 }
 
 /// What the specular pass gathers from.
@@ -280,6 +290,7 @@ impl GpuRenderer {
                 format: ctx.radiance_format,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                     | wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::STORAGE_BINDING
                     | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             })
@@ -372,6 +383,9 @@ impl GpuRenderer {
             camera: scene.camera.clone(),
             bounds,
             points: std::cell::OnceCell::new(),
+            tiled_pass: OnceCell::new(),
+            global_tiled: RefCell::new(None),
+            caustic_tiled: RefCell::new(None),
             ctx,
         }
     }
@@ -421,6 +435,9 @@ impl GpuRenderer {
         };
         self.global_lod = upload(&global_photons, "global photons");
         self.caustic_lod = upload(&traced.caustic, "caustic photons");
+        // The tiled state binds the old photon buffers.
+        self.global_tiled.replace(None);
+        self.caustic_tiled.replace(None);
         self.volume_lod = upload(&traced.volume, "volume photons");
         self.power_unit = traced.power_unit;
         let inputs = specular_inputs(&self.settings, traced, &global_photons, self.ctx.loop_budget);
@@ -497,7 +514,71 @@ impl GpuRenderer {
         self.ctx.queue.submit([encoder.finish()]);
         scopes.finish()?;
         self.ctx.wait()?;
-        self.settle_specular()
+        self.settle_specular()?;
+        self.settle_tiled()
+    }
+
+    /// The tiled estimator's pass, made on first use.
+    fn tiled_pass(&self) -> &TiledPass {
+        self.tiled_pass.get_or_init(|| TiledPass::new(&self.ctx.device, self.ctx.radiance_format))
+    }
+
+    /// The tiled estimator's state for one map and what it estimates into.
+    fn tiled_maps(&self) -> [(&RefCell<Option<TiledBinding>>, &LodOutput, &wgpu::Texture); 2] {
+        [
+            (&self.global_tiled, &self.global_lod, &self.targets.indirect),
+            (&self.caustic_tiled, &self.caustic_lod, &self.targets.caustic),
+        ]
+    }
+
+    /// List entries the adapter's largest storage buffer holds.
+    fn max_tile_entries(&self) -> u32 {
+        (self.ctx.limits.max_storage_buffer_binding_size / 4).min(u32::MAX as u64) as u32
+    }
+
+    /// After a tiled frame: when a map's tile lists overflowed their buffer or
+    /// a list was longer than its gather slices read, the map's buffers are
+    /// sized to what the frame needed and the estimate and resolve run
+    /// again; a photon covering more tiles than the loop budget allows is an
+    /// error. Never an image with photons silently left out.
+    fn settle_tiled(&self) -> Result<(), GpuError> {
+        if self.settings.estimator != Estimator::Tiled {
+            return Ok(());
+        }
+        for _ in 0..4 {
+            let mut rerun = false;
+            for (cell, output, target) in self.tiled_maps() {
+                let mut binding = cell.borrow_mut();
+                let Some(current) = binding.as_ref() else { continue };
+                let status = current.check(&self.ctx)?;
+                if current.fits(&status) {
+                    continue;
+                }
+                let budget = self.ctx.loop_budget;
+                let (entries, slices) = crate::tiled::fitted_sizes(&status, budget, self.max_tile_entries())?;
+                let device = &self.ctx.device;
+                let gbuffer = &self.targets.gbuffer;
+                *binding = Some(self.tiled_pass().bind(device, gbuffer, output, target, entries, slices, budget));
+                rerun = true;
+            }
+            if !rerun {
+                return Ok(());
+            }
+            let scopes = self.ctx.error_scopes();
+            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+            for stage in [Stage::GlobalSplat, Stage::CausticSplat, Stage::Resolve] {
+                self.record_stage(stage, &mut encoder);
+            }
+            self.ctx.queue.submit([encoder.finish()]);
+            scopes.finish()?;
+            self.ctx.wait()?;
+        }
+        Err(GpuError::Failed("the tiled estimator's buffers did not settle after 4 resizes".into()))
+    }
+
+    /// Dispatches and list entries of the tiled estimator's global map (tests).
+    pub fn tiled_sizes(&self) -> Option<(u32, u32)> {
+        self.global_tiled.borrow().as_ref().map(|b| (b.slices(), b.list_capacity()))
     }
 
     /// Re-runs the specular pass with more slices until no pixel runs over
@@ -618,9 +699,29 @@ impl GpuRenderer {
                      estimate: &FixedRadius,
                      target: &wgpu::Texture| {
             self.lod_pass.record(queue, encoder, output, self.camera_position, lod);
-            let view = target.create_view(&Default::default());
             let params = self.splat_params(estimate);
-            self.splat_pass.record(queue, encoder, binding, output, &params, &view, true);
+            match self.settings.estimator {
+                Estimator::Raster => {
+                    let view = target.create_view(&Default::default());
+                    self.splat_pass.record(queue, encoder, binding, output, &params, &view, true);
+                }
+                Estimator::Tiled => {
+                    let cell = if std::ptr::eq(target, &self.targets.indirect) {
+                        &self.global_tiled
+                    } else {
+                        &self.caustic_tiled
+                    };
+                    let pass = self.tiled_pass();
+                    let budget = self.ctx.loop_budget;
+                    let mut state = cell.borrow_mut();
+                    let tiled = state.get_or_insert_with(|| {
+                        // A first guess: four tiles a photon, settled by `render`.
+                        let entries = output.capacity().saturating_mul(4).clamp(1024, self.max_tile_entries());
+                        pass.bind(&self.ctx.device, &self.targets.gbuffer, output, target, entries, 1, budget)
+                    });
+                    pass.record(queue, encoder, tiled, &params, output, budget);
+                }
+            }
         };
         match stage {
             Stage::GBuffer => {

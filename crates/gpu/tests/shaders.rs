@@ -28,6 +28,8 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("volume.wgsl", hikari_gpu::volume::shader_source()),
         ("trace.wgsl", hikari_gpu::trace::trace_shader_source()),
         ("compact.wgsl", hikari_gpu::trace::compact_shader_source()),
+        ("tiled.wgsl (f32)", hikari_gpu::tiled::shader_source(wgpu::TextureFormat::Rgba32Float)),
+        ("tiled.wgsl (f16)", hikari_gpu::tiled::shader_source(wgpu::TextureFormat::Rgba16Float)),
     ]
 }
 
@@ -240,6 +242,37 @@ fn shared_structs_match_wgsl_layouts() {
         "FlatShading",
         hikari_core::geometry::FlatShading,
         [geometric_normal, has_vertex_normals, vertex_normals]
+    );
+    let tiled = hikari_gpu::tiled::shader_source(wgpu::TextureFormat::Rgba32Float);
+    assert_layout!(
+        tiled,
+        "TiledParams",
+        hikari_gpu::tiled::TiledParams,
+        [
+            clip_from_world,
+            radius,
+            power_unit,
+            normal_test,
+            width,
+            height,
+            tiles_x,
+            tiles_y,
+            list_capacity,
+            scan_workgroups,
+            slice_start,
+            slice_length,
+            last_slice,
+            loop_budget,
+            _pad0,
+            _pad1,
+            _pad2
+        ]
+    );
+    assert_layout!(
+        tiled,
+        "LodPhoton",
+        LodPhoton,
+        [position_x, position_y, position_z, power_rgb9e5, direction_and_class, scale]
     );
     let lod = hikari_gpu::lod::shader_source();
     assert_layout!(

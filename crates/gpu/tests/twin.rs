@@ -1,6 +1,7 @@
-//! Twin tests: the GPU splat against the CPU fixed-radius estimate, on the
-//! same photons, the same radius and the G-buffer pixels read back from the
-//! GPU (METHOD.md §3: the same sum in a different order).
+//! Twin tests: the GPU splat and the tiled estimator against the CPU
+//! fixed-radius estimate, on the same photons, the same radius and the
+//! G-buffer pixels read back from the GPU (METHOD.md §3: the same sum in a
+//! different order).
 
 use glam::Vec3;
 use hikari_core::estimate::{FixedRadius, fixed_radius_radiance};
@@ -10,7 +11,10 @@ use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_seed};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
 use hikari_gpu::test_support::test_context;
+use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuRenderer, GpuSettings};
+
+const ESTIMATORS: [Estimator; 2] = [Estimator::Raster, Estimator::Tiled];
 
 struct TwinStats {
     lit: usize,
@@ -20,21 +24,27 @@ struct TwinStats {
     tolerance: f32,
 }
 
-fn twin(scene_name: &str, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
+fn twin(scene_name: &str, photons: u64, normal_test: bool, estimator: Estimator) -> Option<(TwinStats, TwinStats)> {
     let mut scene = Scene::load(scene_name).unwrap();
     scene.camera = scene.camera.with_resolution(64, 64).unwrap();
-    twin_scene(scene, photons, normal_test)
+    twin_scene(scene, photons, normal_test, estimator)
 }
 
-fn twin_scene(scene: Scene, photons: u64, normal_test: bool) -> Option<(TwinStats, TwinStats)> {
-    twin_pass(scene, photons, normal_test, 1)
+fn twin_scene(scene: Scene, photons: u64, normal_test: bool, estimator: Estimator) -> Option<(TwinStats, TwinStats)> {
+    twin_pass(scene, photons, normal_test, 1, estimator)
 }
 
 /// Pass `pass` of progressive photon mapping (docs/progressive.md): the
 /// renderer is built with pass 1's photons and radii, then given pass
 /// `pass`'s photons and radii (`set_photons`), as `render --passes` does;
 /// pass 1 is the seed's single pass.
-fn twin_pass(scene: Scene, photons: u64, normal_test: bool, pass: u32) -> Option<(TwinStats, TwinStats)> {
+fn twin_pass(
+    scene: Scene,
+    photons: u64,
+    normal_test: bool,
+    pass: u32,
+    estimator: Estimator,
+) -> Option<(TwinStats, TwinStats)> {
     let ctx = test_context("twin");
     // Splats add in the radiance format: f32, or f16 where the adapter
     // cannot blend f32 (Mesa's GL), whose running sums round to 2^-11 at
@@ -48,7 +58,8 @@ fn twin_pass(scene: Scene, photons: u64, normal_test: bool, pass: u32) -> Option
     let first_settings = PhotonCpuSettings { normal_test, ..Default::default() };
     let (global, caustic) = first_settings.estimate_params(&scene);
     let schedules = Schedules::new([global.radius, caustic.radius, global.radius], DEFAULT_ALPHA);
-    let mut gpu = GpuRenderer::new(ctx, &scene, &trace(1), GpuSettings::new(global, caustic)).expect("GPU renderer");
+    let settings = GpuSettings { estimator, ..GpuSettings::new(global, caustic) };
+    let mut gpu = GpuRenderer::new(ctx, &scene, &trace(1), settings).expect("GPU renderer");
     let traced = trace(pass);
     let [r_global, r_caustic, _] = schedules.radii(pass);
     if pass > 1 {
@@ -117,27 +128,27 @@ fn assert_twin(name: &str, stats: &TwinStats, min_lit: usize) {
 
 #[test]
 fn gpu_splat_equals_cpu_estimate_on_cornell_box() {
-    let Some((indirect, _)) = twin("cornell-box", 20_000, false) else {
-        return;
-    };
-    assert_twin("cornell-box indirect", &indirect, 2000);
+    for estimator in ESTIMATORS {
+        let (indirect, _) = twin("cornell-box", 20_000, false, estimator).expect("a twin");
+        assert_twin(&format!("cornell-box indirect ({estimator:?})"), &indirect, 2000);
+    }
 }
 
 #[test]
 fn gpu_splat_equals_cpu_estimate_on_cornell_caustic() {
-    let Some((indirect, caustic)) = twin("cornell-caustic", 20_000, false) else {
-        return;
-    };
-    assert_twin("cornell-caustic indirect", &indirect, 2000);
-    assert_twin("cornell-caustic caustic", &caustic, 20);
+    for estimator in ESTIMATORS {
+        let (indirect, caustic) = twin("cornell-caustic", 20_000, false, estimator).expect("a twin");
+        assert_twin(&format!("cornell-caustic indirect ({estimator:?})"), &indirect, 2000);
+        assert_twin(&format!("cornell-caustic caustic ({estimator:?})"), &caustic, 20);
+    }
 }
 
 #[test]
 fn gpu_splat_equals_cpu_estimate_with_normal_test() {
-    let Some((indirect, _)) = twin("cornell-box", 20_000, true) else {
-        return;
-    };
-    assert_twin("cornell-box indirect, normal test", &indirect, 2000);
+    for estimator in ESTIMATORS {
+        let (indirect, _) = twin("cornell-box", 20_000, true, estimator).expect("a twin");
+        assert_twin(&format!("cornell-box indirect, normal test ({estimator:?})"), &indirect, 2000);
+    }
 }
 
 /// The eye close to the floor inside the box: photon spheres cross the near
@@ -155,8 +166,10 @@ fn gpu_splat_equals_cpu_estimate_with_photons_around_the_eye() {
         64,
     )
     .unwrap();
-    let Some((indirect, _)) = twin_scene(scene, 20_000, false) else { return };
-    assert_twin("eye among photons", &indirect, 2000);
+    for estimator in ESTIMATORS {
+        let (indirect, _) = twin_scene(scene.clone(), 20_000, false, estimator).expect("a twin");
+        assert_twin(&format!("eye among photons ({estimator:?})"), &indirect, 2000);
+    }
 }
 
 /// Progressive passes: pass i of the GPU splat is photon-cpu's estimate at
@@ -169,8 +182,11 @@ fn gpu_passes_equal_cpu_estimates_at_their_radii() {
     for (pass, normal_test) in [(3, false), (10, false), (10, true)] {
         let mut scene = Scene::load("cornell-caustic").unwrap();
         scene.camera = scene.camera.with_resolution(64, 64).unwrap();
-        let (global, caustic) = twin_pass(scene, 20_000, normal_test, pass).expect("a twin");
-        let name = format!("cornell-caustic pass {pass}{}", if normal_test { " (normal test)" } else { "" });
+        // The tiled estimator on the last of them.
+        let estimator = if normal_test { Estimator::Tiled } else { Estimator::Raster };
+        let (global, caustic) = twin_pass(scene, 20_000, normal_test, pass, estimator).expect("a twin");
+        let name =
+            format!("cornell-caustic pass {pass}{} ({estimator:?})", if normal_test { " (normal test)" } else { "" });
         assert_twin(&format!("{name}, global map"), &global, 2000);
         assert_twin(&format!("{name}, caustic map"), &caustic, 20);
     }

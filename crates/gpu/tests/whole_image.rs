@@ -5,7 +5,7 @@ use glam::{Vec2, Vec3};
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_jitter, pass_seed, photon_cpu_pass};
-use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use hikari_core::render::photon_cpu::PhotonCpuSettings;
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
 use hikari_gpu::test_support::test_context;

@@ -385,6 +385,8 @@ impl Viewer {
             volume_slices: self.applied.volume_slices,
             terms: self.applied.terms,
             lod: self.applied.lod,
+            // The documented rule (`render --estimator auto`).
+            estimator: hikari_gpu::tiled::Estimator::for_adapter(&ctx),
             ..GpuSettings::new(global, caustic)
         };
         Ok(GpuRenderer::new(ctx, &scene, &shown.traced, settings)?)

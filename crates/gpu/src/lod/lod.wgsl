@@ -19,15 +19,6 @@ struct LodParams {
     _pad2: u32,
 }
 
-// The splat's instance: a stored photon and its LOD power scale.
-struct LodPhoton {
-    position_x: f32,
-    position_y: f32,
-    position_z: f32,
-    power_rgb9e5: u32,
-    direction_and_class: u32,
-    scale: f32,
-}
 
 struct DrawIndirect {
     vertex_count: u32,

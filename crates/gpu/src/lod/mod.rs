@@ -9,9 +9,14 @@ use bytemuck::{Pod, Zeroable};
 use hikari_core::lod::LodSettings;
 use wgpu::util::DeviceExt;
 
+/// The LOD pass's output record (`photons::LodPhoton`).
+pub static LOD_PHOTON: crate::wgsl::Module =
+    crate::wgsl::Module { name: "lod_photon.wgsl", source: include_str!("lod_photon.wgsl"), requires: &[] };
+
 pub fn shader_source() -> String {
     use crate::wgsl::{Module, PREFIX_SUM, compose};
-    static LOD: Module = Module { name: "lod.wgsl", source: include_str!("lod.wgsl"), requires: &[&PREFIX_SUM] };
+    static LOD: Module =
+        Module { name: "lod.wgsl", source: include_str!("lod.wgsl"), requires: &[&PREFIX_SUM, &LOD_PHOTON] };
     compose(&[&LOD])
 }
 
@@ -59,6 +64,13 @@ pub const MAX_WORKGROUPS_PER_DIMENSION: u32 = 65_535;
 pub fn dispatch_grid(workgroups: u32) -> (u32, u32) {
     let rows = workgroups.div_ceil(MAX_WORKGROUPS_PER_DIMENSION).max(1);
     (workgroups.div_ceil(rows), rows)
+}
+
+impl LodOutput {
+    /// Photons the map holds (survivors are at most this many).
+    pub fn capacity(&self) -> u32 {
+        self.count
+    }
 }
 
 impl LodPass {

@@ -19,8 +19,12 @@ pub struct SplatParams {
 pub static FOOTPRINT: crate::wgsl::Module = crate::wgsl::Module {
     name: "footprint.wgsl",
     source: include_str!("footprint.wgsl"),
-    requires: &[&crate::wgsl::PHOTON_ENCODING],
+    requires: &[&crate::wgsl::PHOTON_ENCODING, &FOOTPRINT_RECT],
 };
+
+/// The conservative screen rectangle of a photon's sphere (`photon_footprint`).
+pub static FOOTPRINT_RECT: crate::wgsl::Module =
+    crate::wgsl::Module { name: "footprint_rect.wgsl", source: include_str!("footprint_rect.wgsl"), requires: &[] };
 
 pub fn shader_source() -> String {
     use crate::wgsl::{ESTIMATE, Module, compose};
