@@ -16,7 +16,7 @@ use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
 use crate::splat::{SplatBinding, SplatParams, SplatPass};
-use crate::tiled::{Estimator, TiledBinding, TiledPass};
+use crate::tiled::{Estimator, TiledBinding, TiledMap, TiledPass};
 use crate::volume::{VolumeParams, VolumePass};
 use glam::{Vec3, Vec4};
 use hikari_core::estimate::FixedRadius;
@@ -170,6 +170,7 @@ pub struct GpuRenderer {
     tiled_pass: OnceCell<TiledPass>,
     global_tiled: RefCell<Option<TiledBinding>>,
     caustic_tiled: RefCell<Option<TiledBinding>>,
+    volume_tiled: RefCell<Option<TiledBinding>>,
 }
 
 /// What the specular pass gathers from.
@@ -386,6 +387,7 @@ impl GpuRenderer {
             tiled_pass: OnceCell::new(),
             global_tiled: RefCell::new(None),
             caustic_tiled: RefCell::new(None),
+            volume_tiled: RefCell::new(None),
             ctx,
         }
     }
@@ -438,6 +440,7 @@ impl GpuRenderer {
         // The tiled state binds the old photon buffers.
         self.global_tiled.replace(None);
         self.caustic_tiled.replace(None);
+        self.volume_tiled.replace(None);
         self.volume_lod = upload(&traced.volume, "volume photons");
         self.power_unit = traced.power_unit;
         let inputs = specular_inputs(&self.settings, traced, &global_photons, self.ctx.loop_budget);
@@ -524,11 +527,27 @@ impl GpuRenderer {
     }
 
     /// The tiled estimator's state for one map and what it estimates into.
-    fn tiled_maps(&self) -> [(&RefCell<Option<TiledBinding>>, &LodOutput, &wgpu::Texture); 2] {
+    fn tiled_maps(&self) -> [(&RefCell<Option<TiledBinding>>, TiledMap, &LodOutput, &wgpu::Texture); 3] {
         [
-            (&self.global_tiled, &self.global_lod, &self.targets.indirect),
-            (&self.caustic_tiled, &self.caustic_lod, &self.targets.caustic),
+            (&self.global_tiled, TiledMap::Surface, &self.global_lod, &self.targets.indirect),
+            (&self.caustic_tiled, TiledMap::Surface, &self.caustic_lod, &self.targets.caustic),
+            (&self.volume_tiled, TiledMap::Volume, &self.volume_lod, &self.targets.volume),
         ]
+    }
+
+    /// Records one map's tiled estimate, making its state on first use.
+    fn record_tiled(&self, encoder: &mut wgpu::CommandEncoder, map: usize, params: &SplatParams) {
+        let (cell, kind, output, target) = self.tiled_maps()[map];
+        let pass = self.tiled_pass();
+        let budget = self.ctx.loop_budget;
+        let mut state = cell.borrow_mut();
+        let tiled = state.get_or_insert_with(|| {
+            // A first guess: four tiles a photon, settled by `render`.
+            let entries = output.capacity().saturating_mul(4).clamp(1024, self.max_tile_entries());
+            let (device, gbuffer) = (&self.ctx.device, &self.targets.gbuffer);
+            pass.bind(device, gbuffer, &self.media, kind, output, target, entries, 1, budget)
+        });
+        pass.record(&self.ctx.queue, encoder, tiled, params, output, budget);
     }
 
     /// List entries the adapter's largest storage buffer holds.
@@ -547,7 +566,7 @@ impl GpuRenderer {
         }
         for _ in 0..4 {
             let mut rerun = false;
-            for (cell, output, target) in self.tiled_maps() {
+            for (cell, kind, output, target) in self.tiled_maps() {
                 let mut binding = cell.borrow_mut();
                 let Some(current) = binding.as_ref() else { continue };
                 let status = current.check(&self.ctx)?;
@@ -558,7 +577,9 @@ impl GpuRenderer {
                 let (entries, slices) = crate::tiled::fitted_sizes(&status, budget, self.max_tile_entries())?;
                 let device = &self.ctx.device;
                 let gbuffer = &self.targets.gbuffer;
-                *binding = Some(self.tiled_pass().bind(device, gbuffer, output, target, entries, slices, budget));
+                let media = &self.media;
+                *binding =
+                    Some(self.tiled_pass().bind(device, gbuffer, media, kind, output, target, entries, slices, budget));
                 rerun = true;
             }
             if !rerun {
@@ -566,7 +587,7 @@ impl GpuRenderer {
             }
             let scopes = self.ctx.error_scopes();
             let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-            for stage in [Stage::GlobalSplat, Stage::CausticSplat, Stage::Resolve] {
+            for stage in [Stage::GlobalSplat, Stage::CausticSplat, Stage::VolumeSplat, Stage::Resolve] {
                 self.record_stage(stage, &mut encoder);
             }
             self.ctx.queue.submit([encoder.finish()]);
@@ -706,20 +727,8 @@ impl GpuRenderer {
                     self.splat_pass.record(queue, encoder, binding, output, &params, &view, true);
                 }
                 Estimator::Tiled => {
-                    let cell = if std::ptr::eq(target, &self.targets.indirect) {
-                        &self.global_tiled
-                    } else {
-                        &self.caustic_tiled
-                    };
-                    let pass = self.tiled_pass();
-                    let budget = self.ctx.loop_budget;
-                    let mut state = cell.borrow_mut();
-                    let tiled = state.get_or_insert_with(|| {
-                        // A first guess: four tiles a photon, settled by `render`.
-                        let entries = output.capacity().saturating_mul(4).clamp(1024, self.max_tile_entries());
-                        pass.bind(&self.ctx.device, &self.targets.gbuffer, output, target, entries, 1, budget)
-                    });
-                    pass.record(queue, encoder, tiled, &params, output, budget);
+                    let map = if std::ptr::eq(target, &self.targets.indirect) { 0 } else { 1 };
+                    self.record_tiled(encoder, map, &params);
                 }
             }
         };
@@ -749,6 +758,15 @@ impl GpuRenderer {
                 // Without media the target is only cleared: the resolve reads it.
                 if self.has_media {
                     self.lod_pass.record(&self.ctx.queue, encoder, &self.volume_lod, self.camera_position, lod);
+                }
+                if self.has_media && self.settings.estimator == Estimator::Tiled {
+                    let params = SplatParams {
+                        radius: self.settings.volume_radius,
+                        normal_test: 0,
+                        ..self.splat_params(&self.settings.global)
+                    };
+                    self.record_tiled(encoder, 2, &params);
+                    return;
                 }
                 let view = self.targets.volume.create_view(&Default::default());
                 let photons = if self.has_media { &self.volume_lod } else { &self.caustic_lod };

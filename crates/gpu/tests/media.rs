@@ -8,6 +8,7 @@ use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
 use hikari_gpu::test_support::media_context;
+use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 use std::path::Path;
 
@@ -133,10 +134,11 @@ struct Twin {
 /// The volume splat against `volume_radiance_along` at the same pixels, with
 /// the same photons, radius and transmittance: exact for media filling the
 /// scene, the same slice interpolation for regions.
-fn volume_twin(scene: &Scene, traced: &TracedPhotons, slices: u32) -> Option<Twin> {
+fn volume_twin(scene: &Scene, traced: &TracedPhotons, slices: u32, estimator: Estimator) -> Option<Twin> {
     let ctx = media_context("volume twin", scene)?;
     let cpu = PhotonCpuRenderer::new(scene, traced, &PhotonCpuSettings::default());
     let settings = GpuSettings {
+        estimator,
         volume_radius: cpu.volume_radius,
         volume_slices: slices,
         ..GpuSettings::new(cpu.global_params, cpu.caustic_params)
@@ -189,16 +191,19 @@ fn assert_volume_twin(name: &str, slices: u32, photons: u64) {
     let mut scene = Scene::load(name).unwrap();
     scene.camera = scene.camera.with_resolution(64, 48).unwrap();
     let traced = trace_photons(&scene, &TraceSettings { photons, seed: 12, ..Default::default() }, &Silent);
-    let Some(t) = volume_twin(&scene, &traced, slices) else { return };
-    eprintln!(
-        "{name}: {} volume photons, {} pixels with in-scattering, {} within 1e-3, worst {:e}",
-        traced.volume.len(),
-        t.lit,
-        t.within,
-        t.worst
-    );
-    assert!(t.lit > 2000, "{name}: only {} pixels", t.lit);
-    assert!(t.within as f64 >= 0.999 * t.lit as f64, "{name}: {} of {} within 1e-3", t.within, t.lit);
+    // The volume splat, and the tiled estimator's volume gather.
+    for estimator in [Estimator::Raster, Estimator::Tiled] {
+        let Some(t) = volume_twin(&scene, &traced, slices, estimator) else { return };
+        eprintln!(
+            "{name} ({estimator:?}): {} volume photons, {} pixels with in-scattering, {} within 1e-3, worst {:e}",
+            traced.volume.len(),
+            t.lit,
+            t.within,
+            t.worst
+        );
+        assert!(t.lit > 2000, "{name}: only {} pixels", t.lit);
+        assert!(t.within as f64 >= 0.999 * t.lit as f64, "{name}: {} of {} within 1e-3", t.within, t.lit);
+    }
 }
 
 #[test]
@@ -221,19 +226,24 @@ fn whole_frame_matches_photon_cpu(name: &str) {
     let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, seed: 13, ..Default::default() }, &Silent);
     let cpu_settings = PhotonCpuSettings { spp: 4, ..Default::default() };
     let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings);
-    let settings =
-        GpuSettings { volume_radius: cpu.volume_radius, ..GpuSettings::new(cpu.global_params, cpu.caustic_params) };
-    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
-    gpu.render().expect("GPU frame");
-    let (image, nonfinite) = gpu.read_image().unwrap();
-    assert_eq!(nonfinite, 0);
     let (reference, _) = cpu.render(&Silent);
     let mean = |img: &hikari_core::render::Image| {
         img.pixels.iter().map(|p| (p.x + p.y + p.z) as f64 / 3.0).sum::<f64>() / img.pixels.len() as f64
     };
-    let (g, c) = (mean(&image), mean(&reference));
-    eprintln!("{name}: GPU mean {g:.5}, photon-cpu {c:.5} ({:+.2}%)", (g / c - 1.0) * 100.0);
-    assert!((g / c - 1.0).abs() < 0.02);
+    for estimator in [Estimator::Raster, Estimator::Tiled] {
+        let settings = GpuSettings {
+            estimator,
+            volume_radius: cpu.volume_radius,
+            ..GpuSettings::new(cpu.global_params, cpu.caustic_params)
+        };
+        let gpu = GpuRenderer::new(ctx.clone(), &scene, &traced, settings).expect("GPU renderer");
+        gpu.render().expect("GPU frame");
+        let (image, nonfinite) = gpu.read_image().unwrap();
+        assert_eq!(nonfinite, 0);
+        let (g, c) = (mean(&image), mean(&reference));
+        eprintln!("{name} ({estimator:?}): GPU mean {g:.5}, photon-cpu {c:.5} ({:+.2}%)", (g / c - 1.0) * 100.0);
+        assert!((g / c - 1.0).abs() < 0.02);
+    }
 }
 
 #[test]

@@ -42,6 +42,7 @@ pub fn shader_source() -> String {
         &BVH,
         &OPTICS,
         &crate::wgsl::SURFACE,
+        &crate::wgsl::VOLUME_CHORD,
         &SPECULAR,
     ])
 }

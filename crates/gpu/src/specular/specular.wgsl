@@ -161,26 +161,11 @@ fn volume_cell(o: vec3<f32>, d: vec3<f32>, len: f32, cell: vec3<i32>, t_enter: f
             if (any(vec3<i32>(floor(p / r)) != neighbour)) {
                 continue;
             }
-            let to_photon = p - o;
-            let t_closest = dot(to_photon, d);
-            let h2 = dot(to_photon, to_photon) - t_closest * t_closest;
-            if (h2 > r2) {
+            let chord = volume_chord(o, d, len, p, r2);
+            if (chord.y <= chord.x || chord.z < t_enter || chord.z >= t_exit) {
                 continue;
             }
-            let half = sqrt(max(r2 - h2, 0.0));
-            let t0 = max(t_closest - half, 0.0);
-            let t1 = min(t_closest + half, len);
-            if (t1 <= t0) {
-                continue;
-            }
-            let s_p = clamp(t_closest, t0, t1);
-            if (s_p < t_enter || s_p >= t_exit) {
-                continue;
-            }
-            let code = grid[base + 4u];
-            let mu = dot(decode_octahedral_15(code & 0x3fffffffu), -d);
-            let phase = phase_eval(code >> 30u, mu);
-            sum += transmittance_along(o, d, s_p) * decode_rgb9e5(grid[base + 3u]) * (phase * (t1 - t0));
+            sum += transmittance_along(o, d, chord.z) * chord_scattering(grid[base + 3u], grid[base + 4u], d, chord);
         }
     }
     return sum;
@@ -238,7 +223,7 @@ fn volume_along(o: vec3<f32>, d: vec3<f32>, len: f32) -> vec3<f32> {
             t_next.z += t_delta.z;
         }
     }
-    let norm = 1.0 / (4.0 / 3.0 * PI * r * r * r);
+    let norm = volume_kernel(r);
     return sum * norm * params.power_unit;
 }
 

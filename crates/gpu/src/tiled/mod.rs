@@ -13,6 +13,7 @@
 use crate::context::{GpuContext, GpuError};
 use crate::gbuffer::GBuffer;
 use crate::lod::{LodOutput, dispatch_grid};
+use crate::media::GpuMedia;
 use crate::wgsl::{ESTIMATE, Module, PREFIX_SUM, SCAN_WORKGROUP, compose};
 use bytemuck::{Pod, Zeroable};
 use std::cell::Cell;
@@ -43,7 +44,15 @@ pub fn shader_source(radiance_format: wgpu::TextureFormat) -> String {
     static TILED: Module = Module {
         name: "tiled.wgsl",
         source: include_str!("tiled.wgsl"),
-        requires: &[&ESTIMATE, &crate::splat::FOOTPRINT_RECT, &PREFIX_SUM, &crate::lod::LOD_PHOTON],
+        requires: &[
+            &crate::wgsl::UNCOUNTED_LOOPS,
+            &ESTIMATE,
+            &crate::splat::FOOTPRINT_RECT,
+            &PREFIX_SUM,
+            &crate::lod::LOD_PHOTON,
+            &crate::media::VIEW_DEPTH,
+            &crate::wgsl::VOLUME_CHORD,
+        ],
     };
     let format = if radiance_format == wgpu::TextureFormat::Rgba32Float { "rgba32float" } else { "rgba16float" };
     compose(&[&TILED]).replace("RADIANCE_FORMAT", format)
@@ -79,12 +88,14 @@ pub struct TiledPass {
     write_starts: wgpu::ComputePipeline,
     fill_tiles: wgpu::ComputePipeline,
     gather: wgpu::ComputePipeline,
+    gather_volume: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
 }
 
 /// One map's tiles, lists and sums, kept between frames; rebuilt when its
 /// photons (`LodOutput`) change or a frame needed more room.
 pub struct TiledBinding {
+    map: TiledMap,
     tiles: (u32, u32),
     size: (u32, u32),
     list_capacity: u32,
@@ -98,6 +109,15 @@ pub struct TiledBinding {
     bind_group: wgpu::BindGroup,
     /// The last frame's status was checked and fitted.
     checked: Cell<bool>,
+}
+
+/// Which estimate a binding gathers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TiledMap {
+    /// A surface map (global or caustic) at the G-buffer's points.
+    Surface,
+    /// The volume map along the view rays.
+    Volume,
 }
 
 /// What a frame of one map needed (`TiledBinding::check`).
@@ -141,6 +161,9 @@ impl TiledPass {
                         view_dimension: wgpu::TextureViewDimension::D2,
                     },
                 ),
+                compute(13, crate::binding::uniform()),
+                compute(14, storage(true)),
+                compute(15, texture(wgpu::TextureViewDimension::D2Array)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "tiled", &layout);
@@ -154,16 +177,21 @@ impl TiledPass {
             write_starts: pipeline("write_starts"),
             fill_tiles: pipeline("fill_tiles"),
             gather: pipeline("gather"),
+            gather_volume: pipeline("gather_volume"),
             layout,
         }
     }
 
     /// Buffers for estimating `photons` over `gbuffer` into `target`, with
-    /// room for `list_capacity` list entries and `slices` gather dispatches.
+    /// room for `list_capacity` list entries and `slices` gather dispatches;
+    /// `map` says which gather (the volume's sees `media`).
+    #[allow(clippy::too_many_arguments)]
     pub fn bind(
         &self,
         device: &wgpu::Device,
         gbuffer: &GBuffer,
+        media: &GpuMedia,
+        map: TiledMap,
         photons: &LodOutput,
         target: &wgpu::Texture,
         list_capacity: u32,
@@ -192,6 +220,10 @@ impl TiledPass {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo, output) =
             (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo), view(target));
+        let slices_view = media.slices.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
         fn whole(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
@@ -222,9 +254,13 @@ impl TiledPass {
                 texture(10, &normal),
                 texture(11, &albedo),
                 texture(12, &output),
+                whole(13, &media.params_buffer),
+                whole(14, &media.regions),
+                texture(15, &slices_view),
             ],
         });
         TiledBinding {
+            map,
             tiles,
             size,
             list_capacity,
@@ -291,7 +327,7 @@ impl TiledPass {
         pass.dispatch_workgroups(scan_workgroups, 1, 1);
         pass.set_pipeline(&self.fill_tiles);
         pass.dispatch_workgroups(x, y, 1);
-        pass.set_pipeline(&self.gather);
+        pass.set_pipeline(if binding.map == TiledMap::Volume { &self.gather_volume } else { &self.gather });
         for slice in 0..binding.slices {
             pass.set_bind_group(0, &binding.bind_group, &[slice * PARAMS_STRIDE as u32]);
             pass.dispatch_workgroups(binding.tiles.0, binding.tiles.1, 1);

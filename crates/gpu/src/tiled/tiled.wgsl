@@ -10,7 +10,8 @@
 // and the frame is the same on every run. A gather may be split into
 // slices of each tile's list (dispatches adding to `accum`), so no
 // invocation runs past the adapter's loop budget.
-// Composed with estimate.wgsl, footprint_rect.wgsl and prefix_sum.wgsl.
+// Composed with estimate.wgsl, footprint_rect.wgsl, prefix_sum.wgsl,
+// lod_photon.wgsl, view_depth.wgsl and volume_chord.wgsl.
 
 struct TiledParams {
     clip_from_world: mat4x4<f32>,
@@ -56,6 +57,10 @@ struct TiledParams {
 @group(0) @binding(10) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(11) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<RADIANCE_FORMAT, write>;
+// The media, for the volume map's gather (media.wgsl, view_depth.wgsl).
+@group(0) @binding(13) var<uniform> media: MediaParams;
+@group(0) @binding(14) var<storage, read> regions: array<RegionTriangle>;
+@group(0) @binding(15) var slices_tex: texture_2d_array<f32>;
 
 const TILE: u32 = 16u;
 
@@ -169,66 +174,105 @@ fn fixed_value(sum: vec2<u32>) -> f32 {
     return f32(sum.y) * 256.0 + f32(sum.x) * (1.0 / 16777216.0);
 }
 
+// A pixel's fixed-point sum across gather slices.
+struct FixedSum {
+    r: vec2<u32>,
+    g: vec2<u32>,
+    b: vec2<u32>,
+    count: u32,
+}
+
+fn load_sum(index: u32) -> FixedSum {
+    if (params.slice_start == 0u) {
+        return FixedSum(vec2<u32>(0u), vec2<u32>(0u), vec2<u32>(0u), 0u);
+    }
+    return FixedSum(
+        vec2<u32>(accum[index], accum[index + 1u]),
+        vec2<u32>(accum[index + 2u], accum[index + 3u]),
+        vec2<u32>(accum[index + 4u], accum[index + 5u]),
+        accum[index + 6u],
+    );
+}
+
+fn add_to_sum(sum: ptr<function, FixedSum>, v: vec3<f32>) {
+    (*sum).r = add_fixed((*sum).r, v.x);
+    (*sum).g = add_fixed((*sum).g, v.y);
+    (*sum).b = add_fixed((*sum).b, v.z);
+    (*sum).count += 1u;
+}
+
+// Keeps the sum for the next slice, or (last slice) stores factor × sum.
+fn finish_sum(pixel: vec2<i32>, index: u32, sum: FixedSum, factor: vec3<f32>) {
+    if (params.last_slice == 0u) {
+        accum[index] = sum.r.x;
+        accum[index + 1u] = sum.r.y;
+        accum[index + 2u] = sum.g.x;
+        accum[index + 3u] = sum.g.y;
+        accum[index + 4u] = sum.b.x;
+        accum[index + 5u] = sum.b.y;
+        accum[index + 6u] = sum.count;
+        return;
+    }
+    let value = vec3<f32>(fixed_value(sum.r), fixed_value(sum.g), fixed_value(sum.b));
+    // Alpha counts the photons that reached the pixel, as the splat's does.
+    textureStore(output, pixel, vec4<f32>(factor * value, f32(sum.count)));
+}
+
+// The list entries of tile t this slice reads: [first slot, end slot).
+fn slice_slots(t: u32) -> vec2<u32> {
+    let start = tile_starts[t];
+    let end = min(atomicLoad(&tile_counts[t]), params.slice_start + params.slice_length);
+    return vec2<u32>(start + params.slice_start, min(start + end, params.list_capacity));
+}
+
+// Surface maps: the splat's estimate (splat.wgsl) at the pixel's surface point.
 @compute @workgroup_size(16, 16)
 fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) gid: vec3<u32>) {
-    let t = wid.y * params.tiles_x + wid.x;
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
     let pixel = vec2<i32>(gid.xy);
-    let inside = gid.x < params.width && gid.y < params.height;
     let index = 8u * (gid.y * params.width + gid.x);
-    var r = vec2<u32>(0u);
-    var g = vec2<u32>(0u);
-    var b = vec2<u32>(0u);
-    var count = 0u;
-    if (inside && params.slice_start > 0u) {
-        r = vec2<u32>(accum[index], accum[index + 1u]);
-        g = vec2<u32>(accum[index + 2u], accum[index + 3u]);
-        b = vec2<u32>(accum[index + 4u], accum[index + 5u]);
-        count = accum[index + 6u];
-    }
-    var position = vec4<f32>(0.0);
-    var normal = vec3<f32>(0.0);
-    var albedo = vec4<f32>(0.0);
-    if (inside) {
-        position = textureLoad(gbuffer_position, pixel, 0);
-        normal = textureLoad(gbuffer_normal, pixel, 0).xyz;
-        albedo = textureLoad(gbuffer_albedo, pixel, 0);
-    }
+    var sum = load_sum(index);
+    let position = textureLoad(gbuffer_position, pixel, 0);
+    let normal = textureLoad(gbuffer_normal, pixel, 0).xyz;
+    let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     // Only visible diffuse surfaces (kind 0) take photon light.
-    if (inside && position.w != 0.0 && albedo.a == 0.0) {
-        let start = tile_starts[t];
-        let end = min(atomicLoad(&tile_counts[t]), params.slice_start + params.slice_length);
-        for (var k = params.slice_start; k < end; k++) {
-            let slot = start + k;
-            if (slot >= params.list_capacity) {
-                break;
-            }
+    if (position.w != 0.0 && albedo.a == 0.0) {
+        let slots = slice_slots(wid.y * params.tiles_x + wid.x);
+        for (var slot = slots.x; slot < slots.y; slot++) {
             let p = survivors[tile_lists[slot]];
             let d = position.xyz - vec3<f32>(p.position_x, p.position_y, p.position_z);
             let direction = decode_octahedral_15(p.direction_and_class & 0x3fffffffu);
             if (photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
-                let power = decode_rgb9e5(p.power_rgb9e5) * p.scale;
-                r = add_fixed(r, power.x);
-                g = add_fixed(g, power.y);
-                b = add_fixed(b, power.z);
-                count += 1u;
+                add_to_sum(&sum, decode_rgb9e5(p.power_rgb9e5) * p.scale);
             }
         }
     }
-    if (!inside) {
+    finish_sum(pixel, index, sum, radiance_per_power(albedo.rgb, params.radius) * params.power_unit);
+}
+
+// The volume map: the volume splat's chords (volume.wgsl) along the pixel's view ray.
+@compute @workgroup_size(16, 16)
+fn gather_volume(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
         return;
     }
-    if (params.last_slice == 0u) {
-        accum[index] = r.x;
-        accum[index + 1u] = r.y;
-        accum[index + 2u] = g.x;
-        accum[index + 3u] = g.y;
-        accum[index + 4u] = b.x;
-        accum[index + 5u] = b.y;
-        accum[index + 6u] = count;
-        return;
+    let pixel = vec2<i32>(gid.xy);
+    let index = 8u * (gid.y * params.width + gid.x);
+    var sum = load_sum(index);
+    // The fragment position the splat shades: the pixel centre.
+    let ray = view_ray(textureLoad(gbuffer_position, pixel, 0), vec2<f32>(gid.xy) + 0.5);
+    let r2 = params.radius * params.radius;
+    let slots = slice_slots(wid.y * params.tiles_x + wid.x);
+    for (var slot = slots.x; slot < slots.y; slot++) {
+        let p = survivors[tile_lists[slot]];
+        let chord = volume_chord(media.camera_position, ray.xyz, ray.w, vec3<f32>(p.position_x, p.position_y, p.position_z), r2);
+        if (chord.y <= chord.x) {
+            continue;
+        }
+        let transmittance = exp(-view_optical_depth(pixel, chord.z, ray.w));
+        add_to_sum(&sum, transmittance * chord_scattering(p.power_rgb9e5, p.direction_and_class, ray.xyz, chord) * p.scale);
     }
-    let power = vec3<f32>(fixed_value(r), fixed_value(g), fixed_value(b));
-    let radiance = radiance_per_power(albedo.rgb, params.radius) * power * params.power_unit;
-    // Alpha counts the photons that reached the pixel, as the splat's does.
-    textureStore(output, pixel, vec4<f32>(radiance, f32(count)));
+    finish_sum(pixel, index, sum, vec3<f32>(volume_kernel(params.radius) * params.power_unit));
 }

@@ -30,6 +30,7 @@ pub fn shader_source() -> String {
         &crate::splat::FOOTPRINT,
         &crate::media::MEDIA,
         &crate::media::VIEW_DEPTH,
+        &crate::wgsl::VOLUME_CHORD,
         &VOLUME,
     ])
 }

@@ -3,8 +3,8 @@
 // the light the photon scatters toward the eye along the pixel's view ray:
 // p(μ) · ΔΦ / ((4/3)π r³) · chord · T(eye → chord point nearest the photon),
 // the chord clipped to the visible surface's depth. The CPU twin is
-// hikari_core::estimate::volume_radiance_along. Prepended with
-// estimate.wgsl, footprint.wgsl, media.wgsl and view_depth.wgsl.
+// hikari_core::estimate::volume_radiance_along. Composed with
+// footprint.wgsl, view_depth.wgsl and volume_chord.wgsl.
 
 struct VolumeParams {
     clip_from_world: mat4x4<f32>,
@@ -26,25 +26,12 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(in.clip.xy);
     let ray = view_ray(textureLoad(gbuffer_position, pixel, 0), in.clip.xy);
     let dir = ray.xyz;
-    let to_photon = in.photon_position - media.camera_position;
-    let t_closest = dot(to_photon, dir);
-    let h2 = dot(to_photon, to_photon) - t_closest * t_closest;
-    let r2 = params.radius * params.radius;
-    if (h2 > r2) {
+    let chord = volume_chord(media.camera_position, dir, ray.w, in.photon_position, params.radius * params.radius);
+    if (chord.y <= chord.x) {
         discard;
     }
-    let half_chord = sqrt(max(r2 - h2, 0.0));
-    let t0 = max(t_closest - half_chord, 0.0);
-    let t1 = min(t_closest + half_chord, ray.w);
-    if (t1 <= t0) {
-        discard;
-    }
-    let s_p = clamp(t_closest, t0, t1);
-    let mu = dot(decode_octahedral_15(in.direction_and_class & 0x3fffffffu), -dir);
-    let phase = phase_eval(in.direction_and_class >> 30u, mu);
-    let transmittance = exp(-view_optical_depth(pixel, s_p, ray.w));
-    let norm = 1.0 / (4.0 / 3.0 * PI * r2 * params.radius);
-    let radiance = transmittance * decode_rgb9e5(in.power_rgb9e5) * (phase * (t1 - t0))
-        * (norm * params.power_unit * in.scale);
+    let transmittance = exp(-view_optical_depth(pixel, chord.z, ray.w));
+    let radiance = transmittance * chord_scattering(in.power_rgb9e5, in.direction_and_class, dir, chord)
+        * (volume_kernel(params.radius) * params.power_unit * in.scale);
     return vec4<f32>(radiance, 1.0);
 }

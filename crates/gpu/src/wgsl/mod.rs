@@ -69,6 +69,13 @@ pub static PREFIX_SUM: Module =
 /// `SCAN_WORKGROUP` in prefix_sum.wgsl (a test reads it back from the WGSL).
 pub const SCAN_WORKGROUP: u32 = 256;
 
+/// One volume photon's chord and in-scattering (hikari_core::estimate).
+pub static VOLUME_CHORD: Module = Module {
+    name: "volume_chord.wgsl",
+    source: include_str!("volume_chord.wgsl"),
+    requires: &[&CONSTANTS, &PHOTON_ENCODING, &crate::media::MEDIA],
+};
+
 /// The radiance estimate (hikari_core::estimate).
 pub static ESTIMATE: Module =
     Module { name: "estimate.wgsl", source: include_str!("estimate.wgsl"), requires: &[&CONSTANTS, &PHOTON_ENCODING] };
