@@ -197,10 +197,10 @@ fn shared_structs_match_wgsl_layouts() {
             epsilon,
             record_capacity,
             iteration_budget,
-            sigma_t,
             medium_count,
-            albedo_factor,
-            lambda
+            global_mask,
+            region_triangles,
+            _pad0
         ]
     );
     assert_layout!(
@@ -224,7 +224,18 @@ fn shared_structs_match_wgsl_layouts() {
             _pad2
         ]
     );
-    assert_layout!(trace, "TraceMedium", TraceMedium, [share, phase_kind, phase_parameter, phase_slot]);
+    assert_layout!(
+        trace,
+        "TraceMedium",
+        TraceMedium,
+        [sigma_t, phase_slot, sigma_s, phase_kind, phase_parameter, _pad0, _pad1, _pad2]
+    );
+    assert_layout!(
+        trace,
+        "TraceRegionTriangle",
+        hikari_gpu::trace::TraceRegionTriangle,
+        [a, medium, b, _pad0, c, _pad1]
+    );
     let record_fields = |source: &String| {
         assert_layout!(
             source,

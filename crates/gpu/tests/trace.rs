@@ -367,6 +367,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("cornell-box", Scene::load("cornell-box").unwrap()),
         ("cornell-caustic", Scene::load("cornell-caustic").unwrap()),
         ("fog-stage", Scene::load("fog-stage").unwrap()),
+        ("fog-stage-layered", Scene::load("fog-stage-layered").unwrap()),
         ("features", feature_scene(false)),
         ("features + media", feature_scene(true)),
     ]
@@ -520,13 +521,4 @@ fn images_from_gpu_traced_maps_match() {
         eprintln!("{name}: relative RMSE {:.2e}, mean ratio {:.6}", error.relative_rmse, error.mean_ratio);
         assert!(error.relative_rmse < 0.02 && (error.mean_ratio - 1.0).abs() < 0.005, "{name}: {error:?}");
     }
-}
-
-/// Scenes with region media are refused with a reason (the CLI then traces on the CPU).
-#[test]
-fn region_media_are_refused_with_a_reason() {
-    let scene = Scene::load("fog-stage-layered").unwrap();
-    let why = GpuTracer::unsupported(&scene).expect("region media refused");
-    assert!(why.contains("region"), "{why}");
-    assert!(GpuTracer::unsupported(&Scene::load("fog-stage").unwrap()).is_none());
 }

@@ -1,6 +1,7 @@
 //! Photon tracing in a compute shader (trace.wgsl), compacted into the
 //! global, caustic and volume maps in path order (compact.wgsl): the GPU
-//! twin of `hikari_core::photon::trace_photons`, with the same random
+//! twin of `hikari_core::photon::trace_photons` (every light, material and
+//! medium, region meshes included), with the same random
 //! streams and the same 20-byte photons.
 //!
 //! Paths run in batches of at most `MAX_BATCH_PATHS`; each batch's buffers
@@ -59,10 +60,10 @@ pub struct TraceParams {
     pub epsilon: f32,
     pub record_capacity: u32,
     pub iteration_budget: u32,
-    pub sigma_t: [f32; 3],
     pub medium_count: u32,
-    pub albedo_factor: [f32; 3],
-    pub lambda: f32,
+    pub global_mask: u32,
+    pub region_triangles: u32,
+    pub _pad0: u32,
 }
 
 /// Mirrors `TraceLight` in trace.wgsl.
@@ -89,10 +90,26 @@ pub struct TraceLight {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct TraceMedium {
-    pub share: f32,
+    pub sigma_t: [f32; 3],
+    pub phase_slot: u32,
+    pub sigma_s: [f32; 3],
     pub phase_kind: f32,
     pub phase_parameter: f32,
-    pub phase_slot: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+/// Mirrors `TraceRegionTriangle` in trace.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TraceRegionTriangle {
+    pub a: [f32; 3],
+    pub medium: u32,
+    pub b: [f32; 3],
+    pub _pad0: u32,
+    pub c: [f32; 3],
+    pub _pad1: u32,
 }
 
 /// Mirrors `PhotonRecord` in trace.wgsl and compact.wgsl.
@@ -159,14 +176,13 @@ struct TraceScene {
     shading: wgpu::Buffer,
     surfaces: wgpu::Buffer,
     media: wgpu::Buffer,
+    regions: wgpu::Buffer,
+    region_triangles: u32,
+    global_mask: u32,
     lights: Vec<Light>,
     probabilities: Vec<f32>,
     total_power: f32,
     epsilon: f32,
-    /// Σ σ_t, the roulette's factor and Λ of the media filling the scene.
-    sigma_t: Rgb,
-    albedo_factor: Rgb,
-    lambda: f32,
     medium_count: u32,
 }
 
@@ -187,9 +203,6 @@ impl TraceScene {
         let empty = [FlatNode { min: [1.0; 3], prim_count: 0, max: [-1.0; 3], first: 0 }];
         let nodes: &[FlatNode] = if bvh.nodes.is_empty() { &empty } else { &bvh.nodes };
         let media = &scene.media;
-        let global = media.global_mask();
-        let (lambda, albedo_factor) = media.scattering(global);
-        let total_scattering = mean(media.sigma_s(global));
         let entries: Vec<TraceMedium> = media
             .entries()
             .iter()
@@ -199,11 +212,28 @@ impl TraceScene {
                     hikari_core::medium::Phase::HenyeyGreenstein { g } => (1.0, g),
                 };
                 TraceMedium {
-                    share: mean(e.medium.sigma_s) / total_scattering,
+                    sigma_t: e.medium.sigma_t().to_array(),
+                    phase_slot: e.phase_slot as u32,
+                    sigma_s: e.medium.sigma_s.to_array(),
                     phase_kind: kind,
                     phase_parameter: parameter,
-                    phase_slot: e.phase_slot as u32,
+                    ..TraceMedium::zeroed()
                 }
+            })
+            .collect();
+        let regions: Vec<TraceRegionTriangle> = media
+            .entries()
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| e.region.as_ref().map(|r| (i, r)))
+            .flat_map(|(i, region)| {
+                region.triangles().iter().map(move |[a, b, c]| TraceRegionTriangle {
+                    a: a.to_array(),
+                    medium: i as u32,
+                    b: b.to_array(),
+                    c: c.to_array(),
+                    ..TraceRegionTriangle::zeroed()
+                })
             })
             .collect();
         TraceScene {
@@ -216,13 +246,13 @@ impl TraceScene {
                 bytemuck::cast_slice(&crate::scene_upload::scene_surfaces(scene)),
             ),
             media: storage_buffer(device, "trace media", bytemuck::cast_slice(&entries)),
+            regions: storage_buffer(device, "trace region triangles", bytemuck::cast_slice(&regions)),
+            region_triangles: regions.len() as u32,
+            global_mask: media.global_mask(),
             lights: scene.lights.clone(),
             probabilities: scene.light_selection_probabilities(),
             total_power: scene.lights.iter().map(|l| mean(l.power())).sum(),
             epsilon: bvh.epsilon,
-            sigma_t: media.global_sigma_t(),
-            albedo_factor,
-            lambda,
             medium_count: entries.len() as u32,
         }
     }
@@ -287,18 +317,7 @@ pub struct GpuTracer {
 }
 
 impl GpuTracer {
-    /// Why the GPU tracer cannot trace `scene`, if it cannot.
-    pub fn unsupported(scene: &Scene) -> Option<String> {
-        scene.media.has_regions().then(|| {
-            "media bounded by region meshes are traced on the CPU (the GPU tracer handles media filling the scene)"
-                .into()
-        })
-    }
-
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
-        if let Some(why) = Self::unsupported(scene) {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -316,6 +335,7 @@ impl GpuTracer {
                     compute(7, storage(false)),
                     compute(8, storage(false)),
                     compute(9, storage(false)),
+                    compute(10, storage(true)),
                 ],
             });
             let compact_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -381,9 +401,6 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
-        if let Some(why) = Self::unsupported(scene) {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let scene = ctx.scoped(|| TraceScene::upload(&ctx.device, scene))?;
         self.scene = scene;
         // The bind groups hold the old scene's buffers.
@@ -559,7 +576,19 @@ impl GpuTracer {
         let trace_bind_group = bind(
             &self.trace_layout,
             "trace",
-            &[&params, &s.nodes, &s.prims, &s.shading, &s.surfaces, &lights, &s.media, &records, &counts, &status],
+            &[
+                &params,
+                &s.nodes,
+                &s.prims,
+                &s.shading,
+                &s.surfaces,
+                &lights,
+                &s.media,
+                &records,
+                &counts,
+                &status,
+                &s.regions,
+            ],
         );
         let compact_bind_group = bind(
             &self.compact_layout,
@@ -612,10 +641,10 @@ impl GpuTracer {
             epsilon: s.epsilon,
             record_capacity: batch.record_capacity,
             iteration_budget: self.iteration_budget,
-            sigma_t: s.sigma_t.to_array(),
             medium_count: s.medium_count,
-            albedo_factor: s.albedo_factor.to_array(),
-            lambda: s.lambda,
+            global_mask: s.global_mask,
+            region_triangles: s.region_triangles,
+            _pad0: 0,
         };
         let elements = 3 * paths;
         let scan_workgroups = elements.div_ceil(crate::wgsl::SCAN_WORKGROUP);

@@ -20,12 +20,12 @@ struct TraceParams {
     epsilon: f32,
     record_capacity: u32,
     iteration_budget: u32,
-    // The media filling the scene (0 media: none): Σ σ_t, and the albedo
-    // roulette's per-channel factor and scattering probability Λ.
-    sigma_t: vec3<f32>,
+    // Media (0: none), the mask of those filling the scene, and the
+    // triangles of the region meshes bounding the others.
     medium_count: u32,
-    albedo_factor: vec3<f32>,
-    lambda: f32,
+    global_mask: u32,
+    region_triangles: u32,
+    _pad0: u32,
 }
 
 // A light as the tracer emits from it (trace::TraceLight).
@@ -51,13 +51,26 @@ struct TraceLight {
     _pad2: u32,
 }
 
-// A medium filling the scene, in the order of hikari_core's Media entries.
+// A medium, in the order of hikari_core's Media entries (its bit in a mask).
 struct TraceMedium {
-    // mean σ_s of this medium over mean σ_s of all (choose_scatterer).
-    share: f32,
+    sigma_t: vec3<f32>,
+    phase_slot: u32,
+    sigma_s: vec3<f32>,
     phase_kind: f32,
     phase_parameter: f32,
-    phase_slot: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// A triangle of a region mesh, wound with its normal out of the medium.
+struct TraceRegionTriangle {
+    a: vec3<f32>,
+    medium: u32,
+    b: vec3<f32>,
+    _pad0: u32,
+    c: vec3<f32>,
+    _pad1: u32,
 }
 
 struct FlatShading {
@@ -80,6 +93,7 @@ struct FlatShading {
 // [records taken (may pass the capacity), paths truncated, paths over the
 // loop budget, most loop iterations one path ran].
 @group(0) @binding(9) var<storage, read_write> status: array<atomic<u32>, 4>;
+@group(0) @binding(10) var<storage, read> regions: array<TraceRegionTriangle>;
 
 const GLOBAL_MAP: u32 = 0u;
 const CAUSTIC_MAP: u32 = 1u;
@@ -259,29 +273,23 @@ fn trace_one(rng: ptr<function, Rng>) {
             return;
         }
         let hit = trace_bvh(ray.origin, ray.dir, params.epsilon);
-        // Free flight through the media filling the scene (eq. 5.10–5.12;
-        // Media::sample_flight with one piece).
+        // Free flight through the media (eq. 5.10–5.12).
         if (params.medium_count > 0u) {
-            let xi = rng_next_f32(rng);
-            let sigma_bar = mean(params.sigma_t);
-            let target_depth = -log(1.0 - xi);
-            if (sigma_bar > 0.0 && sigma_bar * hit.t > target_depth) {
-                let distance = target_depth / sigma_bar;
-                let weight = exp(-(params.sigma_t * distance - vec3<f32>(target_depth))) * params.sigma_t / sigma_bar;
-                if (rng_next_f32(rng) >= params.lambda) {
+            let flight = sample_flight(ray.origin, ray.dir, hit.t, rng_next_f32(rng));
+            if (flight.interaction) {
+                let scattering = media_scattering(flight.mask);
+                if (rng_next_f32(rng) >= scattering.w) {
                     return;
                 }
-                power *= weight * params.albedo_factor;
-                let x = ray.origin + ray.dir * distance;
-                let m = media[choose_scatterer(rng_next_f32(rng))];
+                power *= flight.weight * scattering.xyz;
+                let x = ray.origin + ray.dir * flight.distance;
+                let m = media[choose_scatterer(flight.mask, rng_next_f32(rng))];
                 store(VOLUME_MAP, diffuse_bounces, x, power, ray.dir, m.phase_slot);
                 diffuse_bounces += 1u;
                 ray = Ray(x, phase_sample(m.phase_kind, m.phase_parameter, ray.dir, rng_next_2d(rng)));
                 continue;
             }
-            if (sigma_bar > 0.0) {
-                power *= exp(-(params.sigma_t * hit.t - vec3<f32>(sigma_bar * hit.t)));
-            }
+            power *= flight.weight;
         }
         if (hit.t >= NO_HIT) {
             return;
@@ -343,19 +351,207 @@ fn trace_one(rng: ptr<function, Rng>) {
     atomicAdd(&status[1], 1u);
 }
 
-// Media::choose_scatterer among the media filling the scene.
-fn choose_scatterer(xi: f32) -> u32 {
-    var acc = 0.0;
-    var last = 0u;
-    for (var i = 0u; i < params.medium_count; i++) {
+struct Coefficients {
+    sigma_t: vec3<f32>,
+    sigma_s: vec3<f32>,
+}
+
+// Media::sigma_t and sigma_s of the media in `mask`, each summed in bit order.
+fn mask_coefficients(mask: u32) -> Coefficients {
+    var total = Coefficients(vec3<f32>(0.0), vec3<f32>(0.0));
+    var bits = mask;
+    while (bits != 0u) {
         if (!loop_iteration()) {
             break;
         }
-        acc += media[i].share;
+        let m = media[firstTrailingBit(bits)];
+        total.sigma_t += m.sigma_t;
+        total.sigma_s += m.sigma_s;
+        bits &= bits - 1u;
+    }
+    return total;
+}
+
+// Media::scattering: the albedo roulette's per-channel factor (xyz) and Λ (w).
+fn media_scattering(mask: u32) -> vec4<f32> {
+    let coefficients = mask_coefficients(mask);
+    let sigma_t = coefficients.sigma_t;
+    let sigma_s = coefficients.sigma_s;
+    var lambda = 0.0;
+    if (mean(sigma_t) > 0.0) {
+        lambda = mean(sigma_s) / mean(sigma_t);
+    }
+    if (lambda <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let albedo = select(vec3<f32>(0.0), sigma_s / sigma_t, sigma_t > vec3<f32>(0.0));
+    return vec4<f32>(albedo / lambda, lambda);
+}
+
+// Media::choose_scatterer: a medium of `mask` with probability ∝ its mean σ_s.
+fn choose_scatterer(mask: u32, xi: f32) -> u32 {
+    let total = mean(mask_coefficients(mask).sigma_s);
+    var acc = 0.0;
+    var bits = mask;
+    var last = firstTrailingBit(mask);
+    while (bits != 0u) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let i = firstTrailingBit(bits);
+        bits &= bits - 1u;
+        acc += mean(media[i].sigma_s) / total;
         last = i;
         if (xi < acc) {
             break;
         }
     }
     return last;
+}
+
+struct Flight {
+    interaction: bool,
+    distance: f32,
+    weight: vec3<f32>,
+    mask: u32,
+}
+
+// region::intersect_triangle (Woop, Benthin and Wald's watertight test,
+// two-sided, t > 0): the distance, or 0 for no crossing. The CPU takes the
+// edge functions in f64; here they are f32, whose products round, so a
+// ray within rounding of an edge may count differently (photon paths are
+// compared within statistics there).
+fn region_crossing(o: vec3<f32>, d: vec3<f32>, tri: TraceRegionTriangle) -> f32 {
+    let ad = abs(d);
+    var kz = 0u;
+    if (ad.y > ad.x) {
+        kz = 1u;
+    }
+    if (ad.z > max(ad.x, ad.y)) {
+        kz = 2u;
+    }
+    var kx = (kz + 1u) % 3u;
+    var ky = (kz + 2u) % 3u;
+    if (d[kz] < 0.0) {
+        let swap = kx;
+        kx = ky;
+        ky = swap;
+    }
+    let sx = d[kx] / d[kz];
+    let sy = d[ky] / d[kz];
+    let sz = 1.0 / d[kz];
+    let qa = tri.a - o;
+    let qb = tri.b - o;
+    let qc = tri.c - o;
+    let pa = vec3<f32>(qa[kx] - sx * qa[kz], qa[ky] - sy * qa[kz], sz * qa[kz]);
+    let pb = vec3<f32>(qb[kx] - sx * qb[kz], qb[ky] - sy * qb[kz], sz * qb[kz]);
+    let pc = vec3<f32>(qc[kx] - sx * qc[kz], qc[ky] - sy * qc[kz], sz * qc[kz]);
+    let u = pc.x * pb.y - pc.y * pb.x;
+    let v = pa.x * pc.y - pa.y * pc.x;
+    let w = pb.x * pa.y - pb.y * pa.x;
+    let det = u + v + w;
+    if (det == 0.0) {
+        return 0.0;
+    }
+    if (!(edge_inside(u, det, pb, pc) && edge_inside(v, det, pc, pa) && edge_inside(w, det, pa, pb))) {
+        return 0.0;
+    }
+    let t = (u * pa.z + v * pb.z + w * pc.z) / det;
+    return max(t, 0.0);
+}
+
+fn edge_inside(e: f32, det: f32, p: vec3<f32>, q: vec3<f32>) -> bool {
+    let top_left = q.y > p.y || (q.y == p.y && q.x < p.x);
+    if (det > 0.0) {
+        return e > 0.0 || (e == 0.0 && top_left);
+    }
+    return e < 0.0 || (e == 0.0 && top_left);
+}
+
+// +1 where the ray leaves the medium through the triangle, −1 where it enters.
+fn crossing_sign(d: vec3<f32>, tri: TraceRegionTriangle) -> i32 {
+    return select(-1, 1, dot(cross(tri.b - tri.a, tri.c - tri.a), d) > 0.0);
+}
+
+var<private> winding: array<i32, 32>;
+
+fn winding_mask(count: u32) -> u32 {
+    var mask = params.global_mask;
+    for (var i = 0u; i < count; i++) {
+        if (winding[i] > 0) {
+            mask |= 1u << i;
+        }
+    }
+    return mask;
+}
+
+// Media::sample_flight along o + t·d up to t_max: the pieces of constant
+// media between region crossings (Media::segments), walked in order
+// without sorting (the next crossing found each time).
+fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
+    let target_depth = -log(1.0 - xi);
+    var tau_bar = 0.0;
+    var tau = vec3<f32>(0.0);
+    var t0 = 0.0;
+    var mask = params.global_mask;
+    if (params.region_triangles > 0u) {
+        for (var i = 0u; i < params.medium_count; i++) {
+            winding[i] = 0;
+        }
+        // The net number of exits ahead is the winding at the origin.
+        for (var i = 0u; i < params.region_triangles; i++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            if (region_crossing(o, d, regions[i]) > 0.0) {
+                winding[regions[i].medium] += crossing_sign(d, regions[i]);
+            }
+        }
+        mask = winding_mask(params.medium_count);
+    }
+    loop {
+        if (!loop_iteration()) {
+            break;
+        }
+        // The next crossing ahead of t0.
+        var t_next = NO_HIT;
+        for (var i = 0u; i < params.region_triangles; i++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            let t = region_crossing(o, d, regions[i]);
+            if (t > t0 && t < t_next) {
+                t_next = t;
+            }
+        }
+        let t1 = min(t_next, t_max);
+        let sigma_t = mask_coefficients(mask).sigma_t;
+        let sigma_bar = mean(sigma_t);
+        if (sigma_bar > 0.0) {
+            let length = t1 - t0;
+            if (tau_bar + sigma_bar * length > target_depth) {
+                let distance = (target_depth - tau_bar) / sigma_bar;
+                let tau_c = tau + sigma_t * distance;
+                let weight = exp(-(tau_c - vec3<f32>(target_depth))) * sigma_t / sigma_bar;
+                return Flight(true, t0 + distance, weight, mask);
+            }
+            tau_bar += sigma_bar * length;
+            tau += sigma_t * length;
+        }
+        if (t_next >= t_max) {
+            break;
+        }
+        // Every crossing at t_next (shared edges give one per mesh).
+        for (var i = 0u; i < params.region_triangles; i++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            if (region_crossing(o, d, regions[i]) == t_next) {
+                winding[regions[i].medium] -= crossing_sign(d, regions[i]);
+            }
+        }
+        t0 = t_next;
+        mask = winding_mask(params.medium_count);
+    }
+    return Flight(false, 0.0, exp(-(tau - vec3<f32>(tau_bar))), mask);
 }
