@@ -68,6 +68,17 @@ impl PhotonTracer {
         }
     }
 
+    /// Traces `scene` from now on: a moved or edited pose of the scene it
+    /// was chosen for (the viewer's). A GPU failure sends later sets to the CPU.
+    pub fn set_scene(&mut self, scene: &Scene) {
+        if let Some((ctx, tracer)) = &mut self.gpu {
+            if let Err(e) = tracer.set_scene(ctx, scene) {
+                eprintln!("trace: gpu: {e}: tracing photons on the CPU instead");
+                self.gpu = None;
+            }
+        }
+    }
+
     /// "gpu" or "cpu": where the next set will be traced.
     pub fn device(&self) -> &'static str {
         if self.gpu.is_some() { "gpu" } else { "cpu" }

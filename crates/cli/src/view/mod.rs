@@ -44,6 +44,7 @@ mod scene_watch;
 mod trace_budget;
 
 use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution, parse_time};
+use crate::tracing::{PhotonTracer, TraceDevice};
 use anyhow::{Result, anyhow};
 use clap::Args;
 use clock::AnimationClock;
@@ -106,6 +107,10 @@ pub struct ViewArgs {
     /// (--photons is the first set's count).
     #[arg(long)]
     pub trace_every_frame: bool,
+    /// Where photon sets are traced: auto is the GPU on a hardware adapter
+    /// and the CPU on a software one (as `hikari render --trace`).
+    #[arg(long, value_enum, default_value_t = TraceDevice::Auto)]
+    pub trace: TraceDevice,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
@@ -277,11 +282,18 @@ impl Viewer {
     /// Starts the tracing thread for the scene as loaded and waits for its
     /// first set (the scene at the clock's time), which it puts on screen.
     fn start_tracing(&mut self) -> Result<()> {
-        self.photon_sets = Some(PhotonSets::start(self.base.clone())?);
+        // The tracer opens its own device: tracing runs beside the frames.
+        let ctx = match self.args.trace {
+            TraceDevice::Cpu => None,
+            _ => GpuContext::new().ok(),
+        };
+        let tracer = PhotonTracer::choose(self.args.trace, ctx.as_ref(), &self.base);
+        let device = tracer.device();
+        self.photon_sets = Some(PhotonSets::start(self.base.clone(), tracer)?);
         self.requested = None;
         self.pending_poses.clear();
         if !self.args.quiet {
-            eprintln!("view: tracing {} photon paths", self.controls.photons);
+            eprintln!("view: tracing {} photon paths on the {device}", self.controls.photons);
         }
         self.request(self.pose())?;
         let first = self.photon_sets.as_mut().expect("started").next(true)?.expect("the first set");

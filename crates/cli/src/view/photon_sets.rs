@@ -6,8 +6,9 @@
 //! with the posed scene they were traced in, so the window always draws a
 //! scene and photons that belong together.
 
+use crate::tracing::PhotonTracer;
 use anyhow::{Result, anyhow};
-use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
+use hikari_core::photon::{TraceSettings, TracedPhotons};
 use hikari_core::scene::{Pose, Scene};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
@@ -42,9 +43,10 @@ pub struct PhotonSets {
 }
 
 impl PhotonSets {
-    /// A tracing thread for poses of `scene` (as loaded). It ends when this
-    /// is dropped (its channels close).
-    pub fn start(scene: Arc<Scene>) -> Result<Self> {
+    /// A tracing thread for poses of `scene` (as loaded), tracing with
+    /// `tracer` (chosen for `scene`). It ends when this is dropped (its
+    /// channels close).
+    pub fn start(scene: Arc<Scene>, mut tracer: PhotonTracer) -> Result<Self> {
         let (jobs, job_receiver) = channel::<(u64, Job)>();
         let (sender, results) = channel();
         std::thread::Builder::new()
@@ -63,11 +65,12 @@ impl PhotonSets {
                         _ => {
                             let s = Arc::new(scene.posed(&pose));
                             posed = Some((pose.clone(), s.clone()));
+                            tracer.set_scene(&s);
                             s
                         }
                     };
                     let settings = TraceSettings { photons, seed, ..Default::default() };
-                    let traced = trace_photons(&scene, &settings, &hikari_core::progress::Silent);
+                    let traced = tracer.trace(&scene, &settings, &hikari_core::progress::Silent);
                     let seconds = start.elapsed().as_secs_f64();
                     let set = PhotonSet { id, pose, scene, traced, seconds, photons };
                     if sender.send(set).is_err() {
@@ -122,6 +125,7 @@ impl PhotonSets {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hikari_core::photon::trace_photons;
 
     fn bits(t: &TracedPhotons) -> Vec<[u32; 3]> {
         t.global.iter().map(|p| p.position.map(f32::to_bits)).collect()
@@ -130,7 +134,7 @@ mod tests {
     #[test]
     fn a_set_is_the_trace_of_its_request() {
         let scene = Arc::new(Scene::load("cornell-orbit").unwrap());
-        let mut sets = PhotonSets::start(scene.clone()).unwrap();
+        let mut sets = PhotonSets::start(scene.clone(), PhotonTracer::cpu()).unwrap();
         for (k, time) in [(1u64, 0.0f32), (2, 1.7)] {
             let pose = Pose { time, ..scene.rest_pose() };
             let id = sets.request(Job { pose: pose.clone(), photons: 500, seed: 7 + k }).unwrap();
@@ -146,10 +150,34 @@ mod tests {
         }
     }
 
+    /// On the GPU tracer, each set is traced in its own pose: the thread
+    /// hands every newly posed scene to the tracer.
+    #[test]
+    fn gpu_sets_follow_the_pose() {
+        use crate::tracing::TraceDevice;
+        let scene = Arc::new(Scene::load("cornell-orbit").unwrap());
+        let ctx = hikari_gpu::GpuContext::new().expect("an adapter (scripts/test.sh installs lavapipe)");
+        let tracer = PhotonTracer::choose(TraceDevice::Gpu, Some(&ctx), &scene);
+        assert_eq!(tracer.device(), "gpu");
+        let mut sets = PhotonSets::start(scene.clone(), tracer).unwrap();
+        let mut previous = None;
+        for time in [0.0f32, 1.7] {
+            let pose = Pose { time, ..scene.rest_pose() };
+            sets.request(Job { pose: pose.clone(), photons: 500, seed: 3 }).unwrap();
+            let got = sets.next(true).unwrap().unwrap();
+            let settings = TraceSettings { photons: 500, seed: 3, ..Default::default() };
+            let mut fresh = hikari_gpu::trace::GpuTracer::new(&ctx, &scene.posed(&pose)).unwrap();
+            let want = fresh.trace(&ctx, &settings).unwrap().0;
+            assert_eq!(bits(&got.traced), bits(&want), "time {time}");
+            assert_ne!(previous, Some(bits(&got.traced)), "the light moved, the photons did not");
+            previous = Some(bits(&got.traced));
+        }
+    }
+
     #[test]
     fn waiting_skips_to_the_newest_request() {
         let scene = Arc::new(Scene::load("cornell-box").unwrap());
-        let mut sets = PhotonSets::start(scene.clone()).unwrap();
+        let mut sets = PhotonSets::start(scene.clone(), PhotonTracer::cpu()).unwrap();
         for seed in 0..5 {
             sets.request(Job { pose: scene.rest_pose(), photons: 2000, seed }).unwrap();
         }
