@@ -118,6 +118,31 @@ pub fn compute_pipeline(
     })
 }
 
+/// A compute pipeline running `entry_point` of `module` whose workgroups are
+/// `side × side` invocations: the WGSL declares `override WORKGROUP: u32`
+/// and `@workgroup_size(WORKGROUP, WORKGROUP)`, and the Rust side
+/// dispatches with the same `side`, so the size is written once.
+pub fn square_compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry_point: &str,
+    side: u32,
+) -> wgpu::ComputePipeline {
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        module,
+        entry_point: Some(entry_point),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants: &[("WORKGROUP", side as f64)],
+            ..Default::default()
+        },
+        cache: None,
+    })
+}
+
 /// An `Rgba32Float` image a compute pass writes and later passes read or copy.
 pub fn storage_output_texture(device: &wgpu::Device, label: &str, width: u32, height: u32) -> wgpu::Texture {
     device.create_texture(&wgpu::TextureDescriptor {

@@ -26,6 +26,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("resolve.wgsl", hikari_gpu::resolve::shader_source()),
         ("optical_depth.wgsl", hikari_gpu::media::optical_depth_shader_source()),
         ("volume.wgsl", hikari_gpu::volume::shader_source()),
+        ("accumulate.wgsl", hikari_gpu::accumulate::SHADER.to_string()),
         ("trace.wgsl", hikari_gpu::trace::trace_shader_source()),
         ("compact.wgsl", hikari_gpu::trace::compact_shader_source()),
         ("tiled.wgsl (f32)", hikari_gpu::tiled::shader_source(wgpu::TextureFormat::Rgba32Float)),

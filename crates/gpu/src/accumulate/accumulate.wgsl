@@ -15,7 +15,10 @@ struct AccumulateParams {
 @group(0) @binding(2) var<storage, read_write> sum: array<vec4<f32>>;
 @group(0) @binding(3) var mean: texture_storage_2d<rgba32float, write>;
 
-@compute @workgroup_size(8, 8)
+// Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
+override WORKGROUP: u32;
+
+@compute @workgroup_size(WORKGROUP, WORKGROUP)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= params.width || id.y >= params.height) {
         return;

@@ -4,6 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
+/// Workgroup side (the `WORKGROUP` override of the shader).
 const WORKGROUP: u32 = 8;
 pub const SHADER: &str = include_str!("accumulate.wgsl");
 
@@ -50,7 +51,8 @@ impl AccumulatePass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "accumulate", &layout);
-        let pipeline = crate::binding::compute_pipeline(device, "accumulate", &pipeline_layout, &module, "main");
+        let pipeline =
+            crate::binding::square_compute_pipeline(device, "accumulate", &pipeline_layout, &module, "main", WORKGROUP);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("accumulate params"),
             size: std::mem::size_of::<AccumulateParams>() as u64,

@@ -6,6 +6,7 @@ pub fn shader_source() -> String {
     static RESOLVE: Module = Module { name: "resolve.wgsl", source: include_str!("resolve.wgsl"), requires: &[] };
     compose(&[&UNCOUNTED_LOOPS, &crate::media::MEDIA, &crate::media::VIEW_DEPTH, &RESOLVE])
 }
+/// Workgroup side (the `WORKGROUP` override of the shader).
 const WORKGROUP: u32 = 8;
 
 /// Which radiance terms the frame holds. Mirrors `Terms` in resolve.wgsl.
@@ -68,7 +69,8 @@ impl ResolvePass {
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = crate::binding::pipeline_layout(device, "resolve", &layout);
-        let pipeline = crate::binding::compute_pipeline(device, "resolve", &pipeline_layout, &module, "main");
+        let pipeline =
+            crate::binding::square_compute_pipeline(device, "resolve", &pipeline_layout, &module, "main", WORKGROUP);
         let output = crate::binding::storage_output_texture(device, "resolved radiance", width, height);
         let mut views: Vec<wgpu::TextureView> = inputs.iter().map(|t| t.create_view(&Default::default())).collect();
         views.push(output.create_view(&Default::default()));

@@ -29,7 +29,10 @@ struct Terms {
 }
 @group(0) @binding(11) var<uniform> terms: Terms;
 
-@compute @workgroup_size(8, 8)
+// Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
+override WORKGROUP: u32;
+
+@compute @workgroup_size(WORKGROUP, WORKGROUP)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(output);
     if (id.x >= size.x || id.y >= size.y) {

@@ -18,6 +18,7 @@ use hikari_core::photon::Photon;
 use hikari_core::scene::Scene;
 use wgpu::util::DeviceExt;
 
+/// Workgroup side (the `WORKGROUP` override of the shader).
 const WORKGROUP: u32 = 8;
 
 /// Whether any surface is a mirror, glass or partly mirroring: the pass
@@ -342,7 +343,8 @@ impl SpecularPass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
-        let pipeline = crate::binding::compute_pipeline(device, "specular", &pipeline_layout, &module, "main");
+        let pipeline =
+            crate::binding::square_compute_pipeline(device, "specular", &pipeline_layout, &module, "main", WORKGROUP);
 
         let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();

@@ -236,7 +236,10 @@ struct Branch {
 
 const STACK: u32 = 16u;
 
-@compute @workgroup_size(8, 8)
+// Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
+override WORKGROUP: u32;
+
+@compute @workgroup_size(WORKGROUP, WORKGROUP)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= params.width || id.y >= params.height) {
         return;
