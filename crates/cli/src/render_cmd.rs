@@ -40,9 +40,13 @@ pub enum RendererKind {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum EstimatorChoice {
-    /// `Estimator::for_adapter`: tiled on hardware GPUs, raster on software adapters.
+    /// Tiled on hardware GPUs (their compute units far outnumber their
+    /// rasterizers), raster on software adapters (lavapipe, llvmpipe).
     Auto,
+    /// The seed's method: one instanced quad per photon, added by blending.
     Raster,
+    /// Photons binned into 16×16-pixel screen tiles, each pixel summing
+    /// its tile's photons in a compute shader (exact fixed-point sums).
     Tiled,
 }
 
@@ -70,10 +74,7 @@ pub struct RenderArgs {
     /// the CPU on a software one (lavapipe, llvmpipe) or without an adapter.
     #[arg(long, value_enum, default_value_t = TraceDevice::Auto)]
     pub trace: TraceDevice,
-    /// How the GPU renderer estimates the global and caustic maps: raster
-    /// (the seed's photon splat), tiled (a compute-shader gather over
-    /// screen tiles), or auto: tiled on hardware GPUs, raster on software
-    /// adapters.
+    /// How the GPU renderer estimates the global, caustic and volume maps.
     #[arg(long, value_enum, default_value_t = EstimatorChoice::Auto)]
     pub estimator: EstimatorChoice,
     /// Photon paths emitted from the lights (1 to 100,000,000; the memory

@@ -34,7 +34,12 @@ pub struct PhotonSet {
 }
 
 pub struct PhotonSets {
-    jobs: Sender<(u64, Job)>,
+    /// None once dropping (closing it ends the thread).
+    jobs: Option<Sender<(u64, Job)>>,
+    /// Joined on drop: a GPU tracer's device must be released before the
+    /// process exits (lavapipe crashes tearing down a device another
+    /// thread still holds).
+    thread: Option<std::thread::JoinHandle<()>>,
     results: Receiver<PhotonSet>,
     /// Requests made so far (the newest has number `requested - 1`).
     requested: u64,
@@ -49,7 +54,7 @@ impl PhotonSets {
     pub fn start(scene: Arc<Scene>, mut tracer: PhotonTracer) -> Result<Self> {
         let (jobs, job_receiver) = channel::<(u64, Job)>();
         let (sender, results) = channel();
-        std::thread::Builder::new()
+        let thread = std::thread::Builder::new()
             .name("photon sets".into())
             .spawn(move || {
                 let mut posed: Option<(Pose, Arc<Scene>)> = None;
@@ -79,14 +84,15 @@ impl PhotonSets {
                 }
             })
             .map_err(|e| anyhow!("cannot start the photon-tracing thread: {e}"))?;
-        Ok(PhotonSets { jobs, results, requested: 0, received: 0 })
+        Ok(PhotonSets { jobs: Some(jobs), thread: Some(thread), results, requested: 0, received: 0 })
     }
 
     /// Asks for a set; returns its number. Requests are numbered from 0 in
     /// the order made, so the same requests give the same numbers.
     pub fn request(&mut self, job: Job) -> Result<u64> {
         let id = self.requested;
-        self.jobs.send((id, job)).map_err(|_| anyhow!("the photon-tracing thread stopped"))?;
+        let stopped = || anyhow!("the photon-tracing thread stopped");
+        self.jobs.as_ref().ok_or_else(stopped)?.send((id, job)).map_err(|_| stopped())?;
         self.requested += 1;
         Ok(id)
     }
@@ -119,6 +125,17 @@ impl PhotonSets {
             }
         }
         Ok(newest)
+    }
+}
+
+impl Drop for PhotonSets {
+    /// Closes the request channel and waits for the thread to finish the
+    /// set under way (results go to an unbounded channel, so it never blocks).
+    fn drop(&mut self) {
+        self.jobs = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
     }
 }
 

@@ -74,23 +74,11 @@ fn segment_optical_depth(origin: vec3<f32>, dir: vec3<f32>, len: f32) -> vec3<f3
             break;
         }
         let tri = regions[i];
-        let e1 = tri.b.xyz - tri.a.xyz;
-        let e2 = tri.c.xyz - tri.a.xyz;
-        let p = cross(dir, e2);
-        let det = dot(e1, p);
-        if (abs(det) < 1e-12) {
+        let t = region_crossing(origin, dir, tri.a.xyz, tri.b.xyz, tri.c.xyz);
+        if (t <= 0.0) {
             continue;
         }
-        let inv = 1.0 / det;
-        let s = origin - tri.a.xyz;
-        let u = dot(s, p) * inv;
-        let q = cross(s, e1);
-        let v = dot(dir, q) * inv;
-        let t = dot(e2, q) * inv;
-        if (u < 0.0 || v < 0.0 || u + v > 1.0 || t <= 0.0) {
-            continue;
-        }
-        let leaving = dot(cross(e1, e2), dir) > 0.0;
+        let leaving = dot(cross(tri.b.xyz - tri.a.xyz, tri.c.xyz - tri.a.xyz), dir) > 0.0;
         tau += select(-1.0, 1.0, leaving) * tri.sigma_t.xyz * min(t, len);
     }
     return max(tau, vec3<f32>(0.0));

@@ -14,7 +14,7 @@ use wgpu::util::DeviceExt;
 pub static MEDIA: crate::wgsl::Module = crate::wgsl::Module {
     name: "media.wgsl",
     source: include_str!("media.wgsl"),
-    requires: &[&crate::wgsl::CONSTANTS],
+    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::REGION_CROSSING],
 };
 /// The optical depth along view rays from the slices.
 pub static VIEW_DEPTH: crate::wgsl::Module =

@@ -36,7 +36,17 @@ pub fn trace_shader_source() -> String {
     static TRACE: Module = Module {
         name: "trace.wgsl",
         source: include_str!("trace.wgsl"),
-        requires: &[&RANDOM, &SAMPLING, &OPTICS, &BVH, &SURFACE, &SPOT, &PHOTON_ENCODING, &RECORD],
+        requires: &[
+            &RANDOM,
+            &SAMPLING,
+            &OPTICS,
+            &BVH,
+            &SURFACE,
+            &SPOT,
+            &PHOTON_ENCODING,
+            &RECORD,
+            &crate::wgsl::REGION_CROSSING,
+        ],
     };
     compose(&[&TRACE])
 }

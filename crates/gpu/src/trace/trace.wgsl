@@ -416,56 +416,9 @@ struct Flight {
     mask: u32,
 }
 
-// region::intersect_triangle (Woop, Benthin and Wald's watertight test,
-// two-sided, t > 0): the distance, or 0 for no crossing. The CPU takes the
-// edge functions in f64; here they are f32, whose products round, so a
-// ray within rounding of an edge may count differently (photon paths are
-// compared within statistics there).
-fn region_crossing(o: vec3<f32>, d: vec3<f32>, tri: TraceRegionTriangle) -> f32 {
-    let ad = abs(d);
-    var kz = 0u;
-    if (ad.y > ad.x) {
-        kz = 1u;
-    }
-    if (ad.z > max(ad.x, ad.y)) {
-        kz = 2u;
-    }
-    var kx = (kz + 1u) % 3u;
-    var ky = (kz + 2u) % 3u;
-    if (d[kz] < 0.0) {
-        let swap = kx;
-        kx = ky;
-        ky = swap;
-    }
-    let sx = d[kx] / d[kz];
-    let sy = d[ky] / d[kz];
-    let sz = 1.0 / d[kz];
-    let qa = tri.a - o;
-    let qb = tri.b - o;
-    let qc = tri.c - o;
-    let pa = vec3<f32>(qa[kx] - sx * qa[kz], qa[ky] - sy * qa[kz], sz * qa[kz]);
-    let pb = vec3<f32>(qb[kx] - sx * qb[kz], qb[ky] - sy * qb[kz], sz * qb[kz]);
-    let pc = vec3<f32>(qc[kx] - sx * qc[kz], qc[ky] - sy * qc[kz], sz * qc[kz]);
-    let u = pc.x * pb.y - pc.y * pb.x;
-    let v = pa.x * pc.y - pa.y * pc.x;
-    let w = pb.x * pa.y - pb.y * pa.x;
-    let det = u + v + w;
-    if (det == 0.0) {
-        return 0.0;
-    }
-    if (!(edge_inside(u, det, pb, pc) && edge_inside(v, det, pc, pa) && edge_inside(w, det, pa, pb))) {
-        return 0.0;
-    }
-    let t = (u * pa.z + v * pb.z + w * pc.z) / det;
-    return max(t, 0.0);
-}
-
-fn edge_inside(e: f32, det: f32, p: vec3<f32>, q: vec3<f32>) -> bool {
-    let top_left = q.y > p.y || (q.y == p.y && q.x < p.x);
-    if (det > 0.0) {
-        return e > 0.0 || (e == 0.0 && top_left);
-    }
-    return e < 0.0 || (e == 0.0 && top_left);
+// A region triangle's crossing (region_crossing.wgsl): its distance, or 0.
+fn triangle_crossing(o: vec3<f32>, d: vec3<f32>, tri: TraceRegionTriangle) -> f32 {
+    return region_crossing(o, d, tri.a, tri.b, tri.c);
 }
 
 // +1 where the ray leaves the medium through the triangle, −1 where it enters.
@@ -503,7 +456,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             if (!loop_iteration()) {
                 break;
             }
-            if (region_crossing(o, d, regions[i]) > 0.0) {
+            if (triangle_crossing(o, d, regions[i]) > 0.0) {
                 winding[regions[i].medium] += crossing_sign(d, regions[i]);
             }
         }
@@ -519,7 +472,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             if (!loop_iteration()) {
                 break;
             }
-            let t = region_crossing(o, d, regions[i]);
+            let t = triangle_crossing(o, d, regions[i]);
             if (t > t0 && t < t_next) {
                 t_next = t;
             }
@@ -546,7 +499,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             if (!loop_iteration()) {
                 break;
             }
-            if (region_crossing(o, d, regions[i]) == t_next) {
+            if (triangle_crossing(o, d, regions[i]) == t_next) {
                 winding[regions[i].medium] -= crossing_sign(d, regions[i]);
             }
         }

@@ -60,6 +60,10 @@ pub static SURFACE: Module = Module { name: "surface.wgsl", source: include_str!
 /// Mitsuba's spot falloff (hikari_core::light::spot_falloff).
 pub static SPOT: Module = Module { name: "spot.wgsl", source: include_str!("spot.wgsl"), requires: &[] };
 
+/// Watertight ray–region-triangle crossings (hikari_core::medium::region).
+pub static REGION_CROSSING: Module =
+    Module { name: "region_crossing.wgsl", source: include_str!("region_crossing.wgsl"), requires: &[] };
+
 /// Closest hits in the flat BVH (hikari_core::geometry::FlatBvh).
 pub static BVH: Module = Module { name: "bvh.wgsl", source: include_str!("bvh.wgsl"), requires: &[] };
 
