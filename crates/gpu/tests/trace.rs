@@ -174,7 +174,21 @@ fn sampling_matches_the_cpu() {
 
 /// Every light type, mirror, glass, diffuse + mirror, a smooth-normal mesh
 /// and (optionally) two media filling the box with different phase functions.
+/// The features scene's four lights, one TOML entry each.
+const FEATURE_LIGHTS: [&str; 4] = [
+    "[[light]]\ntype = \"point\"\nposition = [0.0, 0.9, 0.0]\nintensity = [2.0, 2.0, 2.0]\n",
+    "[[light]]\ntype = \"spot\"\nposition = [-0.8, 0.9, 0.8]\ndirection = [0.5, -1.0, -0.4]\nintensity = [6.0, 5.0, 4.0]\ncutoff_angle = 30.0\nfalloff_start_angle = 15.0\n",
+    "[[light]]\ntype = \"sphere\"\ncenter = [0.7, 0.8, 0.6]\nradius = 0.08\nradiance = [20.0, 20.0, 20.0]\n",
+    "[[light]]\ntype = \"quad\"\ncorner = [-0.3, 1.15, -0.3]\nedge_u = [0.6, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.6]\nradiance = [8.0, 8.0, 8.0]\n",
+];
+
 fn feature_scene(media: bool) -> Scene {
+    feature_scene_lit(media, &FEATURE_LIGHTS)
+}
+
+/// The features scene lit by `lights` (entries of `FEATURE_LIGHTS`).
+fn feature_scene_lit(media: bool, lights: &[&str]) -> Scene {
+    let lights_text = lights.join("\n");
     let dir = std::env::temp_dir().join(format!("hikari-trace-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // A tetrahedron-like mesh with normals that differ from its faces.
@@ -262,31 +276,7 @@ scale = 0.5
 translate = [0.3, 0.2, -0.6]
 material = "white"
 
-[[light]]
-type = "point"
-position = [0.0, 0.9, 0.0]
-intensity = [2.0, 2.0, 2.0]
-
-[[light]]
-type = "spot"
-position = [-0.8, 0.9, 0.8]
-direction = [0.5, -1.0, -0.4]
-intensity = [6.0, 5.0, 4.0]
-cutoff_angle = 30.0
-falloff_start_angle = 15.0
-
-[[light]]
-type = "sphere"
-center = [0.7, 0.8, 0.6]
-radius = 0.08
-radiance = [20.0, 20.0, 20.0]
-
-[[light]]
-type = "quad"
-corner = [-0.3, 1.15, -0.3]
-edge_u = [0.6, 0.0, 0.0]
-edge_v = [0.0, 0.0, 0.6]
-radiance = [8.0, 8.0, 8.0]
+{lights_text}
 {media_text}
 "#
     );
@@ -429,21 +419,7 @@ fn stored_flux_matches_per_class_and_bounce() {
         let photons = 100_000;
         let cpu = trace_photons(&scene, &TraceSettings { photons, seed: 21, ..Default::default() }, &Silent);
         let gpu = gpu_trace(&ctx, &scene, &TraceSettings { photons, seed: 22, ..Default::default() });
-        let flux = |t: &TracedPhotons, class: PathClass| -> f64 {
-            t.global.iter().filter(|p| p.class() == class).map(|p| p.power_in_units().element_sum() as f64).sum::<f64>()
-                * t.power_unit as f64
-        };
-        for class in [PathClass::Direct, PathClass::Caustic, PathClass::Indirect] {
-            let (g, c) = (flux(&gpu, class), flux(&cpu, class));
-            let count = cpu.global.iter().filter(|p| p.class() == class).count();
-            if count < 400 {
-                continue;
-            }
-            // A sum of `count` roughly equal terms: 5 standard deviations of both runs.
-            let tolerance = 5.0 * (2.0 / count as f64).sqrt() + 0.01;
-            eprintln!("{name} {class:?}: GPU {g:.4} CPU {c:.4} ({count} photons)");
-            assert!((g / c - 1.0).abs() < tolerance, "{name} {class:?}: GPU {g} vs CPU {c}");
-        }
+        assert_flux_per_class(name, &gpu, &cpu);
         let per_bounce = |t: &TracedPhotons| t.stats.stored_flux_per_bounce.clone();
         for (k, (g, c)) in per_bounce(&gpu).iter().zip(per_bounce(&cpu).iter()).enumerate().take(3) {
             let rel = ((*g - *c) / *c).abs().max_element();
@@ -455,6 +431,48 @@ fn stored_flux_matches_per_class_and_bounce() {
             let (g, c) = (volume(&gpu), volume(&cpu));
             assert!((g / c - 1.0).abs() < 0.05, "{name} volume flux: GPU {g} vs CPU {c}");
         }
+    }
+}
+
+/// The flux stored per path class by independent GPU and CPU runs agrees
+/// within its statistics.
+fn assert_flux_per_class(name: &str, gpu: &TracedPhotons, cpu: &TracedPhotons) {
+    let flux = |t: &TracedPhotons, class: PathClass| -> f64 {
+        t.global.iter().filter(|p| p.class() == class).map(|p| p.power_in_units().element_sum() as f64).sum::<f64>()
+            * t.power_unit as f64
+    };
+    for class in [PathClass::Direct, PathClass::Caustic, PathClass::Indirect] {
+        let (g, c) = (flux(gpu, class), flux(cpu, class));
+        let count = cpu.global.iter().filter(|p| p.class() == class).count();
+        if count < 400 {
+            continue;
+        }
+        // A sum of `count` roughly equal terms: 5 standard deviations of both runs.
+        let tolerance = 5.0 * (2.0 / count as f64).sqrt() + 0.01;
+        eprintln!("{name} {class:?}: GPU {g:.4} CPU {c:.4} ({count} photons)");
+        assert!((g / c - 1.0).abs() < tolerance, "{name} {class:?}: GPU {g} vs CPU {c}");
+    }
+}
+
+/// Light by light: the features scene lit by each of its four lights
+/// alone (point, spot, sphere, quad), in fog, stores the same flux per
+/// path class on the GPU as on the CPU, and the same volume flux.
+#[test]
+fn stored_flux_matches_per_light() {
+    let ctx = test_context("stored_flux_matches_per_light");
+    for (k, light) in FEATURE_LIGHTS.iter().enumerate() {
+        let scene = feature_scene_lit(true, &[light]);
+        let name = format!("light {k}");
+        let photons = 60_000;
+        let cpu = trace_photons(&scene, &TraceSettings { photons, seed: 31, ..Default::default() }, &Silent);
+        let gpu = gpu_trace(&ctx, &scene, &TraceSettings { photons, seed: 32, ..Default::default() });
+        assert_flux_per_class(&name, &gpu, &cpu);
+        let volume = |t: &TracedPhotons| {
+            t.volume.iter().map(|p| p.power_in_units().element_sum() as f64).sum::<f64>() * t.power_unit as f64
+        };
+        let (g, c) = (volume(&gpu), volume(&cpu));
+        eprintln!("{name} volume: GPU {g:.4} CPU {c:.4} ({} photons)", cpu.volume.len());
+        assert!(cpu.volume.len() > 1000 && (g / c - 1.0).abs() < 0.05, "{name} volume flux: GPU {g} vs CPU {c}");
     }
 }
 
