@@ -271,9 +271,10 @@ fn render_on_gpu(
     settings: GpuSettings,
 ) -> Result<(Image, u64), GpuError> {
     let adapter = format!("{}, {:?} estimator", ctx.describe(), settings.estimator);
-    if !ctx.float32_blend {
+    if !ctx.float32_blend && settings.estimator == Estimator::Raster {
         eprintln!(
-            "note: {adapter} cannot blend 32-bit float targets; photon splats accumulate in 16-bit floats (about 3 significant digits)"
+            "note: {} cannot blend 32-bit float targets; photon splats accumulate in 16-bit floats (about 3 significant digits)",
+            ctx.describe()
         );
     }
     let setup_start = Instant::now();

@@ -5,9 +5,13 @@
 //! instanced quad covering the screen footprint of its radius-r sphere, and
 //! the fragment shader adds that photon's contribution at the pixel's surface
 //! point. The estimate is the one of `hikari_core::estimate`, mirrored in
-//! `estimate.wgsl`; the twin tests hold the two to the same numbers.
+//! `wgsl/estimate.wgsl`; the twin tests hold the two to the same numbers.
+//! `tiled` computes the same sums in compute shaders over screen tiles, and
+//! `trace` traces the photons themselves in a compute shader, the CPU
+//! tracer's twin.
 //!
-//! Each pass is a small struct with its pipeline, its shader beside it.
+//! Each pass is a small struct with its pipeline, its shader beside it;
+//! WGSL shared between passes is in `wgsl`, composed once per shader.
 
 pub mod accumulate;
 pub mod binding;
