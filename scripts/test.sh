@@ -25,11 +25,27 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
     XDG_RUNTIME_DIR="$(mktemp -d)"
 fi
 
+# A one-off build gains nothing from incremental compilation but a gigabyte
+# of disk.
+export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
+
 cargo test --workspace --locked "$@"
 
 # The GPU tests again on Mesa's OpenGL (llvmpipe through EGL): the storage
-# G-buffer, 16-bit splat sums and the media refusal (see README).
-WGPU_BACKEND=gl cargo test -p hikari-gpu --locked "$@"
+# G-buffer, 16-bit splat sums and the media refusal (see README). The
+# executables the workspace build made run again (`cargo test -p` would
+# compile wgpu a second time).
+echo "GPU tests on OpenGL (WGPU_BACKEND=gl)"
+mapfile -t gpu_tests < <(bash scripts/test-executables.sh crates/gpu "" "$@")
+if [ ${#gpu_tests[@]} -lt 2 ]; then
+    echo "found no GPU test executables to run on GL" >&2
+    exit 1
+fi
+for entry in "${gpu_tests[@]}"; do
+    read -r dir exe <<<"$entry"
+    echo "== $(basename "$exe") on GL"
+    (cd "$dir" && WGPU_BACKEND=gl "$exe")
+done
 
 # A minute of the structured scene fuzzer (new mutants for every commit).
-bash scripts/fuzz-ci.sh
+bash scripts/fuzz-ci.sh "$@"
