@@ -65,6 +65,62 @@ impl Light {
         }
     }
 
+    /// Where a point or spot light sits; None for area lights.
+    pub fn delta_position(&self) -> Option<Vec3> {
+        match *self {
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some(position),
+            Light::Sphere { .. } | Light::Quad { .. } => None,
+        }
+    }
+
+    /// The part [ta, tb] of the ray `origin + t·dir` (unit `dir`), t in
+    /// [t0, t1], that the light can reach: a spot's cone (convex while its
+    /// cutoff is under 90°) cut out of the interval, the whole interval for
+    /// other lights. None if the ray misses the cone there.
+    pub fn lit_interval(&self, origin: Vec3, dir: Vec3, t0: f32, t1: f32) -> Option<(f32, f32)> {
+        let Light::Spot { position, axis, cutoff, .. } = *self else { return Some((t0, t1)) };
+        if cutoff >= CLIPPED_CONE_LIMIT {
+            return Some((t0, t1));
+        }
+        let cos_cutoff = cutoff.cos();
+        let inside = |t: f32| {
+            let to_point = origin + dir * t - position;
+            to_point.dot(axis) >= cos_cutoff * to_point.length()
+        };
+        // Along the ray the cone's boundary, (p − apex)·axis = cos·|p − apex|,
+        // squared: a t² + b t + c = 0. Between consecutive roots (and the
+        // apex plane) whether a point is inside does not change, so a test
+        // at one point of each piece decides it.
+        let v = origin - position;
+        let cos2 = cos_cutoff * cos_cutoff;
+        let (dk, vk) = (dir.dot(axis), v.dot(axis));
+        let (a, b, c) = (dk * dk - cos2, 2.0 * (vk * dk - cos2 * v.dot(dir)), vk * vk - cos2 * v.length_squared());
+        let mut cuts = [t0, t1, f32::NAN, f32::NAN, f32::NAN];
+        let discriminant = b * b - 4.0 * a * c;
+        if discriminant >= 0.0 && a != 0.0 {
+            let q = -0.5 * (b + discriminant.sqrt().copysign(b));
+            (cuts[2], cuts[3]) = (q / a, if q != 0.0 { c / q } else { f32::NAN });
+        } else if a == 0.0 && b != 0.0 {
+            cuts[2] = -c / b;
+        }
+        if dk != 0.0 {
+            cuts[4] = -vk / dk;
+        }
+        let mut cuts: Vec<f32> = cuts.into_iter().filter(|t| *t >= t0 && *t <= t1).collect();
+        cuts.sort_by(f32::total_cmp);
+        let mut lit: Option<(f32, f32)> = None;
+        for piece in cuts.windows(2) {
+            let (start, end) = (piece[0], piece[1]);
+            let probe = if end.is_finite() { 0.5 * (start + end) } else { start + 1.0 + start.abs() };
+            if end > start && inside(probe) {
+                lit = Some(lit.map_or((start, end), |(s, _)| (s, end)));
+            }
+        }
+        // Roots are rounded: widen by a hair (the falloff is zero at the
+        // cutoff, so what is gained or lost at the boundary carries nothing).
+        lit.map(|(s, e)| ((s - 1e-4 * (1.0 + s.abs())).max(t0), (e + 1e-4 * (1.0 + e.abs())).min(t1)))
+    }
+
     /// The same light with its anchor at `anchor`.
     pub fn with_anchor(&self, anchor: Vec3) -> Light {
         let mut light = self.clone();
@@ -223,6 +279,10 @@ impl Light {
     }
 }
 
+/// Spots with a cutoff from here on are not clipped by [`Light::lit_interval`]
+/// (the cone stops being convex at 90°).
+const CLIPPED_CONE_LIMIT: f32 = 85.0 * PI / 180.0;
+
 fn delta_sample(point: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSample> {
     let to_light = position - point;
     let d2 = to_light.length_squared();
@@ -291,6 +351,49 @@ pub fn sample_spot_direction(cutoff: f32, falloff_start: f32, rng: &mut Rng) -> 
 mod tests {
     use super::*;
     use crate::sampling::chi2::{assert_direction_distribution, assert_unit_density};
+
+    /// The lit interval of a spot holds every point of the ray inside the
+    /// cone and starts and ends at the cone (dense sampling along rays from
+    /// inside and outside, toward and away from the apex).
+    #[test]
+    fn lit_interval_is_the_part_of_the_ray_inside_the_cone() {
+        let spot = Light::Spot {
+            position: Vec3::new(0.0, 4.5, 0.0),
+            axis: Vec3::NEG_Y,
+            intensity: Vec3::ONE,
+            cutoff: 22f32.to_radians(),
+            falloff_start: 16f32.to_radians(),
+        };
+        let Light::Spot { position, axis, cutoff, .. } = spot else { unreachable!() };
+        let inside = |p: Vec3| (p - position).normalize().dot(axis) >= cutoff.cos();
+        let mut rng = Rng::for_item(17, 0);
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..2000 {
+            let origin = Vec3::new(rng.next_f32() * 8.0 - 4.0, rng.next_f32() * 7.0 - 1.0, rng.next_f32() * 8.0 - 4.0);
+            let dir = crate::sampling::uniform_sphere(rng.next_2d());
+            let t1 = 12.0;
+            let steps = 6000;
+            let samples: Vec<f32> =
+                (0..=steps).map(|i| t1 * i as f32 / steps as f32).filter(|&t| inside(origin + dir * t)).collect();
+            match (spot.lit_interval(origin, dir, 0.0, t1), samples.first(), samples.last()) {
+                (Some((a, b)), Some(&first), Some(&last)) => {
+                    hits += 1;
+                    assert!(a <= first && b >= last, "[{a}, {b}] misses [{first}, {last}]");
+                    let step = t1 / steps as f32;
+                    assert!(first - a < step + 3e-3 && b - last < step + 3e-3, "[{a}, {b}] vs [{first}, {last}]");
+                }
+                (None, None, None) => misses += 1,
+                // A sliver thinner than the sampling step may be found by one side only.
+                (Some((a, b)), None, None) => assert!(b - a < 0.01, "[{a}, {b}] with no sample inside"),
+                (None, Some(&first), Some(&last)) => panic!("no interval, samples inside from {first} to {last}"),
+                other => unreachable!("{other:?}"),
+            }
+        }
+        assert!(hits > 100 && misses > 100, "{hits} rays through the cone, {misses} past it");
+        // Other lights reach the whole interval.
+        let point = Light::Point { position, intensity: Vec3::ONE };
+        assert_eq!(point.lit_interval(Vec3::ZERO, Vec3::X, 0.5, 3.0), Some((0.5, 3.0)));
+    }
 
     #[test]
     fn spot_solid_angle_is_the_closed_form_and_stable_for_thin_ramps() {

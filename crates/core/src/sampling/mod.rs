@@ -6,8 +6,10 @@
 
 #[cfg(test)]
 pub(crate) mod chi2;
+mod equiangular;
 mod rng;
 
+pub use equiangular::Equiangular;
 pub use rng::Rng;
 
 use glam::{Vec2, Vec3};
