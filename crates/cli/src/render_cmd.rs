@@ -34,7 +34,7 @@ pub enum RendererKind {
     Gpu,
     /// The seed's fixed-radius photon mapping on the CPU.
     PhotonCpu,
-    /// Path tracer (ground truth; slow to converge).
+    /// Path tracer: the unbiased ground truth (next-event estimation with MIS; equiangular sampling of point and spot lights in fog).
     Path,
 }
 
