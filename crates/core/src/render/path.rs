@@ -51,8 +51,9 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
         let hit = scene.accel.intersect(&ray);
         let media = &scene.media;
         if !media.is_empty() {
-            l += beta * in_scattered_from_delta_lights(scene, &ray, hit.map_or(f32::INFINITY, |h| h.t), rng);
-            match media.sample_flight(ray.origin, ray.dir, hit.map_or(f32::INFINITY, |h| h.t), rng.next_f32()) {
+            let t_max = hit.map_or(f32::INFINITY, |h| h.t);
+            l += beta * in_scattered_from_delta_lights(scene, &ray, t_max, rng);
+            match media.sample_flight(ray.origin, ray.dir, t_max, rng.next_f32()) {
                 Flight::Passed { weight } => beta *= weight,
                 Flight::Interaction { distance, weight, mask } => {
                     let (lambda, albedo) = media.scattering(mask);
