@@ -108,14 +108,7 @@ pub fn compute_pipeline(
     module: &wgpu::ShaderModule,
     entry_point: &str,
 ) -> wgpu::ComputePipeline {
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some(label),
-        layout: Some(layout),
-        module,
-        entry_point: Some(entry_point),
-        compilation_options: Default::default(),
-        cache: None,
-    })
+    compute_pipeline_with(device, label, layout, module, entry_point, &[])
 }
 
 /// A compute pipeline running `entry_point` of `module` whose workgroups are
@@ -130,15 +123,25 @@ pub fn square_compute_pipeline(
     entry_point: &str,
     side: u32,
 ) -> wgpu::ComputePipeline {
+    compute_pipeline_with(device, label, layout, module, entry_point, &[("WORKGROUP", side as f64)])
+}
+
+/// A compute pipeline with values for the shader's pipeline-overridable
+/// constants.
+fn compute_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
         module,
         entry_point: Some(entry_point),
-        compilation_options: wgpu::PipelineCompilationOptions {
-            constants: &[("WORKGROUP", side as f64)],
-            ..Default::default()
-        },
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
         cache: None,
     })
 }

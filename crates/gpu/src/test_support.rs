@@ -27,3 +27,18 @@ pub fn media_context(test: &str, scene: &Scene) -> Option<GpuContext> {
     eprintln!("{test}: {why}");
     None
 }
+
+/// A camera at `size`×`size` with the eye close to `cornell-box`'s floor,
+/// looking down into the corner: photon spheres there cross the near plane
+/// and lie behind the eye, the hard case for a splat's or a tile's footprint.
+pub fn eye_near_the_floor(size: u32) -> hikari_core::camera::Camera {
+    hikari_core::camera::Camera::new(
+        glam::Vec3::new(0.2, -0.93, 0.6),
+        glam::Vec3::new(-0.5, -1.0, -0.6),
+        glam::Vec3::Y,
+        100.0,
+        size,
+        size,
+    )
+    .expect("a valid camera")
+}

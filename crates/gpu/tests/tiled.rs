@@ -92,15 +92,7 @@ fn tiled_lists_and_slices_grow_until_the_frame_fits() {
     // exact and rounds to f16 once.
     let tolerance = if ctx.float32_blend { 2e-4 } else { 5e-2 };
     let mut scene = Scene::load("cornell-box").unwrap();
-    scene.camera = hikari_core::camera::Camera::new(
-        Vec3::new(0.2, -0.93, 0.6),
-        Vec3::new(-0.5, -1.0, -0.6),
-        Vec3::Y,
-        100.0,
-        48,
-        48,
-    )
-    .unwrap();
+    scene.camera = hikari_gpu::test_support::eye_near_the_floor(48);
     let traced = trace_photons(&scene, &TraceSettings { photons: 10_000, seed: 9, ..Default::default() }, &Silent);
     // Photon spheres of radius 0.4 (a fifth of the box) cover most of the 9 tiles.
     let radius = Some(0.4);

@@ -157,15 +157,7 @@ fn gpu_splat_equals_cpu_estimate_with_normal_test() {
 #[test]
 fn gpu_splat_equals_cpu_estimate_with_photons_around_the_eye() {
     let mut scene = Scene::load("cornell-box").unwrap();
-    scene.camera = hikari_core::camera::Camera::new(
-        Vec3::new(0.2, -0.93, 0.6),
-        Vec3::new(-0.5, -1.0, -0.6),
-        Vec3::Y,
-        100.0,
-        64,
-        64,
-    )
-    .unwrap();
+    scene.camera = hikari_gpu::test_support::eye_near_the_floor(64);
     for estimator in ESTIMATORS {
         let (indirect, _) = twin_scene(scene.clone(), 20_000, false, estimator).expect("a twin");
         assert_twin(&format!("eye among photons ({estimator:?})"), &indirect, 2000);
