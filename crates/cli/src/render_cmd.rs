@@ -62,7 +62,8 @@ impl EstimatorChoice {
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// A built-in scene name (see `hikari scenes`) or a path to a .toml scene file.
+    /// A built-in scene name (see `hikari scenes`), a path to a .toml scene
+    /// file, or a glTF 2.0 file (.glb, or .gltf with its buffers).
     #[arg(default_value = builtin::DEFAULT)]
     pub scene: String,
     /// Output image: .png (tone-mapped sRGB) or .exr (linear float RGB).
@@ -92,10 +93,15 @@ pub struct RenderArgs {
     /// Samples per pixel, 1 to 65536 [default: 4 for photon-cpu, 64 for path].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub spp: Option<u32>,
-    /// Override the scene's resolution, e.g. 1280x720 (each side 1 to 16384,
-    /// at most 8192x8192 pixels in all).
+    /// Override the scene's resolution, e.g. 1280x720, or 1280 (or x720) to
+    /// keep the camera's aspect ratio (each side 1 to 16384, at most
+    /// 8192x8192 pixels in all).
     #[arg(long, value_parser = parse_resolution)]
-    pub resolution: Option<(u32, u32)>,
+    pub resolution: Option<Resolution>,
+    /// The camera of a glTF file to render through, by name [default: the
+    /// first perspective camera; without one, a camera framing the scene].
+    #[arg(long)]
+    pub camera: Option<String>,
     /// Random seed: the same seed gives the same image whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -185,18 +191,68 @@ pub fn parse_time(text: &str) -> Result<f32, String> {
     if (0.0..=1e6).contains(&t) { Ok(t) } else { Err(format!("{t} s is outside 0 to 1,000,000 s")) }
 }
 
-pub fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 640x480"));
-    let (w, h) = (parse(w)?, parse(h)?);
+/// An image size from `--resolution`: both sides, or one side with the
+/// other following the camera's aspect ratio.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resolution {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+}
+
+impl Resolution {
+    /// Both sides, the missing one from `aspect` (width / height).
+    pub fn resolve(&self, aspect: f32) -> Result<(u32, u32), String> {
+        use hikari_core::scene::limits::{MAX_PIXELS, MAX_SIDE};
+        let side = |x: f32| (x.round() as u32).max(1);
+        let (w, h) = match (self.width, self.height) {
+            (Some(w), Some(h)) => (w, h),
+            (Some(w), None) => (w, side(w as f32 / aspect)),
+            (None, Some(h)) => (side(h as f32 * aspect), h),
+            (None, None) => unreachable!("parse_resolution gives at least one side"),
+        };
+        if w > MAX_SIDE || h > MAX_SIDE {
+            return Err(format!("--resolution: {w}x{h} at the camera's aspect ratio has a side above {MAX_SIDE}"));
+        }
+        if w as u64 * h as u64 > MAX_PIXELS {
+            return Err(format!("--resolution: {w}x{h} is more than {MAX_PIXELS} pixels (8192x8192)"));
+        }
+        Ok((w, h))
+    }
+}
+
+/// `WIDTHxHEIGHT`, or `WIDTH` (also `WIDTHx`) or `xHEIGHT` to keep the camera's aspect ratio.
+pub fn parse_resolution(s: &str) -> Result<Resolution, String> {
+    let expected = || format!("`{s}`: expected WIDTHxHEIGHT (e.g. 640x480), WIDTH or xHEIGHT");
+    let (w, h) = s.split_once(['x', 'X']).unwrap_or((s, ""));
+    let parse = |v: &str| -> Result<Option<u32>, String> {
+        let v = v.trim();
+        if v.is_empty() { Ok(None) } else { v.parse::<u32>().map(Some).map_err(|_| expected()) }
+    };
+    let (width, height) = (parse(w)?, parse(h)?);
+    if width.is_none() && height.is_none() {
+        return Err(expected());
+    }
     use hikari_core::scene::limits::{MAX_PIXELS, MAX_SIDE};
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+    if [width, height].iter().flatten().any(|&x| x == 0 || x > MAX_SIDE) {
         return Err(format!("`{s}`: each side must be between 1 and {MAX_SIDE}"));
     }
-    if w as u64 * h as u64 > MAX_PIXELS {
+    if let (Some(w), Some(h)) = (width, height)
+        && w as u64 * h as u64 > MAX_PIXELS
+    {
         return Err(format!("`{s}`: at most {MAX_PIXELS} pixels (8192x8192)"));
     }
-    Ok((w, h))
+    Ok(Resolution { width, height })
+}
+
+/// Loads `spec` (built-in name, `.toml`, `.gltf` or `.glb`) through
+/// `camera`, printing the loader's notes; a bad file is a usage error.
+pub fn load_scene(spec: &str, camera: Option<&str>) -> Result<Scene, UsageError> {
+    let options = hikari_core::scene::LoadOptions { camera: camera.map(str::to_string) };
+    let scene = Scene::load_with(spec, &options).map_err(|e| UsageError(e.to_string()))?;
+    for note in &scene.notes {
+        eprintln!("note: {note}");
+    }
+    Ok(scene)
 }
 
 /// Most photon paths `--photons` accepts: about 6 GB of photon maps in the
@@ -506,7 +562,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .context("setting the thread count")?;
     }
 
-    let mut scene = Scene::load(&args.scene).map_err(|e| UsageError(e.to_string()))?;
+    let mut scene = load_scene(&args.scene, args.camera.as_deref())?;
     if scene.is_animated() {
         scene = scene.at_time(args.at);
     }
@@ -515,7 +571,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     radius_in_range("caustic-radius", args.caustic_radius, diagonal)?;
     radius_in_range("volume-radius", args.volume_radius, diagonal)?;
     let renderer = args.renderer;
-    if let Some((w, h)) = args.resolution {
+    if let Some(resolution) = args.resolution {
+        let (w, h) = resolution.resolve(scene.camera.aspect()).map_err(UsageError)?;
         scene.camera = scene.camera.with_resolution(w, h).map_err(UsageError)?;
     }
     let progress = TerminalProgress::new(args.quiet);

@@ -346,3 +346,46 @@ fn tiled_estimator_renders_the_splat_image() {
     // f16 splat sums on GL differ from the exact tiled sums by up to ~1%.
     assert!(error.relative_rmse < 5e-3, "{error:?}");
 }
+
+/// A glTF file renders from the command line (its camera's aspect kept by a
+/// one-sided `--resolution`); a broken one, or an unknown `--camera`, is a
+/// located error with exit code 2 and no image.
+#[test]
+fn gltf_files_render_and_broken_ones_are_located_errors() {
+    use hikari_core::scene::Scene;
+    use hikari_core::scene::gltf::export::scene_to_glb;
+    let dir = scratch_dir("gltf");
+    let mut scene = Scene::load("cornell-box").unwrap();
+    scene.camera = scene.camera.with_resolution(40, 20).unwrap();
+    let glb = scene_to_glb(&scene).unwrap();
+    std::fs::write(dir.join("box.glb"), &glb).unwrap();
+    let out = hikari(
+        &[
+            "render",
+            "box.glb",
+            "--renderer",
+            "photon-cpu",
+            "--resolution",
+            "x10",
+            "--photons",
+            "2000",
+            "-o",
+            "g.png",
+            "-q",
+        ],
+        &dir,
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let img = image::open(dir.join("g.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (20, 10), "the camera's 2:1 aspect ratio is kept");
+    std::fs::remove_file(dir.join("g.png")).unwrap();
+
+    std::fs::write(dir.join("cut.glb"), &glb[..glb.len() / 2]).unwrap();
+    let out = hikari(&["render", "cut.glb", "-o", "g.png", "-q"], &dir);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_fails_with(&out, &dir, &["cut.glb", "glTF"]);
+
+    let out = hikari(&["render", "box.glb", "--camera", "Nope", "-o", "g.png", "-q"], &dir);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert_fails_with(&out, &dir, &["box.glb", "cameras", "\"Nope\""]);
+}

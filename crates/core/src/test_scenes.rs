@@ -37,3 +37,101 @@ intensity = [{i}, {i}, {i}]
     );
     Scene::from_toml(&text, "furnace", None).expect("the furnace scene is valid")
 }
+
+/// A 4×4 diffuse floor of albedo `albedo` at y = 0 (facing +y) under a sun
+/// of irradiance `irradiance` tilted `theta_degrees` from the zenith toward
+/// +x, seen from straight above by a 16×16 camera that sees only the floor.
+/// With `blocker`, a black box floats off camera at (1.5, 0.5, 1.5), its
+/// shadow off camera too (it reflects nothing, so the camera's view stays
+/// lit by the sun alone): radiance albedo/π · E cos θ everywhere in view.
+pub fn sunlit_floor(theta_degrees: f32, irradiance: f32, albedo: f32, blocker: bool) -> Scene {
+    let (s, c) = theta_degrees.to_radians().sin_cos();
+    let blocker = if blocker {
+        "[[object]]\nshape = \"box\"\ncenter = [1.5, 0.5, 1.5]\nsize = [0.4, 0.4, 0.4]\nmaterial = \"black\"\n"
+    } else {
+        ""
+    };
+    let light = format!(
+        "[[light]]\ntype = \"directional\"\ndirection = [{s}, {}, 0.0]\nirradiance = [{irradiance}, {irradiance}, {irradiance}]\n",
+        -c
+    );
+    Scene::from_toml(&floor_scene(albedo, &format!("{blocker}{light}")), "sunlit-floor", None)
+        .expect("the sunlit floor is valid")
+}
+
+/// The floor of [`sunlit_floor`] (no blocker) under a uniform sky of
+/// radiance `radiance` and nothing else, made of `material` (a TOML
+/// material table body named "floor"): a diffuse floor of albedo ρ shows ρ·L
+/// (it sees the upper hemisphere, irradiance π·L), a mirror R·L.
+pub fn sky_floor(radiance: f32, material: &str) -> Scene {
+    let text = floor_scene(0.5, &format!("[environment]\nradiance = [{radiance}, {radiance}, {radiance}]\n"))
+        .replace("name = \"floor\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", material);
+    Scene::from_toml(&text, "sky-floor", None).expect("the sky floor is valid")
+}
+
+fn floor_scene(albedo: f32, extra: &str) -> String {
+    format!(
+        r#"
+[camera]
+position = [0.0, 3.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+fov_y = 20.0
+resolution = [16, 16]
+
+[[material]]
+name = "floor"
+type = "diffuse"
+albedo = [{albedo}, {albedo}, {albedo}]
+
+[[material]]
+name = "black"
+type = "diffuse"
+albedo = [0.0, 0.0, 0.0]
+
+[[object]]
+shape = "quad"
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "floor"
+
+{extra}"#
+    )
+}
+
+/// The Cornell box at `size`×`size` pixels, its point light replaced by a
+/// 0.5×0.5 quad light of radiance 12 facing down just under the ceiling.
+pub fn cornell_quad_light(size: u32) -> Scene {
+    let text = crate::scene::builtin::source("cornell-box").expect("cornell-box is built in");
+    let start = text.find("[[light]]").expect("cornell-box has a light");
+    let quad = "[[light]]\ntype = \"quad\"\ncorner = [-0.25, 0.999, -0.25]\nedge_u = [0.5, 0.0, 0.0]\nedge_v = [0.0, 0.0, 0.5]\nradiance = [12.0, 12.0, 12.0]\n";
+    let mut scene = Scene::from_toml(&format!("{}{quad}", &text[..start]), "cornell-quad", None).unwrap();
+    scene.camera = scene.camera.with_resolution(size, size).unwrap();
+    scene
+}
+
+/// `scene` with every quad light turned into the same two triangles as an
+/// emissive mesh ([`crate::light::Light::Mesh`]) whose surface is a black
+/// diffuse material instead of `Material::Emitter`: the same light, carried
+/// by the code paths of emissive meshes.
+pub fn quad_lights_as_meshes(scene: &Scene) -> Scene {
+    use crate::light::{EmissiveMesh, Light};
+    use crate::material::Material;
+    let mut scene = scene.clone();
+    let black = scene.materials.len() as u32;
+    scene.materials.push(Material::Diffuse { albedo: Vec3::ZERO, specular: Vec3::ZERO });
+    for (i, light) in scene.lights.iter_mut().enumerate() {
+        let Light::Quad { corner, edge_u, edge_v, radiance } = *light else { continue };
+        // The loader's winding (`add_quad`): normal edge_u × edge_v.
+        let triangles = vec![
+            [corner, corner + edge_u, corner + edge_u + edge_v],
+            [corner, corner + edge_u + edge_v, corner + edge_v],
+        ];
+        *light = Light::Mesh(std::sync::Arc::new(EmissiveMesh::new(triangles, radiance, false).unwrap()));
+        for surface in scene.surfaces.iter_mut().filter(|s| s.emitter == Some(i as u32)) {
+            surface.material = black;
+        }
+    }
+    scene
+}

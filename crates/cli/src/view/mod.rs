@@ -43,7 +43,7 @@ mod photon_sets;
 mod scene_watch;
 mod trace_budget;
 
-use crate::render_cmd::{MAX_PHOTONS, UsageError, parse_resolution, parse_time};
+use crate::render_cmd::{MAX_PHOTONS, Resolution, UsageError, load_scene, parse_resolution, parse_time};
 use crate::tracing::{PhotonTracer, TraceDevice};
 use anyhow::{Result, anyhow};
 use clap::Args;
@@ -75,7 +75,8 @@ use winit::window::{Window, WindowId};
 
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// A built-in scene name (see `hikari scenes`) or a path to a .toml scene file.
+    /// A built-in scene name (see `hikari scenes`), a path to a .toml scene
+    /// file, or a glTF 2.0 file (.glb, or .gltf with its buffers).
     #[arg(default_value = builtin::DEFAULT)]
     pub scene: String,
     /// Photon paths per photon set (1 to 100,000,000).
@@ -87,9 +88,14 @@ pub struct ViewArgs {
     /// Exposure in stops (-64 to 64).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
-    /// Window size in pixels, e.g. 1280x720 [default: the scene's resolution].
+    /// Window size in pixels, e.g. 1280x720, or 1280 (or x720) to keep the
+    /// camera's aspect ratio [default: the scene's resolution].
     #[arg(long, value_parser = parse_resolution)]
-    pub size: Option<(u32, u32)>,
+    pub size: Option<Resolution>,
+    /// The camera of a glTF file to start from, by name [default: the first
+    /// perspective camera; without one, a camera framing the scene].
+    #[arg(long)]
+    pub camera: Option<String>,
     /// Quit after this many frames (for tests and benchmarks).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
@@ -126,7 +132,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
             return Err(UsageError(format!("{}: unsupported image type (use .png or .exr)", path.display())).into());
         }
     }
-    let scene = Scene::load(&args.scene).map_err(|e| UsageError(e.to_string()))?;
+    let scene = load_scene(&args.scene, args.camera.as_deref())?;
+    if let Some(size) = args.size {
+        size.resolve(scene.camera.aspect()).map_err(UsageError)?;
+    }
     let event_loop = EventLoop::new()
         .map_err(|e| anyhow!("cannot open a window ({e}); `hikari render` writes an image without one"))?;
     let mut viewer = Viewer::new(args, scene);
@@ -334,7 +343,12 @@ impl Viewer {
     /// Opens the window, finds an adapter that can present to it, traces
     /// the first photon set and builds the renderer.
     fn open(&mut self, event_loop: &ActiveEventLoop) -> Result<Session> {
-        let (width, height) = self.args.size.unwrap_or((self.base.camera.width, self.base.camera.height));
+        let camera = &self.base.camera;
+        let (width, height) = match self.args.size {
+            // Checked when the viewer started.
+            Some(size) => size.resolve(camera.aspect()).unwrap_or((camera.width, camera.height)),
+            None => (camera.width, camera.height),
+        };
         let attributes = Window::default_attributes()
             .with_title(format!("hikari view — {}", self.args.scene))
             .with_inner_size(PhysicalSize::new(width, height));
@@ -409,7 +423,8 @@ impl Viewer {
         if !self.watch.changed() {
             return Ok(());
         }
-        let scene = match Scene::load(&self.args.scene) {
+        let options = hikari_core::scene::LoadOptions { camera: self.args.camera.clone() };
+        let scene = match Scene::load_with(&self.args.scene, &options) {
             Ok(scene) => scene,
             Err(e) => {
                 eprintln!("view: {e} (the last good scene stays)");

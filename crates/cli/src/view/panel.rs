@@ -251,6 +251,9 @@ fn scene_edits(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
                 Light::Spot { .. } => "spot",
                 Light::Sphere { .. } => "sphere",
                 Light::Quad { .. } => "quad",
+                Light::Directional { .. } => "directional",
+                Light::Environment { .. } => "environment",
+                Light::Mesh(_) => "emissive mesh",
             };
             let name = r.light_names.get(i).cloned().flatten().unwrap_or_else(|| format!("light #{}", i + 1));
             ui.label(format!("{name} ({kind})"));

@@ -160,7 +160,10 @@ impl PathTracer<'_> {
             // Free flight through the media, if any (eq. 5.10–5.12).
             let media = &self.scene.media;
             if !media.is_empty() {
-                match media.sample_flight(ray.origin, ray.dir, hit.map_or(f32::INFINITY, |h| h.t), rng.next_f32()) {
+                // A photon leaving the scene flies through fog as far as an
+                // eye ray would (`Scene::escape_distance`).
+                let t_max = hit.map_or_else(|| self.scene.escape_distance(ray.origin, ray.dir), |h| h.t);
+                match media.sample_flight(ray.origin, ray.dir, t_max, rng.next_f32()) {
                     Flight::Passed { weight } => power *= weight,
                     Flight::Interaction { distance, weight, mask } => {
                         let (lambda, albedo) = media.scattering(mask);
@@ -355,5 +358,33 @@ mod tests {
         assert!(count(PathClass::Direct) > 0 && count(PathClass::Indirect) > 0);
         assert_eq!(count(PathClass::Caustic), traced.caustic.len());
         assert!(traced.caustic.iter().all(|p| p.class() == PathClass::Caustic));
+    }
+
+    /// A sun's photons carry its irradiance: a floor of area A tilted θ from
+    /// it receives E·cos θ·A at their first hits.
+    #[test]
+    fn sun_photons_carry_e_cos_theta_per_area() {
+        let scene = test_scenes::sunlit_floor(30.0, 3.0, 0.5, false);
+        let traced =
+            trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 11, ..Default::default() }, &Silent);
+        let expected = 3.0 * 30f32.to_radians().cos() * 16.0;
+        let got = traced.stats.stored_flux_per_bounce[0];
+        eprintln!("sun: {got} vs {expected}");
+        // Each photon hits with probability 0.55: ±0.2%.
+        assert!(((got - Vec3::splat(expected)) / expected).abs().max_element() < 0.01, "{got} vs {expected}");
+    }
+
+    /// A sky's photons carry its radiance: a floor of area A open to a sky
+    /// of radiance L receives π·L·A on each face, 2π·L·A in all.
+    #[test]
+    fn sky_photons_carry_pi_l_per_area_and_face() {
+        let scene = test_scenes::sky_floor(2.0, "name = \"floor\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]");
+        let traced =
+            trace_photons(&scene, &TraceSettings { photons: 200_000, seed: 12, ..Default::default() }, &Silent);
+        let expected = 2.0 * std::f32::consts::PI * 2.0 * 16.0;
+        let got = traced.stats.stored_flux_per_bounce[0];
+        eprintln!("sky: {got} vs {expected}");
+        // Each photon hits with probability 0.32: ±0.3%.
+        assert!(((got - Vec3::splat(expected)) / expected).abs().max_element() < 0.015, "{got} vs {expected}");
     }
 }

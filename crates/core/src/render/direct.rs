@@ -7,13 +7,13 @@ use crate::scene::Scene;
 use glam::Vec3;
 use std::f32::consts::PI;
 
-/// Reflected radiance albedo/π · ∫ L_i cos θ dω from all lights, each point
-/// and spot light by one shadow ray, each area light by `area_samples`
-/// samples. `normal` faces the viewer.
+/// Reflected radiance albedo/π · ∫ L_i cos θ dω from all lights, each delta
+/// light (point, spot, sun) by one shadow ray, each area light and the sky
+/// by `area_samples` samples. `normal` faces the viewer.
 pub fn direct_diffuse(scene: &Scene, x: Vec3, normal: Vec3, albedo: Rgb, area_samples: u32, rng: &mut Rng) -> Rgb {
     let mut sum = Rgb::ZERO;
     for light in &scene.lights {
-        let samples = if light.is_area() { area_samples.max(1) } else { 1 };
+        let samples = if light.is_delta() { 1 } else { area_samples.max(1) };
         let mut light_sum = Rgb::ZERO;
         for _ in 0..samples {
             let Some(s) = light.sample_incident(x, rng.next_2d()) else {

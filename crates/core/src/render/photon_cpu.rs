@@ -2,7 +2,9 @@
 //! renderer. Primary rays; mirror and glass followed recursively (Whitted) to
 //! the first diffuse hit; there, direct light by shadow rays, indirect light
 //! from the global map and caustics from the caustic map, both with the
-//! fixed-radius estimate of `crate::estimate`.
+//! fixed-radius estimate of `crate::estimate`. Rays that leave the scene
+//! (from the eye or a mirror or glass) see the sky; emissive surfaces seen
+//! add their light to what their material reflects.
 
 use super::{Image, direct_diffuse, render_pixels};
 use crate::estimate::{FixedRadius, fixed_radius_radiance};
@@ -38,7 +40,7 @@ pub struct PhotonCpuSettings {
     pub volume_radius: Option<f32>,
     pub spp: u32,
     pub seed: u64,
-    /// Shadow-ray samples per area light at each shaded point.
+    /// Shadow-ray samples per area light and sky at each shaded point.
     pub area_light_samples: u32,
     /// Mirror/glass bounces followed from the eye before giving up.
     pub max_specular_depth: u32,
@@ -151,12 +153,16 @@ impl<'a> PhotonCpuRenderer<'a> {
     /// the surface's, attenuated by the medium, plus in-scattered light.
     pub fn radiance(&self, ray: &Ray, depth: u32, rng: &mut Rng) -> Rgb {
         let hit = self.scene.accel.intersect(ray);
-        let surface = hit.map_or(Rgb::ZERO, |h| self.surface_radiance(ray, &h, depth, rng));
+        // Direct light at diffuse points comes from shadow rays, so only
+        // these specular or eye rays see the sky itself.
+        let surface =
+            hit.map_or_else(|| self.scene.escaped_radiance(ray.dir), |h| self.surface_radiance(ray, &h, depth, rng));
         let media = &self.scene.media;
         if media.is_empty() {
             return surface;
         }
-        let length = hit.map_or_else(|| self.scene.diagonal() * 2.0, |h| h.t);
+        let escape = self.scene.escape_distance(ray.origin, ray.dir);
+        let length = hit.map_or_else(|| if escape.is_finite() { escape } else { self.scene.diagonal() * 2.0 }, |h| h.t);
         let along = MediaAlong::new(media, ray.origin, ray.dir, length);
         let volume = if self.settings.components.volume {
             crate::estimate::volume_radiance_along(&self.volume, media.phases(), ray.origin, ray.dir, length, |s| {
@@ -168,12 +174,19 @@ impl<'a> PhotonCpuRenderer<'a> {
         along.transmittance(length) * surface + volume
     }
 
-    /// Radiance leaving the surface at `hit` toward the ray's origin.
+    /// Radiance leaving the surface at `hit` toward the ray's origin:
+    /// emitted, plus reflected unless the surface is a light's black body.
     fn surface_radiance(&self, ray: &Ray, hit: &crate::geometry::Hit, depth: u32, rng: &mut Rng) -> Rgb {
-        let hit = *hit;
-        if let Some(light) = self.scene.emitter(&hit) {
-            return light.emitted_radiance(ray.dir, hit.geometric_normal);
+        let emitted = self.scene.emitter(hit).map_or(Rgb::ZERO, |l| l.emitted_radiance(ray.dir, hit.geometric_normal));
+        if matches!(self.scene.material(hit), Material::Emitter) {
+            return emitted;
         }
+        emitted + self.reflected_radiance(ray, hit, depth, rng)
+    }
+
+    /// Radiance the surface at `hit` reflects toward the ray's origin.
+    fn reflected_radiance(&self, ray: &Ray, hit: &crate::geometry::Hit, depth: u32, rng: &mut Rng) -> Rgb {
+        let hit = *hit;
         let can_recurse = depth < self.settings.max_specular_depth;
         let material = self.scene.material(&hit);
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
@@ -214,5 +227,111 @@ impl<'a> PhotonCpuRenderer<'a> {
         render_pixels(&self.scene.camera, self.settings.spp, self.settings.seed, progress, |ray, rng| {
             self.radiance(&ray, 0, rng)
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::photon::{TraceSettings, trace_photons};
+    use crate::progress::Silent;
+    use crate::render::path::tests::{compare, off_emitters};
+    use crate::test_scenes::{cornell_quad_light, quad_lights_as_meshes, sky_floor, sunlit_floor};
+    use glam::Vec3;
+    use std::f32::consts::PI;
+
+    fn render_with(scene: &Scene, photons: u64, seed: u64, settings: PhotonCpuSettings) -> (Image, PhotonCpuSettings) {
+        let traced = trace_photons(scene, &TraceSettings { photons, seed, ..Default::default() }, &Silent);
+        let settings = PhotonCpuSettings { seed, ..settings };
+        let (image, nonfinite) = PhotonCpuRenderer::new(scene, &traced, &settings).render(&Silent);
+        assert_eq!(nonfinite, 0);
+        (image, settings)
+    }
+
+    /// The sun's light on the floor is direct light, by shadow rays:
+    /// ρ/π · E cos θ in every pixel (its photons are all direct, or lost to
+    /// the sky or the black box), nothing in the box's shadow.
+    #[test]
+    fn a_sun_lights_a_floor_by_e_cos_theta() {
+        let scene = sunlit_floor(30.0, 3.0, 0.5, true);
+        let expected = 0.5 / PI * 3.0 * 30f32.to_radians().cos();
+        let (image, _) = render_with(&scene, 20_000, 1, PhotonCpuSettings::default());
+        for p in &image.pixels {
+            assert!((*p - Rgb::splat(expected)).abs().max_element() < 1e-4 * expected, "{p} vs {expected}");
+        }
+        let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, ..Default::default() }, &Silent);
+        let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
+        let shadowed = Vec3::new(1.5 + 0.5 * 30f32.to_radians().tan(), 0.1, 1.5);
+        let l = renderer.radiance(&Ray::new(shadowed, Vec3::NEG_Y), 0, &mut Rng::for_item(1, 0));
+        assert_eq!(l, Rgb::ZERO);
+    }
+
+    /// In absorbing fog the sun's light is attenuated from the disc its
+    /// photons leave (one radius r upstream of the floor's centre) to the
+    /// floor, and from there to the eye: e^(−σ(r + 1)) for an eye 1 above.
+    #[test]
+    fn a_sun_through_fog_is_attenuated_from_its_disc() {
+        use crate::medium::{Media, Medium, Phase};
+        let mut scene = sunlit_floor(30.0, 3.0, 0.5, false);
+        let sigma = 0.2;
+        let fog = Medium { sigma_a: Vec3::splat(sigma), sigma_s: Vec3::ZERO, phase: Phase::Schlick { k: 0.0 } };
+        scene.media = Media::homogeneous(fog);
+        let r = scene.lights[0].distant_disc().unwrap().radius;
+        let expected = 0.5 / PI * 3.0 * 30f32.to_radians().cos() * (-sigma * (r + 1.0)).exp();
+        let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+        let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
+        let l = renderer.radiance(&Ray::new(Vec3::Y, Vec3::NEG_Y), 0, &mut Rng::for_item(1, 0));
+        assert!((l - Rgb::splat(expected)).abs().max_element() < 1e-4 * expected, "{l} vs {expected}");
+    }
+
+    /// Under a sky of radiance L an open floor of albedo ρ shows ρ·L (direct
+    /// light, sampled over the sphere); the eye sees L where it looks at the
+    /// sky, and R·L in a mirror floor.
+    #[test]
+    fn a_sky_lights_an_open_floor_and_shows_in_mirrors() {
+        let scene = sky_floor(2.0, "name = \"floor\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]");
+        let settings = PhotonCpuSettings { spp: 16, area_light_samples: 16, ..Default::default() };
+        let (image, _) = render_with(&scene, 20_000, 1, settings);
+        // 65,536 sky samples of standard deviation 1.3·ρL: ±0.5%.
+        let mean = image.mean();
+        eprintln!("sky floor: {mean}");
+        assert!((mean - 1.0).abs() < 0.02, "floor radiance {mean}, expected 1");
+        let mirror = sky_floor(2.0, "name = \"floor\"\ntype = \"mirror\"\nreflectance = [0.8, 0.8, 0.8]");
+        let traced = trace_photons(&mirror, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+        let renderer = PhotonCpuRenderer::new(&mirror, &traced, &PhotonCpuSettings::default());
+        let mut rng = Rng::for_item(1, 0);
+        let down = renderer.radiance(&Ray::new(Vec3::new(0.1, 1.0, 0.2), Vec3::NEG_Y), 0, &mut rng);
+        assert!((down - Rgb::splat(1.6)).abs().max_element() < 1e-6, "{down}");
+        assert_eq!(renderer.radiance(&Ray::new(Vec3::Y, Vec3::Y), 0, &mut rng), Rgb::splat(2.0));
+    }
+
+    /// A quad light and the same triangles as an emissive mesh give the same
+    /// photon-cpu image of the Cornell box, direct light and photon maps
+    /// alike, within the spread of two quad images with different seeds.
+    #[test]
+    fn an_emissive_mesh_lights_like_the_same_quad_light() {
+        let quad = cornell_quad_light(16);
+        let mesh = quad_lights_as_meshes(&quad);
+        let settings = PhotonCpuSettings { spp: 16, ..Default::default() };
+        let (a, _) = render_with(&quad, 300_000, 1, settings.clone());
+        let (b, _) = render_with(&quad, 300_000, 2, settings.clone());
+        let (m, _) = render_with(&mesh, 300_000, 3, settings);
+        // Off the light (the pixels that see it have the noise of its
+        // covered fraction, 16 samples each): the same image within noise.
+        let mask = off_emitters(&quad);
+        let ((noise, mean_a, mean_b), (difference, _, mean_m)) = (compare(&a, &b, &mask), compare(&a, &m, &mask));
+        eprintln!(
+            "off the light: means quad {mean_a} {mean_b}, mesh {mean_m}; rms quad–quad {noise}, quad–mesh {difference}"
+        );
+        assert!(difference < 1.5 * noise, "quad–mesh {difference} vs quad–quad {noise}");
+        assert!((mean_m / mean_a - 1.0).abs() < 0.025, "mesh {mean_m} vs quad {mean_a}");
+        // The light itself, seen from below, and nothing from its back.
+        let mut rng = Rng::for_item(1, 0);
+        for (scene, seen) in [(&quad, "quad"), (&mesh, "mesh")] {
+            let traced = trace_photons(scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+            let renderer = PhotonCpuRenderer::new(scene, &traced, &PhotonCpuSettings::default());
+            let up = renderer.radiance(&Ray::new(Vec3::new(0.05, 0.5, 0.02), Vec3::Y), 0, &mut rng);
+            assert_eq!(up, Rgb::splat(12.0), "{seen}");
+        }
     }
 }

@@ -110,7 +110,7 @@ impl Scene {
                 .filter(|a| a.target == target)
                 .fold(Affine3A::IDENTITY, |m, a| a.motion.at(pose.time) * m)
         };
-        let lights: Vec<Light> =
+        let mut lights: Vec<Light> =
             pose.lights.iter().enumerate().map(|(i, light)| light.moved(&motion_of(Target::Light(i as u32)))).collect();
         // Per surface: the edit's translation, then the animations.
         let surface_motion: Vec<Affine3A> = self
@@ -142,16 +142,20 @@ impl Scene {
             .spheres()
             .map(|(sphere, s)| (Sphere { center: moved(s).transform_point3(sphere.center), radius: sphere.radius }, s))
             .unzip();
+        let accel = Accel::build(triangles, triangle_surfaces, spheres, sphere_surfaces);
+        // The sun and sky cover the scene where it now is.
+        crate::light::fit_distant_lights(&mut lights, accel.bounds());
         Scene {
             source: self.source.clone(),
             camera: self.camera.clone(),
             materials: self.materials.clone(),
             surfaces: self.surfaces.clone(),
             lights,
-            accel: Accel::build(triangles, triangle_surfaces, spheres, sphere_surfaces),
+            accel,
             media: self.media.clone(),
             names: self.names.clone(),
             animations: self.animations.clone(),
+            notes: self.notes.clone(),
         }
     }
 }
@@ -265,6 +269,27 @@ period = 2.0
         let (body, _) = moved.accel.spheres().next().unwrap();
         assert!((body.center - moved.lights[0].anchor()).length() < 1e-6, "the sphere body follows its light");
         assert!((body.center - Vec3::new(-0.5, 0.5, 0.0)).length() < 1e-6);
+    }
+
+    /// Posing refits the sun's disc to where the scene now is, and turns
+    /// the sun with its animation.
+    #[test]
+    fn a_posed_scene_refits_the_distant_lights() {
+        let text = format!(
+            "{ANIMATED}\n[[light]]\nname = \"sun\"\ntype = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = [1.0, 1.0, 1.0]\n\n[[animation]]\ntarget = \"sun\"\ntype = \"rotate\"\ncenter = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\nperiod = 4.0\n"
+        );
+        let scene = Scene::from_toml(&text, "sun.toml", None).unwrap();
+        // The block pushed 2 along +x, past the floor's edge, at t = 1.
+        let mut pose = Pose { time: 1.0, ..scene.rest_pose() };
+        pose.offsets[1] = Vec3::new(2.0, 0.0, 0.0);
+        let posed = scene.posed(&pose);
+        let Light::Directional { direction, disc, .. } = posed.lights[1] else { unreachable!() };
+        let mut refit = posed.lights.clone();
+        crate::light::fit_distant_lights(&mut refit, posed.accel.bounds());
+        assert_eq!(Some(disc), refit[1].distant_disc());
+        assert!(disc.center.x > scene.lights[1].distant_disc().unwrap().center.x + 0.01, "{disc:?}");
+        // A quarter turn about +z: −y goes to +x.
+        assert!((direction - Vec3::X).length() < 1e-5, "{direction}");
     }
 
     #[test]

@@ -23,6 +23,7 @@ pub struct SceneDesc {
     pub medium: Vec<Spanned<MediumDesc>>,
     #[serde(default)]
     pub animation: Vec<Spanned<AnimationDesc>>,
+    pub environment: Option<Spanned<EnvironmentDesc>>,
 }
 
 #[derive(Deserialize, Debug)]
@@ -66,8 +67,12 @@ pub struct ObjectDesc {
     /// Lets animations and the viewer's panel refer to the object.
     pub name: Option<String>,
     /// Spanned so that an unknown name is reported where it is written.
-    pub material: Spanned<String>,
+    /// Required, except for glTF objects, whose materials are the file's.
+    pub material: Option<Spanned<String>>,
     pub mesh: Option<String>,
+    /// A `.gltf` or `.glb` file placed as one object (its meshes,
+    /// materials, lights and emissive surfaces; its cameras are ignored).
+    pub gltf: Option<String>,
     pub shape: Option<String>,
     pub center: Option<V3>,
     pub radius: Option<f32>,
@@ -100,6 +105,16 @@ pub struct LightDesc {
     pub corner: Option<V3>,
     pub edge_u: Option<V3>,
     pub edge_v: Option<V3>,
+    /// W/m² on a surface facing a directional light.
+    pub irradiance: Option<V3>,
+}
+
+/// A uniform sky.
+#[derive(Deserialize, Debug)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    /// W/(m² sr), the same from every direction.
+    pub radiance: V3,
 }
 
 #[derive(Deserialize, Debug)]

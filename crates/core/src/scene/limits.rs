@@ -4,7 +4,7 @@
 //! The ranges are chosen so that every quantity derived from a scene stays
 //! finite in 32-bit floats: with every point within ±`MAX_COORD` the scene's
 //! bounding box, its diagonal (≤ 3.5e6), squared lengths (≤ 1.2e13), areas and
-//! light powers (≤ 1e6 · 4π² · 1e12 ≈ 4e19) are all far below f32::MAX ≈ 3.4e38,
+//! light powers (≤ 1e6 · 4π² · 3e12 ≈ 1.2e20) are all far below f32::MAX ≈ 3.4e38,
 //! and with lengths ≥ `MIN_LENGTH` no default photon radius squares to zero.
 
 /// Largest magnitude of any coordinate, in scene units: positions, corners,
@@ -19,7 +19,10 @@ pub const MIN_LENGTH: f32 = 1e-6;
 /// Smallest |edge_u × edge_v| of a quad (object or light).
 pub const MIN_QUAD_AREA: f32 = 1e-12;
 
-/// Largest component of a light's `intensity` (W/sr) or `radiance` (W/(m² sr)).
+/// Largest component of a light's `intensity` (W/sr), `radiance`
+/// (W/(m² sr); also the environment's) or `irradiance` (W/m²). The largest
+/// power, an environment's L·4π·πr² over a scene of radius r ≤ 1.75e6, is
+/// about 1.2e20 W.
 pub const MAX_EMISSION: f32 = 1e6;
 
 /// Smallest total power (mean over channels) of a light, in watts: below it a

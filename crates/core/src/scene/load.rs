@@ -1,12 +1,14 @@
 //! Turns a parsed scene description into a `Scene`, checking every value.
 
-use super::desc::{AnimationDesc, CameraDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3};
+use super::desc::{
+    AnimationDesc, CameraDesc, EnvironmentDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3,
+};
 use super::error::{SceneError, line_col};
 use super::limits::{self, MAX_COORD, MAX_EMISSION, MIN_LENGTH};
 use super::{Animation, Motion, Names, Scene, Surface, Target};
 use crate::camera::Camera;
 use crate::geometry::{Accel, Sphere, Triangle, TriangleNormals};
-use crate::light::Light;
+use crate::light::{Disc, Light};
 use crate::material::{Material, mean};
 use crate::medium::{Media, Medium, Phase, RegionMesh};
 use glam::{Mat3, Vec3};
@@ -124,18 +126,25 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         }
         Ok(Some(name.clone()))
     };
+    let mut lights = Vec::new();
     for (i, o) in desc.object.iter().enumerate() {
         let p = place(o.span(), format!("[[object]] #{}", i + 1));
         let obj = o.get_ref();
-        let material = *by_name.get(obj.material.get_ref()).ok_or_else(|| {
+        if let Some(file) = &obj.gltf {
+            let mut parts = SceneParts { materials: &mut materials, lights: &mut lights, names: &mut names };
+            load_gltf_object(obj, file, &p, base_dir, &mut geometry, &mut parts)?;
+            continue;
+        }
+        let Some(material_name) = &obj.material else { return Err(p.error("missing field `material`")) };
+        let material = *by_name.get(material_name.get_ref()).ok_or_else(|| {
             let known: Vec<&str> = desc.material.iter().map(|m| m.get_ref().name.as_str()).collect();
-            let at = place(obj.material.span(), p.context.clone());
+            let at = place(material_name.span(), p.context.clone());
             let hint = if known.is_empty() {
                 "no [[material]] is defined".to_string()
             } else {
                 format!("defined: {}", known.join(", "))
             };
-            at.error(format!("unknown material \"{}\" ({hint})", obj.material.get_ref()))
+            at.error(format!("unknown material \"{}\" ({hint})", material_name.get_ref()))
         })?;
         let surface = geometry.add_surface(Surface { material, emitter: None });
         if let Some(n) = name(&p, &obj.name, Target::Object(surface))? {
@@ -146,7 +155,6 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         geometry.check_since(start, &p)?;
     }
 
-    let mut lights = Vec::new();
     for (i, l) in desc.light.iter().enumerate() {
         let p = place(l.span(), format!("[[light]] #{}", i + 1));
         let light = load_light(l.get_ref(), &p)?;
@@ -167,12 +175,17 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         }
         lights.push(light);
     }
+    if let Some(env) = &desc.environment {
+        let p = place(env.span(), "[environment]".into());
+        lights.push(load_environment(env.get_ref(), &p)?);
+        names.lights.push(None);
+    }
     if lights.is_empty() {
         return Err(SceneError {
             file: file.into(),
             position: None,
             context: String::new(),
-            message: "the scene has no [[light]]: photon mapping needs at least one".into(),
+            message: "the scene has no [[light]] and no [environment]: photon mapping needs at least one".into(),
         });
     }
 
@@ -220,6 +233,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = geometry.triangles.into_iter().unzip();
     let (spheres, sphere_surfaces): (Vec<_>, Vec<_>) = geometry.spheres.into_iter().unzip();
     let accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
+    crate::light::fit_distant_lights(&mut lights, accel.bounds());
     Ok(Scene {
         source: file.to_string(),
         camera,
@@ -230,7 +244,67 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         media,
         names,
         animations,
+        notes: Vec::new(),
     })
+}
+
+/// What a glTF object adds to besides geometry.
+struct SceneParts<'a> {
+    materials: &'a mut Vec<Material>,
+    lights: &'a mut Vec<Light>,
+    names: &'a mut Names,
+}
+
+/// Places a glTF file's meshes, materials, lights and emissive surfaces by
+/// the object's `rotate_y`, `scale` and `translate`.
+fn load_gltf_object(
+    o: &ObjectDesc,
+    file: &str,
+    p: &Place,
+    base_dir: Option<&Path>,
+    geo: &mut GeometryBuilder,
+    parts: &mut SceneParts,
+) -> Result<(), SceneError> {
+    let given = [
+        ("name", o.name.is_some()),
+        ("material", o.material.is_some()),
+        ("mesh", o.mesh.is_some()),
+        ("shape", o.shape.is_some()),
+        ("rotate_y", o.rotate_y.is_some()),
+        ("scale", o.scale.is_some()),
+        ("translate", o.translate.is_some()),
+    ];
+    p.only("a glTF object (its materials are the file's)", &given, &["rotate_y", "scale", "translate"])?;
+    let scale = p.in_range("scale", o.scale.unwrap_or(1.0), (MIN_LENGTH, MAX_COORD))?;
+    let translate = p.coord("translate", o.translate.unwrap_or([0.0; 3]))?;
+    let degrees = p.in_range("rotate_y", o.rotate_y.unwrap_or(0.0), (-MAX_COORD, MAX_COORD))?;
+    let world_from_file = glam::Affine3A::from_scale_rotation_translation(
+        Vec3::splat(scale),
+        glam::Quat::from_rotation_y(degrees.to_radians()),
+        translate,
+    );
+    let path = base_dir.map_or_else(|| Path::new(file).to_path_buf(), |d| d.join(file));
+    let asset = super::gltf::load_asset(&path, world_from_file, None).map_err(|e| p.error(e.to_string()))?;
+    let first_material = parts.materials.len() as u32;
+    parts.materials.extend(asset.materials);
+    for (_, light) in asset.lights {
+        parts.lights.push(light);
+        parts.names.lights.push(None);
+    }
+    let start = geo.counts();
+    for primitive in asset.primitives {
+        let emitter = primitive.emitted_light().map(|light| {
+            parts.lights.push(light);
+            parts.names.lights.push(None);
+            parts.lights.len() as u32 - 1
+        });
+        let surface = geo.add_surface(Surface { material: first_material + primitive.material, emitter });
+        geo.triangles.extend(primitive.triangles.into_iter().map(|t| (t, surface)));
+    }
+    if geo.counts() == start {
+        return Err(p.error(format!("glTF file {file} has no triangle to render")));
+    }
+    geo.check_since(start, p)
 }
 
 fn load_motion(a: &AnimationDesc, p: &Place) -> Result<Motion, SceneError> {
@@ -413,7 +487,7 @@ fn load_object(
     };
     match (&o.mesh, o.shape.as_deref()) {
         (Some(_), Some(_)) => Err(p.error("give either `mesh` or `shape`, not both")),
-        (None, None) => Err(p.error("missing `mesh` or `shape`")),
+        (None, None) => Err(p.error("missing `mesh`, `shape` or `gltf`")),
         (Some(mesh), None) => {
             p.only("a mesh object", &given, &["rotate_y", "scale", "translate"])?;
             let scale = p.in_range("scale", o.scale.unwrap_or(1.0), (MIN_LENGTH, MAX_COORD))?;
@@ -607,6 +681,7 @@ fn light_from_desc(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
         ("corner", l.corner.is_some()),
         ("edge_u", l.edge_u.is_some()),
         ("edge_v", l.edge_v.is_some()),
+        ("irradiance", l.irradiance.is_some()),
     ];
     let nonzero = |field: &str, c: Vec3| {
         if c.max_element() > 0.0 { Ok(c) } else { Err(p.error(format!("`{field}` is zero: the light emits nothing"))) }
@@ -665,8 +740,29 @@ fn light_from_desc(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
                 radiance: nonzero("radiance", p.color("radiance", p.required("radiance", l.radiance)?, MAX_EMISSION)?)?,
             })
         }
-        other => Err(p.error(format!("unknown light type \"{other}\" (expected point, spot, sphere or quad)"))),
+        "directional" => {
+            p.only("a directional light", &given, &["direction", "irradiance"])?;
+            let irradiance = p.color("irradiance", p.required("irradiance", l.irradiance)?, MAX_EMISSION)?;
+            Ok(Light::Directional {
+                direction: p.direction("direction", p.required("direction", l.direction)?)?,
+                irradiance: nonzero("irradiance", irradiance)?,
+                // Fitted to the scene's bounds once they are known.
+                disc: Disc::UNIT,
+            })
+        }
+        other => {
+            Err(p.error(format!("unknown light type \"{other}\" (expected point, spot, sphere, quad or directional)")))
+        }
     }
+}
+
+/// The `[environment]` table: a uniform sky, its disc fitted later.
+fn load_environment(e: &EnvironmentDesc, p: &Place) -> Result<Light, SceneError> {
+    let radiance = p.color("radiance", e.radiance, MAX_EMISSION)?;
+    if radiance.max_element() <= 0.0 {
+        return Err(p.error("`radiance` is zero: the environment emits nothing"));
+    }
+    Ok(Light::Environment { radiance, disc: Disc::UNIT })
 }
 
 #[cfg(test)]
@@ -767,6 +863,49 @@ intensity = [1.0, 1.0, 1.0]
         assert!(e.message.contains("radius") && e.message.contains("point light"), "{e}");
         let e = err(&BASE.replace("intensity = [1.0, 1.0, 1.0]", "intensity = [0.0, 0.0, 0.0]"));
         assert!(e.message.contains("emits nothing"), "{e}");
+    }
+
+    /// A sun: its direction made unit, its disc fitted to the scene's bounds
+    /// (the unit sphere at the origin: radius √3).
+    #[test]
+    fn directional_lights_load_with_fitted_discs() {
+        let sun = "type = \"directional\"\ndirection = [0.0, -2.0, 0.0]\nirradiance = [3.0, 2.0, 1.0]";
+        let point = format!("type = \"point\"\n{POINT}");
+        let s = parse(&BASE.replace(&point, sun), "test.toml", None).unwrap();
+        let Light::Directional { direction, irradiance, disc } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
+        assert_eq!((direction, irradiance), (Vec3::NEG_Y, Vec3::new(3.0, 2.0, 1.0)));
+        assert!(disc.center.length() < 1e-6 && (disc.radius / 3f32.sqrt() - 1.0).abs() < 0.01, "{disc:?}");
+        let light = "[[light]] #1";
+        rejects(&point, &sun.replace("direction = [0.0, -2.0, 0.0]\n", ""), light, &["direction"]);
+        rejects(&point, &sun.replace("\nirradiance = [3.0, 2.0, 1.0]", ""), light, &["irradiance"]);
+        rejects(&point, &sun.replace("[0.0, -2.0, 0.0]", "[0.0, 0.0, 0.0]"), light, &["direction", "zero"]);
+        rejects(&point, &sun.replace("[3.0, 2.0, 1.0]", "[2e6, 0.0, 0.0]"), light, &["irradiance", "above"]);
+        rejects(&point, &sun.replace("[3.0, 2.0, 1.0]", "[0.0, 0.0, 0.0]"), light, &["irradiance", "nothing"]);
+        rejects(&point, &format!("{sun}\nradius = 1.0"), light, &["radius", "directional"]);
+        rejects(&point, &sun.replace("directional", "sun"), light, &["directional"]);
+    }
+
+    /// An `[environment]` alone lights a scene; bad radiance is located.
+    #[test]
+    fn an_environment_is_a_light() {
+        let text = BASE.split("[[light]]").next().unwrap().to_string();
+        let sky = |radiance: &str| format!("{text}[environment]\nradiance = {radiance}\n");
+        let s = parse(&sky("[0.5, 1.0, 2.0]"), "test.toml", None).unwrap();
+        let Light::Environment { radiance, disc } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
+        assert_eq!(radiance, Vec3::new(0.5, 1.0, 2.0));
+        assert!((disc.radius / 3f32.sqrt() - 1.0).abs() < 0.01, "{disc:?}");
+        assert_eq!(s.names.lights, vec![None]);
+        // With a [[light]] too: both, the sky last.
+        let s = parse(&format!("{BASE}\n[environment]\nradiance = [1.0, 1.0, 1.0]\n"), "test.toml", None).unwrap();
+        assert!(matches!(s.lights[..], [Light::Point { .. }, Light::Environment { .. }]));
+        for (radiance, words) in
+            [("[-1.0, 1.0, 1.0]", "negative"), ("[0.0, 0.0, 0.0]", "nothing"), ("[1e7, 1.0, 1.0]", "above")]
+        {
+            let e = err(&sky(radiance));
+            assert!(e.context == "[environment]" && e.position.is_some() && e.message.contains(words), "{e}");
+        }
+        let e = err(&format!("{text}[environment]\nradiance = [1.0, 1.0, 1.0]\nturbidity = 2.0\n"));
+        assert!(e.message.contains("turbidity"), "{e}");
     }
 
     #[test]

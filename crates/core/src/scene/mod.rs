@@ -1,15 +1,19 @@
 //! The scene: camera, materials, surfaces, lights and the BVH over them,
-//! loaded from a TOML file (docs/scene-format.md) or a built-in scene.
+//! loaded from a TOML file (docs/scene-format.md), a glTF 2.0 file
+//! (`gltf`) or a built-in scene. Loaders are front ends: nothing past them
+//! knows which format a scene came from.
 
 mod animation;
 pub mod builtin;
 mod desc;
 mod error;
+pub mod gltf;
 pub mod limits;
 mod load;
 
 pub use animation::{Animation, Motion, Names, Pose, Target};
 pub use error::SceneError;
+pub use gltf::LoadOptions;
 
 use crate::camera::Camera;
 use crate::geometry::{Accel, Hit};
@@ -39,18 +43,31 @@ pub struct Scene {
     pub names: Names,
     /// How lights and objects move (`posed`); empty for a still scene.
     pub animations: Vec<Animation>,
+    /// One-line notes from the loader on what it ignored, approximated or
+    /// added (a glTF file's unused extensions, a default light or camera).
+    pub notes: Vec<String>,
 }
 
 impl Scene {
-    /// Loads a built-in scene by name, or else a `.toml` file at that path.
+    /// Loads a built-in scene by name, or else a `.toml`, `.gltf` or `.glb`
+    /// file at that path.
     pub fn load(spec: &str) -> Result<Scene, SceneError> {
+        Self::load_with(spec, &LoadOptions::default())
+    }
+
+    /// [`Scene::load`] with options (the camera of a glTF file).
+    pub fn load_with(spec: &str, options: &LoadOptions) -> Result<Scene, SceneError> {
         match builtin::source(spec) {
             Some(text) => load::parse(text, &format!("builtin:{spec}"), None),
+            None if gltf::is_gltf(Path::new(spec)) => gltf::load_scene(Path::new(spec), options),
             None => Self::from_file(Path::new(spec)),
         }
     }
 
     pub fn from_file(path: &Path) -> Result<Scene, SceneError> {
+        if gltf::is_gltf(path) {
+            return gltf::load_scene(path, &LoadOptions::default());
+        }
         let name = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {
             file: name.clone(),
@@ -81,6 +98,21 @@ impl Scene {
     /// Scene size used to derive default radii and offsets.
     pub fn diagonal(&self) -> f32 {
         self.accel.diagonal()
+    }
+
+    /// How far a ray (eye ray or photon) from `origin` along `dir` that hits
+    /// nothing still travels through the media: to the plane of the disc
+    /// that the distant lights' photons of the opposite direction start
+    /// from (`Disc::reach`, also where shadow rays toward them end), so that
+    /// both renderers and the photons see the same fog; forever in a scene
+    /// without distant lights.
+    pub fn escape_distance(&self, origin: glam::Vec3, dir: glam::Vec3) -> f32 {
+        self.lights.iter().find_map(Light::distant_disc).map_or(f32::INFINITY, |disc| disc.reach(origin, dir))
+    }
+
+    /// Radiance reaching the origin of a ray that hits nothing: the sky's.
+    pub fn escaped_radiance(&self, dir: glam::Vec3) -> crate::material::Rgb {
+        self.lights.iter().map(|l| l.escaped_radiance(dir)).sum()
     }
 
     /// Probability of emitting each photon from each light: proportional to

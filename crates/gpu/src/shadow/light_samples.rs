@@ -130,6 +130,9 @@ impl GpuLights {
                         out.add_sample(p, None, far);
                     }
                 }
+                // Refused before any pass is built (`renderer::unsupported_lights`);
+                // skipped here so that sizing a frame never panics.
+                Light::Directional { .. } | Light::Environment { .. } | Light::Mesh(_) => continue,
                 Light::Quad { corner, edge_u, edge_v, radiance } => {
                     record = GpuLight {
                         position: corner.to_array(),

@@ -175,6 +175,10 @@ fn trace_light(light: &Light, power: Rgb, probability: f32) -> TraceLight {
             out.edge_v = edge_v.to_array();
             out.normal = edge_u.cross(edge_v).normalize().to_array();
         }
+        // `GpuTracer::new` and `set_scene` refuse such scenes first.
+        Light::Directional { .. } | Light::Environment { .. } | Light::Mesh(_) => {
+            unreachable!("{}", crate::renderer::UNSUPPORTED_LIGHTS)
+        }
     }
     out
 }
@@ -328,6 +332,9 @@ pub struct GpuTracer {
 
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
+        if let Some(why) = crate::renderer::unsupported_lights(scene) {
+            return Err(GpuError::SceneUnsupported(why));
+        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -411,6 +418,9 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
+        if let Some(why) = crate::renderer::unsupported_lights(scene) {
+            return Err(GpuError::SceneUnsupported(why));
+        }
         let scene = ctx.scoped(|| TraceScene::upload(&ctx.device, scene))?;
         self.scene = scene;
         // The bind groups hold the old scene's buffers.

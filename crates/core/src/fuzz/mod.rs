@@ -20,6 +20,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 use toml::{Table, Value};
 
+pub mod gltf;
+
 /// Renders a scene (already at its tiny test size); returns the image and
 /// the number of samples the renderer dropped as non-finite.
 pub type RenderFn<'a> = Box<dyn Fn(&Scene) -> (Image, u64) + 'a>;
@@ -74,13 +76,18 @@ pub fn check_text(
     slow: Duration,
 ) -> Result<Outcome, String> {
     let loaded = guarded(|| Scene::from_toml(text, name, base_dir)).map_err(|p| format!("loader panicked: {p}"))?;
-    let mut scene = match loaded {
+    let scene = match loaded {
         Err(e) if e.position.is_none() && !e.message.contains("no [[light]]") => {
             return Err(format!("loader error without a position: {e}"));
         }
         Err(e) => return Ok(Outcome::Rejected(e)),
         Ok(scene) => scene,
     };
+    render_all(scene, renderers, slow)
+}
+
+/// Renders a loaded `scene` at `SIZE`×`SIZE` with each renderer (see `check_text`).
+fn render_all(mut scene: Scene, renderers: &[Renderer], slow: Duration) -> Result<Outcome, String> {
     scene.camera = scene.camera.with_resolution(SIZE, SIZE).map_err(|e| format!("camera: {e}"))?;
     for r in renderers {
         let start = Instant::now();

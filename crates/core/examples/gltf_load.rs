@@ -1,0 +1,83 @@
+//! Loading a large glTF file: `cargo run --release -p hikari-core --example
+//! gltf_load -- [triangles] [photons]`. Writes a wavy grid of about that many
+//! triangles (default 1,000,000) under a point light as a `.glb`, then
+//! times `Scene::load` (parse, accessors, transforms, BVH build), reports
+//! the resident memory it added per triangle, and the photon-tracing rate
+//! on it beside cornell-box's.
+
+use glam::Vec3;
+use gltf::json;
+use gltf::json::extensions::scene::khr_lights_punctual::Type;
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::scene::Scene;
+use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial};
+use std::time::Instant;
+
+/// Resident set size of this process, bytes (Linux).
+fn rss() -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("VmRSS:"))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+        .map_or(0, |kb| kb * 1024)
+}
+
+fn rate(scene: &Scene, photons: u64) -> f64 {
+    let start = Instant::now();
+    trace_photons(scene, &TraceSettings { photons, seed: 1, ..Default::default() }, &Silent);
+    photons as f64 / start.elapsed().as_secs_f64() / 1e6
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let triangles: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
+    let photons: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
+    // An n×n grid of quads (two triangles each) over [-1, 1]², heights a gentle wave.
+    let n = ((triangles as f64 / 2.0).sqrt().ceil() as u32).max(1);
+    let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, z) = (2.0 * i as f32 / n as f32 - 1.0, 2.0 * j as f32 / n as f32 - 1.0);
+            positions.push(Vec3::new(x, 0.05 * (9.0 * x).sin() * (7.0 * z).cos(), z));
+        }
+    }
+    let mut indices = Vec::with_capacity((6 * n * n) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+            indices.extend([a, c, b, b, c, d]);
+        }
+    }
+    let mut builder = GltfBuilder::new();
+    let material = builder.material(&PbrMaterial { base_color: Vec3::splat(0.7), ..Default::default() });
+    let mesh = builder.mesh(&positions, None, Some(&indices), Some(material));
+    let grid = builder.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let light = builder.light(Type::Point, Vec3::ONE, 2000.0, None);
+    let light = builder.node(GltfBuilder::light_node(light, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY));
+    let glb = builder.to_glb(vec![grid, light]);
+    let path = std::env::temp_dir().join(format!("hikari-grid-{}.glb", std::process::id()));
+    std::fs::write(&path, &glb).expect("write the grid");
+    drop(glb);
+
+    let before = rss();
+    let start = Instant::now();
+    let scene = Scene::load(path.to_str().unwrap()).expect("the grid loads");
+    let secs = start.elapsed().as_secs_f64();
+    let added = rss().saturating_sub(before);
+    let count = scene.accel.triangle_count();
+    println!(
+        "{count} triangles ({:.1} MB .glb): loaded with BVH in {secs:.2} s, {:.0} bytes resident per triangle",
+        std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6),
+        added as f64 / count as f64
+    );
+    let _ = std::fs::remove_file(&path);
+    let cornell = Scene::load("cornell-box").unwrap();
+    let (big, small) = (rate(&scene, photons), rate(&cornell, photons));
+    println!(
+        "photon tracing: {big:.2} M paths/s on the grid, {small:.2} M paths/s on cornell-box ({:.0}%)",
+        100.0 * big / small
+    );
+}

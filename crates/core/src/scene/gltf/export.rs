@@ -1,0 +1,387 @@
+//! Writing glTF 2.0 (`.glb`) with the `gltf-json` crate: a small builder
+//! for tests and for the scripts that make the example scenes, and
+//! [`scene_to_glb`], which writes a hikari scene of triangles as glTF (so a
+//! test can load the same scene from both formats and compare the images).
+
+use super::LUMENS_PER_WATT;
+use crate::light::Light;
+use crate::material::{Material, Rgb};
+use crate::scene::Scene;
+use glam::{Mat3, Quat, Vec3};
+use gltf::json::{self, Index, validation::Checked::Valid, validation::USize64};
+
+/// A glTF material in the metallic–roughness model.
+#[derive(Clone, Debug)]
+pub struct PbrMaterial {
+    pub name: String,
+    pub base_color: Rgb,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Radiance, W/(m² sr): written as `emissiveFactor` (at most 1 per
+    /// channel) × `KHR_materials_emissive_strength`.
+    pub emission: Rgb,
+    /// Smooth glass with this index of refraction (`KHR_materials_transmission`).
+    pub glass_ior: Option<f32>,
+    pub double_sided: bool,
+}
+
+impl Default for PbrMaterial {
+    fn default() -> Self {
+        PbrMaterial {
+            name: String::new(),
+            base_color: Rgb::ONE,
+            metallic: 0.0,
+            roughness: 1.0,
+            emission: Rgb::ZERO,
+            glass_ior: None,
+            double_sided: true,
+        }
+    }
+}
+
+/// Builds a glTF document whose binary data lives in one buffer (the `.glb`'s).
+#[derive(Default)]
+pub struct GltfBuilder {
+    pub root: json::Root,
+    bin: Vec<u8>,
+    lights: Vec<json::extensions::scene::khr_lights_punctual::Light>,
+}
+
+impl GltfBuilder {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Appends `data` to the binary buffer as a view and returns an accessor over it.
+    fn accessor(
+        &mut self,
+        data: &[u8],
+        count: usize,
+        ty: json::accessor::Type,
+        component: json::accessor::ComponentType,
+        bounds: Option<(Vec3, Vec3)>,
+    ) -> Index<json::Accessor> {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let view = self.root.push(json::buffer::View {
+            buffer: Index::new(0),
+            byte_length: USize64::from(data.len()),
+            byte_offset: Some(USize64::from(self.bin.len())),
+            byte_stride: None,
+            name: None,
+            target: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.bin.extend_from_slice(data);
+        let (min, max) = match bounds {
+            Some((lo, hi)) => (
+                Some(json::serialize::to_value(lo.to_array()).unwrap()),
+                Some(json::serialize::to_value(hi.to_array()).unwrap()),
+            ),
+            None => (None, None),
+        };
+        self.root.push(json::Accessor {
+            buffer_view: Some(view),
+            byte_offset: None,
+            count: USize64::from(count),
+            component_type: Valid(json::accessor::GenericComponentType(component)),
+            extensions: None,
+            extras: Default::default(),
+            type_: Valid(ty),
+            min,
+            max,
+            name: None,
+            normalized: false,
+            sparse: None,
+        })
+    }
+
+    pub fn material(&mut self, m: &PbrMaterial) -> Index<json::Material> {
+        let strength = m.emission.max_element().max(1.0);
+        let mut extensions = json::extensions::material::Material::default();
+        if strength > 1.0 {
+            extensions.emissive_strength = Some(json::extensions::material::EmissiveStrength {
+                emissive_strength: json::extensions::material::EmissiveStrengthFactor(strength),
+            });
+        }
+        if let Some(ior) = m.glass_ior {
+            extensions.transmission = Some(json::extensions::material::Transmission {
+                transmission_factor: json::extensions::material::TransmissionFactor(1.0),
+                transmission_texture: None,
+                extras: Default::default(),
+            });
+            extensions.ior = Some(json::extensions::material::Ior {
+                ior: json::extensions::material::IndexOfRefraction(ior),
+                extras: Default::default(),
+            });
+        }
+        let [r, g, b] = m.base_color.to_array();
+        self.root.push(json::Material {
+            name: Some(m.name.clone()),
+            double_sided: m.double_sided,
+            pbr_metallic_roughness: json::material::PbrMetallicRoughness {
+                base_color_factor: json::material::PbrBaseColorFactor([r, g, b, 1.0]),
+                metallic_factor: json::material::StrengthFactor(m.metallic),
+                roughness_factor: json::material::StrengthFactor(m.roughness),
+                ..Default::default()
+            },
+            emissive_factor: json::material::EmissiveFactor((m.emission / strength).to_array()),
+            extensions: Some(extensions),
+            ..Default::default()
+        })
+    }
+
+    /// A mesh of one primitive: `positions`, optional `normals`, optional
+    /// `indices` (else every three positions are a triangle).
+    pub fn mesh(
+        &mut self,
+        positions: &[Vec3],
+        normals: Option<&[Vec3]>,
+        indices: Option<&[u32]>,
+        material: Option<Index<json::Material>>,
+    ) -> Index<json::Mesh> {
+        use json::accessor::{ComponentType, Type};
+        let bounds = positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let pos = self.accessor(
+            bytemuck::cast_slice(positions),
+            positions.len(),
+            Type::Vec3,
+            ComponentType::F32,
+            Some(bounds),
+        );
+        let mut attributes = std::collections::BTreeMap::new();
+        attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+        if let Some(n) = normals {
+            let acc = self.accessor(bytemuck::cast_slice(n), n.len(), Type::Vec3, ComponentType::F32, None);
+            attributes.insert(Valid(json::mesh::Semantic::Normals), acc);
+        }
+        let indices =
+            indices.map(|i| self.accessor(bytemuck::cast_slice(i), i.len(), Type::Scalar, ComponentType::U32, None));
+        self.root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: None,
+            primitives: vec![json::mesh::Primitive {
+                attributes,
+                extensions: None,
+                extras: Default::default(),
+                indices,
+                material,
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+            }],
+            weights: None,
+        })
+    }
+
+    /// A `KHR_lights_punctual` light in the file's units (cd or lux).
+    pub fn light(
+        &mut self,
+        kind: json::extensions::scene::khr_lights_punctual::Type,
+        color: Rgb,
+        intensity: f32,
+        spot: Option<(f32, f32)>,
+    ) -> u32 {
+        use json::extensions::scene::khr_lights_punctual as k;
+        self.lights.push(k::Light {
+            color: color.to_array(),
+            extensions: None,
+            extras: Default::default(),
+            intensity,
+            name: None,
+            range: None,
+            spot: spot.map(|(inner, outer)| k::Spot { inner_cone_angle: inner, outer_cone_angle: outer }),
+            type_: Valid(kind),
+        });
+        self.lights.len() as u32 - 1
+    }
+
+    /// A perspective camera (`yfov` in radians).
+    pub fn camera(&mut self, yfov: f32, aspect: Option<f32>) -> Index<json::Camera> {
+        self.root.push(json::Camera {
+            name: None,
+            orthographic: None,
+            perspective: Some(json::camera::Perspective {
+                aspect_ratio: aspect,
+                yfov,
+                zfar: None,
+                znear: 0.01,
+                extensions: None,
+                extras: Default::default(),
+            }),
+            type_: Valid(json::camera::Type::Perspective),
+            extensions: None,
+            extras: Default::default(),
+        })
+    }
+
+    pub fn node(&mut self, node: json::Node) -> Index<json::Node> {
+        self.root.push(node)
+    }
+
+    /// A node carrying light `light` (from [`GltfBuilder::light`]).
+    pub fn light_node(light: u32, translation: Vec3, rotation: Quat) -> json::Node {
+        json::Node {
+            translation: Some(translation.to_array()),
+            rotation: Some(json::scene::UnitQuaternion(rotation.to_array())),
+            extensions: Some(json::extensions::scene::Node {
+                khr_lights_punctual: Some(json::extensions::scene::khr_lights_punctual::KhrLightsPunctual {
+                    light: Index::new(light),
+                }),
+                ..Default::default()
+            }),
+            ..Default::default()
+        }
+    }
+
+    /// Makes `roots` the default scene and serialises everything as `.glb`.
+    pub fn to_glb(self, roots: Vec<Index<json::Node>>) -> Vec<u8> {
+        let (root, bin) = self.finish(roots);
+        glb(&root, bin)
+    }
+
+    /// Makes `roots` the default scene: the finished document, whose buffer 0
+    /// is the returned bytes (without a `uri`: a `.glb`'s binary chunk).
+    pub fn finish(mut self, roots: Vec<Index<json::Node>>) -> (json::Root, Vec<u8>) {
+        let scene =
+            self.root.push(json::Scene { extensions: None, extras: Default::default(), name: None, nodes: roots });
+        self.root.scene = Some(scene);
+        self.root.asset.generator = Some("hikari".into());
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        self.root.buffers.push(json::Buffer {
+            byte_length: USize64::from(self.bin.len()),
+            name: None,
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        if !self.lights.is_empty() {
+            self.root.extensions_used.push("KHR_lights_punctual".into());
+            let mut ext = self.root.extensions.take().unwrap_or_default();
+            ext.khr_lights_punctual =
+                Some(json::extensions::root::KhrLightsPunctual { lights: std::mem::take(&mut self.lights) });
+            self.root.extensions = Some(ext);
+        }
+        for m in &self.root.materials {
+            let ext = m.extensions.as_ref();
+            for (used, name) in [
+                (ext.is_some_and(|e| e.transmission.is_some()), "KHR_materials_transmission"),
+                (ext.is_some_and(|e| e.ior.is_some()), "KHR_materials_ior"),
+                (ext.is_some_and(|e| e.emissive_strength.is_some()), "KHR_materials_emissive_strength"),
+            ] {
+                if used && !self.root.extensions_used.iter().any(|e| e == name) {
+                    self.root.extensions_used.push(name.into());
+                }
+            }
+        }
+        (self.root, self.bin)
+    }
+}
+
+/// `root` and its binary chunk as a `.glb` file.
+pub fn glb(root: &json::Root, bin: Vec<u8>) -> Vec<u8> {
+    let json = root.to_vec().expect("a glTF document serialises");
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header { magic: *b"glTF", version: 2, length: 0 },
+        json: json.into(),
+        bin: Some(bin.into()),
+    };
+    glb.to_vec().expect("a .glb serialises")
+}
+
+/// The rotation that turns a glTF camera or light (looking down −z, +y up)
+/// to look along `forward` with `up` as up.
+pub fn looking(forward: Vec3, up: Vec3) -> Quat {
+    let back = -forward.normalize();
+    let right = up.cross(back).normalize();
+    Quat::from_mat3(&Mat3::from_cols(right, back.cross(right), back))
+}
+
+/// Writes `scene` as a `.glb`: each surface's triangles as a mesh with its
+/// material, point, spot and directional lights as `KHR_lights_punctual`
+/// (× 683: cd, lux), quad lights as emissive quads, the camera. Fails on what glTF
+/// cannot hold (analytic spheres, media, sphere lights, animations).
+pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
+    if scene.accel.sphere_count() > 0 {
+        return Err("analytic spheres have no glTF form".into());
+    }
+    if !scene.media.is_empty() {
+        return Err("participating media have no glTF form".into());
+    }
+    let mut b = GltfBuilder::new();
+    let mut roots = Vec::new();
+    for (s, surface) in scene.surfaces.iter().enumerate() {
+        let positions: Vec<Vec3> =
+            scene.accel.triangles().filter(|(_, id)| *id == s as u32).flat_map(|(t, _)| t.v).collect();
+        if positions.is_empty() {
+            continue;
+        }
+        let material = match (&scene.materials[surface.material as usize], surface.emitter) {
+            (Material::Emitter, Some(l)) => PbrMaterial {
+                base_color: Rgb::ZERO,
+                emission: scene.lights[l as usize].emission(),
+                double_sided: false,
+                ..Default::default()
+            },
+            (Material::Diffuse { albedo, specular }, _) if *specular == Rgb::ZERO => {
+                PbrMaterial { base_color: *albedo, ..Default::default() }
+            }
+            (Material::Mirror { reflectance }, _) => {
+                PbrMaterial { base_color: *reflectance, metallic: 1.0, roughness: 0.0, ..Default::default() }
+            }
+            (Material::Glass { ior }, _) => PbrMaterial { roughness: 0.0, glass_ior: Some(*ior), ..Default::default() },
+            (other, _) => return Err(format!("material {other:?} has no glTF form")),
+        };
+        let material = b.material(&PbrMaterial { name: format!("surface{s}"), ..material });
+        let mesh = b.mesh(&positions, None, None, Some(material));
+        roots.push(b.node(json::Node { mesh: Some(mesh), ..Default::default() }));
+    }
+    use json::extensions::scene::khr_lights_punctual::Type;
+    for light in &scene.lights {
+        let node = match *light {
+            Light::Point { position, intensity } => {
+                let l = b.light(Type::Point, Rgb::ONE, 0.0, None);
+                set_intensity(&mut b, l, intensity);
+                GltfBuilder::light_node(l, position, Quat::IDENTITY)
+            }
+            Light::Spot { position, axis, intensity, cutoff, falloff_start } => {
+                let l = b.light(Type::Spot, Rgb::ONE, 0.0, Some((falloff_start, cutoff)));
+                set_intensity(&mut b, l, intensity);
+                let up = if axis.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+                GltfBuilder::light_node(l, position, looking(axis, up))
+            }
+            Light::Directional { direction, irradiance, .. } => {
+                let l = b.light(Type::Directional, Rgb::ONE, 0.0, None);
+                set_intensity(&mut b, l, irradiance);
+                let up = if direction.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+                GltfBuilder::light_node(l, Vec3::ZERO, looking(direction, up))
+            }
+            Light::Quad { .. } => continue, // written above as an emissive surface
+            _ => return Err("only point, spot, directional and quad lights are exported".into()),
+        };
+        roots.push(b.node(node));
+    }
+    let c = &scene.camera;
+    let (forward, _, up, _) = c.basis();
+    let camera = b.camera(c.fov_y.to_radians(), Some(c.aspect()));
+    roots.push(b.node(json::Node {
+        camera: Some(camera),
+        translation: Some(c.position.to_array()),
+        rotation: Some(json::scene::UnitQuaternion(looking(forward, up).to_array())),
+        ..Default::default()
+    }));
+    Ok(b.to_glb(roots))
+}
+
+/// Writes a radiometric intensity (W/sr) or irradiance (W/m²) as glTF's
+/// colour × candela or lux.
+fn set_intensity(b: &mut GltfBuilder, light: u32, intensity: Rgb) {
+    let peak = intensity.max_element();
+    let l = &mut b.lights[light as usize];
+    l.color = if peak > 0.0 { (intensity / peak).to_array() } else { [1.0; 3] };
+    l.intensity = peak * LUMENS_PER_WATT;
+}

@@ -1,0 +1,598 @@
+//! The glTF 2.0 front end: a `.gltf` (with its buffers) or `.glb` file
+//! turned into the parts a [`Scene`](super::Scene) is made of: world-space
+//! triangles per node and primitive, materials, lights and a camera.
+//! What is read, approximated and refused is listed in
+//! docs/scene-format.md ("glTF files").
+//!
+//! Every problem is a [`SceneError`] naming the file and the glTF path of
+//! the culprit (`meshes[3].primitives[0].attributes.POSITION`).
+
+mod accessors;
+pub mod export;
+mod materials;
+
+use super::SceneError;
+use super::limits::MAX_COORD;
+use crate::geometry::{Triangle, TriangleNormals};
+use crate::light::Light;
+use crate::material::{Material, Rgb};
+use glam::{Affine3A, Mat3, Mat4, Vec3};
+use gltf::accessor::DataType;
+use gltf::mesh::Mode;
+use std::collections::HashMap;
+use std::path::Path;
+
+pub use materials::Emission;
+
+/// glTF's photometric units to radiometric ones: 683 lm/W, the luminous
+/// efficacy at 555 nm that defines the candela (docs/scene-format.md).
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+/// Extensions whose meaning hikari reads; a file that requires any other is
+/// refused, one that merely uses another is loaded with a note.
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_transmission"];
+
+/// A glTF file in world space.
+pub struct Asset {
+    /// One per glTF material, then the specification's default material
+    /// (for primitives without one) last.
+    pub materials: Vec<Material>,
+    pub primitives: Vec<Primitive>,
+    /// Each light with its node's name.
+    pub lights: Vec<(Option<String>, Light)>,
+    /// The chosen camera, if the file has one.
+    pub camera: Option<CameraPose>,
+    /// One-line notes on what was ignored or approximated.
+    pub notes: Vec<String>,
+}
+
+/// The triangles of one primitive under one node (a mesh under several
+/// nodes gives one `Primitive` per node: instancing).
+pub struct Primitive {
+    /// The node's name (for the viewer and animations), if it has one.
+    pub name: Option<String>,
+    pub triangles: Vec<Triangle>,
+    /// Index into [`Asset::materials`].
+    pub material: u32,
+    /// Light the surface emits, from its material.
+    pub emission: Option<Emission>,
+}
+
+impl Primitive {
+    /// The light an emissive primitive is (its triangles emitting its
+    /// material's radiance); None for others and for ones without area.
+    pub fn emitted_light(&self) -> Option<Light> {
+        let e = self.emission?;
+        let mesh =
+            crate::light::EmissiveMesh::new(self.triangles.iter().map(|t| t.v).collect(), e.radiance, e.two_sided)?;
+        Some(Light::Mesh(std::sync::Arc::new(mesh)))
+    }
+}
+
+/// A perspective camera placed by its node.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraPose {
+    pub position: Vec3,
+    pub forward: Vec3,
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub fov_y: f32,
+    /// Width / height, when the file gives it.
+    pub aspect: Option<f32>,
+}
+
+/// Is `path` a glTF file (by its extension)?
+pub fn is_gltf(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
+}
+
+fn error(file: &str, context: impl Into<String>, message: impl Into<String>) -> SceneError {
+    SceneError { file: file.to_string(), position: None, context: context.into(), message: message.into() }
+}
+
+/// Reads `path` and places its default scene by `world_from_file`.
+/// `camera` picks a camera by name (else the first perspective one).
+pub fn load_asset(path: &Path, world_from_file: Affine3A, camera: Option<&str>) -> Result<Asset, SceneError> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| error(&file, "", format!("cannot read glTF file: {e}")))?;
+    let binary_name = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if binary_name && !bytes.starts_with(b"glTF") {
+        return Err(error(&file, "", "not a binary glTF file: it does not start with the `glTF` magic bytes"));
+    }
+    asset_from_bytes(&bytes, &file, path.parent(), world_from_file, camera)
+}
+
+/// [`load_asset`] of a file's bytes, named `file` in errors; buffers given
+/// as relative paths are read from `base` (none: such a file is an error).
+pub fn asset_from_bytes(
+    bytes: &[u8],
+    file: &str,
+    base: Option<&Path>,
+    world_from_file: Affine3A,
+    camera: Option<&str>,
+) -> Result<Asset, SceneError> {
+    let file = file.to_string();
+    let gltf = parse(bytes, &file)?;
+    let buffers = load_buffers(&gltf, base, &file)?;
+    let mut notes = Vec::new();
+    check_extensions(&gltf.document, &file, &mut notes)?;
+    let (materials, emissions) = materials::convert(&gltf.document, &mut notes);
+    let mut walk = Walk {
+        file: &file,
+        buffers: &buffers,
+        emissions: &emissions,
+        camera_name: camera,
+        cache: HashMap::new(),
+        asset: Asset { materials, primitives: Vec::new(), lights: Vec::new(), camera: None, notes },
+        visited: vec![false; gltf.document.nodes().len()],
+        ignored_range: false,
+    };
+    let scene = gltf
+        .document
+        .default_scene()
+        .or_else(|| gltf.document.scenes().next())
+        .ok_or_else(|| error(&file, "scenes", "the file has no scene to render"))?;
+    let world = Mat4::from(world_from_file);
+    for node in scene.nodes() {
+        walk.node(&node, world)?;
+    }
+    if let Some(name) = camera
+        && walk.asset.camera.is_none()
+    {
+        let names: Vec<&str> = gltf
+            .document
+            .nodes()
+            .filter(|n| n.camera().is_some())
+            .flat_map(|n| [n.name(), n.camera().and_then(|c| c.name())])
+            .flatten()
+            .collect();
+        return Err(error(
+            &file,
+            "cameras",
+            format!("no perspective camera named \"{name}\" is placed in the scene (cameras: {})", names.join(", ")),
+        ));
+    }
+    if walk.ignored_range {
+        walk.asset.notes.push("light `range` is ignored: lights fall off physically, as 1/d²".into());
+    }
+    Ok(walk.asset)
+}
+
+/// Parses and validates the JSON (of a `.gltf`, or of a `.glb`'s first chunk).
+fn parse(bytes: &[u8], file: &str) -> Result<gltf::Gltf, SceneError> {
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| match e {
+        gltf::Error::Deserialize(json) => SceneError {
+            file: file.to_string(),
+            position: (json.line() > 0).then(|| (json.line(), json.column())),
+            context: String::new(),
+            message: format!("invalid glTF JSON: {json}"),
+        },
+        gltf::Error::Binary(b) => error(file, "", format!("not a valid binary glTF (.glb): {b}")),
+        other => error(file, "", other.to_string()),
+    })?;
+    let root = document.into_json();
+    check_position_indices(&root, file)?;
+    let document = gltf::Document::from_json(root).map_err(|e| match e {
+        gltf::Error::Validation(problems) => {
+            let (path, problem) = &problems[0];
+            let more =
+                if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
+            error(file, path.to_string(), format!("{problem}{more}"))
+        }
+        other => error(file, "", other.to_string()),
+    })?;
+    Ok(gltf::Gltf { document, blob })
+}
+
+/// The `gltf-json` crate's validation reads each primitive's `POSITION`
+/// accessor before checking that it exists (and panics when it does not),
+/// so that index is checked first.
+fn check_position_indices(root: &gltf::json::Root, file: &str) -> Result<(), SceneError> {
+    let positions = gltf::json::validation::Checked::Valid(gltf::json::mesh::Semantic::Positions);
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive.attributes.get(&positions)
+                && index.value() >= root.accessors.len()
+            {
+                return Err(error(
+                    file,
+                    format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
+                    format!("accessor {} does not exist ({} accessors)", index.value(), root.accessors.len()),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Every buffer's bytes, from the `.glb`'s binary chunk, a data URI or a
+/// file beside the glTF file.
+fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>, file: &str) -> Result<Vec<gltf::buffer::Data>, SceneError> {
+    let mut blob = gltf.blob.clone();
+    let mut out = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let at = format!("buffers[{}]", buffer.index());
+        let what = match buffer.source() {
+            gltf::buffer::Source::Bin => "the .glb's binary chunk".to_string(),
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => "its data URI".to_string(),
+            gltf::buffer::Source::Uri(uri) => format!("\"{uri}\""),
+        };
+        let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), base, &mut blob)
+            .map_err(|e| error(file, &at, format!("cannot read {what}: {e}")))?;
+        if data.len() < buffer.length() {
+            return Err(error(
+                file,
+                &at,
+                format!(
+                    "{what} holds {} bytes, fewer than its byteLength {} (truncated?)",
+                    data.len(),
+                    buffer.length()
+                ),
+            ));
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+fn check_extensions(doc: &gltf::Document, file: &str, notes: &mut Vec<String>) -> Result<(), SceneError> {
+    for (i, ext) in doc.extensions_required().enumerate() {
+        if !SUPPORTED_EXTENSIONS.contains(&ext) {
+            return Err(error(
+                file,
+                format!("extensionsRequired[{i}]"),
+                format!(
+                    "the file requires extension {ext}, which hikari does not support (supported: {})",
+                    SUPPORTED_EXTENSIONS.join(", ")
+                ),
+            ));
+        }
+    }
+    let ignored: Vec<&str> = doc.extensions_used().filter(|e| !SUPPORTED_EXTENSIONS.contains(e)).collect();
+    if !ignored.is_empty() {
+        notes.push(format!("optional glTF extensions ignored: {}", ignored.join(", ")));
+    }
+    Ok(())
+}
+
+/// A primitive's triangles in the file's own space, shared by every node
+/// that instances its mesh.
+struct LocalPrimitive {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    /// Three vertex indices per triangle.
+    triangles: Vec<[u32; 3]>,
+    material: u32,
+}
+
+/// The traversal of the node hierarchy.
+struct Walk<'a> {
+    file: &'a str,
+    buffers: &'a [gltf::buffer::Data],
+    emissions: &'a [Option<Emission>],
+    camera_name: Option<&'a str>,
+    /// (mesh, primitive) → its triangles, read once.
+    cache: HashMap<(usize, usize), std::rc::Rc<LocalPrimitive>>,
+    asset: Asset,
+    visited: Vec<bool>,
+    ignored_range: bool,
+}
+
+impl Walk<'_> {
+    fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<(), SceneError> {
+        let at = format!("nodes[{}]", node.index());
+        if std::mem::replace(&mut self.visited[node.index()], true) {
+            return Err(error(
+                self.file,
+                &at,
+                "the node is reached twice in the scene's hierarchy (a cycle, or two parents)",
+            ));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(error(self.file, &at, "the node's transform is not finite"));
+        }
+        let name = node.name().map(str::to_string);
+        if let Some(mesh) = node.mesh() {
+            for primitive in mesh.primitives() {
+                let local = self.local_primitive(&mesh, &primitive)?;
+                let triangles = place_triangles(&local, &world);
+                if let Some(v) = triangles.iter().flat_map(|t| t.v).find(|v| v.abs().max_element() > MAX_COORD) {
+                    return Err(error(
+                        self.file,
+                        format!("{at} (meshes[{}].primitives[{}])", mesh.index(), primitive.index()),
+                        format!("a vertex placed at {v} lies beyond ±{MAX_COORD:e}"),
+                    ));
+                }
+                let material = local.material;
+                let emission = self.emissions[material as usize];
+                self.asset.primitives.push(Primitive { name: name.clone(), triangles, material, emission });
+            }
+        }
+        if let Some(camera) = node.camera() {
+            self.camera(&camera, node.name(), &world);
+        }
+        if let Some(light) = node.light() {
+            let light = self.light(&light, &world, &at)?;
+            self.asset.lights.push((name, light));
+        }
+        for child in node.children() {
+            self.node(&child, world)?;
+        }
+        Ok(())
+    }
+
+    /// Keeps the camera if it is the one asked for by its own or its
+    /// node's name (Blender names the node), or the first one.
+    fn camera(&mut self, camera: &gltf::Camera, node_name: Option<&str>, world: &Mat4) {
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else { return };
+        let wanted = match self.camera_name {
+            Some(name) => camera.name() == Some(name) || node_name == Some(name),
+            None => self.asset.camera.is_none(),
+        };
+        if !wanted {
+            return;
+        }
+        // A glTF camera looks down its node's −z with +y up.
+        self.asset.camera = Some(CameraPose {
+            position: world.transform_point3(Vec3::ZERO),
+            forward: world.transform_vector3(-Vec3::Z).normalize_or_zero(),
+            up: world.transform_vector3(Vec3::Y).normalize_or_zero(),
+            fov_y: p.yfov().to_degrees(),
+            aspect: p.aspect_ratio(),
+        });
+    }
+
+    /// A `KHR_lights_punctual` light in hikari's radiometric units: the
+    /// file's candela (lm/sr) and lux (lm/m²) divided by 683 lm/W give W/sr
+    /// and W/m². A Blender export of a P-watt point light says
+    /// P·683/(4π) cd, so it arrives here as P/(4π) W/sr: P watts, as Blender
+    /// renders it.
+    fn light(&mut self, light: &gltf::khr_lights_punctual::Light, world: &Mat4, at: &str) -> Result<Light, SceneError> {
+        use gltf::khr_lights_punctual::Kind;
+        let at = format!("{at} (KHR_lights_punctual.lights[{}])", light.index());
+        let color = Vec3::from(light.color());
+        let intensity = light.intensity();
+        if !(color.is_finite() && color.min_element() >= 0.0 && intensity.is_finite() && intensity >= 0.0) {
+            return Err(error(self.file, &at, "the light's color and intensity must be finite and non-negative"));
+        }
+        let emission: Rgb = color * intensity / LUMENS_PER_WATT;
+        if emission.max_element() > super::limits::MAX_EMISSION {
+            return Err(error(self.file, &at, format!("intensity {intensity} is beyond hikari's limit")));
+        }
+        self.ignored_range |= light.range().is_some();
+        let position = world.transform_point3(Vec3::ZERO);
+        // Punctual lights shine down their node's −z.
+        let axis = world.transform_vector3(-Vec3::Z).normalize_or_zero();
+        if axis == Vec3::ZERO || position.abs().max_element() > MAX_COORD {
+            return Err(error(self.file, &at, "the light's node transform is degenerate or places it too far away"));
+        }
+        Ok(match light.kind() {
+            Kind::Point => Light::Point { position, intensity: emission },
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                let (min, max) = super::limits::CUTOFF_ANGLE;
+                let outer = outer_cone_angle.to_degrees();
+                if !(outer >= min && outer <= max) {
+                    return Err(error(
+                        self.file,
+                        &at,
+                        format!("outerConeAngle {outer}° must lie between {min}° and {max}°"),
+                    ));
+                }
+                // glTF's smooth step in cos θ between the cone angles becomes
+                // hikari's linear ramp in θ between the same angles.
+                let inner = inner_cone_angle.clamp(0.0, outer_cone_angle);
+                Light::Spot { position, axis, intensity: emission, cutoff: outer_cone_angle, falloff_start: inner }
+            }
+            Kind::Directional => {
+                Light::Directional { direction: axis, irradiance: emission, disc: crate::light::Disc::UNIT }
+            }
+        })
+    }
+
+    /// Reads a primitive once (instancing shares it), checking every value.
+    fn local_primitive(
+        &mut self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+    ) -> Result<std::rc::Rc<LocalPrimitive>, SceneError> {
+        let key = (mesh.index(), primitive.index());
+        if let Some(p) = self.cache.get(&key) {
+            return Ok(p.clone());
+        }
+        let at = format!("meshes[{}].primitives[{}]", mesh.index(), primitive.index());
+        let fail = |field: &str, message: String| error(self.file, format!("{at}{field}"), message);
+        let attribute = |semantic: gltf::Semantic, name: &str, allowed: &[DataType]| {
+            primitive
+                .get(&semantic)
+                .map(|a| {
+                    accessors::read::<3>(&a, self.buffers, allowed)
+                        .map_err(|m| fail(&format!(".attributes.{name}"), format!("accessor {} {m}", a.index())))
+                })
+                .transpose()
+        };
+        let positions: Vec<Vec3> = attribute(gltf::Semantic::Positions, "POSITION", &[DataType::F32])?
+            .ok_or_else(|| fail(".attributes", "the primitive has no POSITION".into()))?
+            .into_iter()
+            .map(Vec3::from)
+            .collect();
+        if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
+            return Err(fail(".attributes.POSITION", format!("vertex {i} is not finite: {p}")));
+        }
+        let normals = attribute(gltf::Semantic::Normals, "NORMAL", &[DataType::F32])?
+            .map(|n| n.into_iter().map(Vec3::from).collect::<Vec<_>>());
+        if let Some((i, n)) = normals.iter().flatten().enumerate().find(|(_, n)| !n.is_finite()) {
+            return Err(fail(".attributes.NORMAL", format!("normal {i} is not finite: {n}")));
+        }
+        if normals.as_ref().is_some_and(|n| n.len() != positions.len()) {
+            return Err(fail(".attributes.NORMAL", "has a different count than POSITION".into()));
+        }
+        let indices = match primitive.indices() {
+            Some(a) => accessors::read_indices(&a, self.buffers)
+                .map_err(|m| fail(".indices", format!("accessor {} {m}", a.index())))?,
+            None => (0..positions.len() as u32).collect(),
+        };
+        if let Some((i, v)) = indices.iter().enumerate().find(|&(_, &v)| v as usize >= positions.len()) {
+            return Err(fail(".indices", format!("index {i} is {v}, beyond the {} vertices", positions.len())));
+        }
+        let triangles = match primitive.mode() {
+            Mode::Triangles => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+            // Strips alternate winding so every triangle faces the same way.
+            Mode::TriangleStrip => (2..indices.len())
+                .map(|i| {
+                    let [a, b, c] = [indices[i - 2], indices[i - 1], indices[i]];
+                    if i % 2 == 0 { [a, b, c] } else { [b, a, c] }
+                })
+                .collect(),
+            Mode::TriangleFan => (2..indices.len()).map(|i| [indices[0], indices[i - 1], indices[i]]).collect(),
+            other => {
+                return Err(fail(".mode", format!("mode {other:?} is not triangles (hikari renders surfaces only)")));
+            }
+        };
+        let material = primitive.material().index().unwrap_or(self.asset.materials.len() - 1) as u32;
+        let local = std::rc::Rc::new(LocalPrimitive { positions, normals, triangles, material });
+        self.cache.insert(key, local.clone());
+        Ok(local)
+    }
+}
+
+/// A primitive's triangles placed by `world`: normals by its inverse
+/// transpose, and the winding reversed where it mirrors (negative
+/// determinant), so the front face stays the front face. Triangles with no
+/// area in 32-bit floats are dropped.
+fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> Vec<Triangle> {
+    let linear = Mat3::from_mat4(*world);
+    let normal_matrix = linear.inverse().transpose();
+    let mirrored = linear.determinant() < 0.0;
+    let positions: Vec<Vec3> = local.positions.iter().map(|&p| world.transform_point3(p)).collect();
+    let normals: Option<Vec<Vec3>> =
+        local.normals.as_ref().map(|n| n.iter().map(|&n| (normal_matrix * n).normalize_or_zero()).collect());
+    local
+        .triangles
+        .iter()
+        .filter_map(|&[a, b, c]| {
+            let order = if mirrored { [a, c, b] } else { [a, b, c] };
+            let v = order.map(|i| positions[i as usize]);
+            let normals = normals.as_ref().map(|n| TriangleNormals(order.map(|i| n[i as usize])));
+            let tri = Triangle { v, normals };
+            tri.geometric_normal().try_normalize().is_some().then_some(tri)
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests;
+
+/// What a user may choose when loading a file on its own.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// The camera to render through, by name (glTF files).
+    pub camera: Option<String>,
+}
+
+/// Side of the longer image edge when the file gives only an aspect ratio.
+const DEFAULT_HEIGHT: u32 = 512;
+
+/// A glTF file as a whole scene: its camera (or one framing its bounds),
+/// its lights and emissive surfaces (or a white environment if it has
+/// none), with a note for each.
+pub fn load_scene(path: &Path, options: &LoadOptions) -> Result<super::Scene, SceneError> {
+    let asset = load_asset(path, Affine3A::IDENTITY, options.camera.as_deref())?;
+    scene_from_asset(asset, path.display().to_string())
+}
+
+/// [`load_scene`] of a file's bytes (see [`asset_from_bytes`]).
+pub fn scene_from_bytes(
+    bytes: &[u8],
+    file: &str,
+    base: Option<&Path>,
+    options: &LoadOptions,
+) -> Result<super::Scene, SceneError> {
+    let asset = asset_from_bytes(bytes, file, base, Affine3A::IDENTITY, options.camera.as_deref())?;
+    scene_from_asset(asset, file.to_string())
+}
+
+fn scene_from_asset(mut asset: Asset, file: String) -> Result<super::Scene, SceneError> {
+    use super::{Names, Scene, Surface};
+    let mut surfaces = Vec::new();
+    let mut triangles = Vec::new();
+    let mut names = Names::default();
+    let mut lights: Vec<Light> = Vec::new();
+    let mut light_names = Vec::new();
+    for (name, light) in asset.lights.drain(..) {
+        light_names.push(name);
+        lights.push(light);
+    }
+    for primitive in asset.primitives.drain(..) {
+        if primitive.triangles.is_empty() {
+            continue;
+        }
+        let surface = surfaces.len() as u32;
+        let emitter = primitive.emitted_light().map(|light| {
+            lights.push(light);
+            light_names.push(None);
+            lights.len() as u32 - 1
+        });
+        surfaces.push(Surface { material: primitive.material, emitter });
+        if let Some(name) = primitive.name
+            && !names.objects.iter().any(|(n, _)| *n == name)
+        {
+            names.objects.push((name, surface));
+        }
+        triangles.extend(primitive.triangles.into_iter().map(|t| (t, surface)));
+    }
+    if triangles.is_empty() {
+        return Err(error(&file, "", "the scene has no triangle to render"));
+    }
+    let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = triangles.into_iter().unzip();
+    let accel = crate::geometry::Accel::build(triangles, tri_surfaces, Vec::new(), Vec::new());
+    if lights.is_empty() {
+        asset.notes.push("the file has no lights: lit by a uniform white environment (radiance 1)".into());
+        lights.push(Light::Environment { radiance: Rgb::ONE, disc: crate::light::Disc::UNIT });
+        light_names.push(None);
+    }
+    crate::light::fit_distant_lights(&mut lights, accel.bounds());
+    names.lights = light_names;
+    let camera = match asset.camera {
+        Some(pose) => camera_from_pose(&pose).map_err(|m| error(&file, "cameras", m))?,
+        None => {
+            asset.notes.push("the file has no camera: one frames the scene's bounds".into());
+            framing_camera(accel.bounds())
+        }
+    };
+    Ok(Scene {
+        source: file,
+        camera,
+        materials: asset.materials,
+        surfaces,
+        lights,
+        accel,
+        media: crate::medium::Media::new(Vec::new()).expect("no media is valid"),
+        names,
+        animations: Vec::new(),
+        notes: asset.notes,
+    })
+}
+
+/// The camera of a glTF camera node, at `DEFAULT_HEIGHT` pixels high and
+/// its aspect ratio (square without one).
+fn camera_from_pose(pose: &CameraPose) -> Result<crate::camera::Camera, String> {
+    let aspect = pose.aspect.filter(|a| a.is_finite() && *a > 0.0).unwrap_or(1.0);
+    let width = ((DEFAULT_HEIGHT as f32 * aspect).round() as u32).clamp(1, super::limits::MAX_SIDE);
+    crate::camera::Camera::new(pose.position, pose.position + pose.forward, pose.up, pose.fov_y, width, DEFAULT_HEIGHT)
+}
+
+/// A camera looking at the bounds' centre from the front (+z) and a little
+/// above, far enough that the bounding sphere fills the 40° field of view.
+fn framing_camera((lo, hi): (Vec3, Vec3)) -> crate::camera::Camera {
+    let center = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let fov_y: f32 = 40.0;
+    let distance = radius / (fov_y.to_radians() * 0.5).sin();
+    let position = center + Vec3::new(0.0, 0.3, 1.0).normalize() * distance;
+    crate::camera::Camera::new(position, center, Vec3::Y, fov_y, DEFAULT_HEIGHT, DEFAULT_HEIGHT)
+        .expect("a camera looking at the centre from outside, with +y up, is valid")
+}

@@ -1,0 +1,334 @@
+//! The glTF front end on files written here with `gltf-json`.
+
+use super::export::{GltfBuilder, PbrMaterial, glb, looking};
+use super::*;
+use gltf::json;
+use std::path::PathBuf;
+
+/// A fresh folder for one test's files.
+fn folder(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hikari-gltf-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+/// One triangle: (0,0,0), (1,0,0), (0,1,0), facing +z.
+const TRIANGLE: [Vec3; 3] = [Vec3::ZERO, Vec3::X, Vec3::Y];
+
+fn one_triangle(b: &mut GltfBuilder) -> json::Index<json::Mesh> {
+    let m = b.material(&PbrMaterial { base_color: Vec3::new(0.5, 0.25, 1.0), ..Default::default() });
+    b.mesh(&TRIANGLE, None, None, Some(m))
+}
+
+fn sorted_vertices(t: &Triangle) -> [Vec3; 3] {
+    t.v
+}
+
+/// A hierarchy: a parent rotated 90° about +z and scaled (2, 1, 1), a child
+/// translated by (0, 0, 5) under it with a negative x scale given as a
+/// matrix, and the same mesh instanced under both.
+#[test]
+fn node_hierarchy_places_and_instances_triangles() {
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    // Column-major matrix: scale x by −1, translate (0, 0, 5).
+    let mut matrix = [0.0f32; 16];
+    matrix[0] = -1.0;
+    matrix[5] = 1.0;
+    matrix[10] = 1.0;
+    matrix[14] = 5.0;
+    matrix[15] = 1.0;
+    let child = b.node(json::Node { mesh: Some(mesh), matrix: Some(matrix), ..Default::default() });
+    let q = glam::Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    let parent = b.node(json::Node {
+        mesh: Some(mesh),
+        rotation: Some(json::scene::UnitQuaternion(q.to_array())),
+        scale: Some([2.0, 1.0, 1.0]),
+        translation: Some([10.0, 0.0, 0.0]),
+        children: Some(vec![child]),
+        ..Default::default()
+    });
+    let dir = folder("hierarchy");
+    let path = write(&dir, "h.glb", &b.to_glb(vec![parent]));
+    let asset = load_asset(&path, Affine3A::IDENTITY, None).unwrap();
+    assert_eq!(asset.primitives.len(), 2, "one mesh under two nodes: two instances");
+    // Parent: p ↦ T + R(S p) with S = diag(2,1,1), R = 90° about z: (x, y) ↦ (−y, x).
+    let parent_of = |p: Vec3| Vec3::new(10.0 - p.y, 2.0 * p.x, p.z);
+    let expected_parent = TRIANGLE.map(parent_of);
+    // Child: p ↦ parent((−x, y, z + 5)); mirrored, so its winding is reversed.
+    let child_of = |p: Vec3| parent_of(Vec3::new(-p.x, p.y, p.z + 5.0));
+    let c = TRIANGLE.map(child_of);
+    let expected_child = [c[0], c[2], c[1]];
+    let close = |a: [Vec3; 3], b: [Vec3; 3]| a.iter().zip(b).all(|(x, y)| (*x - y).length() < 1e-5);
+    let got: Vec<[Vec3; 3]> = asset.primitives.iter().map(|p| sorted_vertices(&p.triangles[0])).collect();
+    assert!(close(got[0], expected_parent), "{:?} vs {expected_parent:?}", got[0]);
+    assert!(close(got[1], expected_child), "{:?} vs {expected_child:?}", got[1]);
+    // Front faces: the parent keeps +z (a rotation about z); the mirrored
+    // child's reversed winding keeps its normal +z too (x ↦ −x alone would flip it).
+    for p in &asset.primitives {
+        let n = p.triangles[0].geometric_normal().normalize();
+        assert!((n - Vec3::Z).length() < 1e-5, "normal {n}");
+    }
+    assert_eq!(
+        asset.materials[asset.primitives[0].material as usize],
+        Material::Diffuse { albedo: Vec3::new(0.5, 0.25, 1.0), specular: Vec3::ZERO }
+    );
+}
+
+#[test]
+fn smooth_normals_follow_the_inverse_transpose() {
+    let mut b = GltfBuilder::new();
+    // A 45° slope in x–y: normal (−1, 1, 0)/√2; scaling x by 2 tilts it to (−1, 2, 0)/√5.
+    let positions = [Vec3::ZERO, Vec3::new(1.0, 1.0, 0.0), Vec3::new(0.0, 0.0, -1.0)];
+    let n = Vec3::new(-1.0, 1.0, 0.0).normalize();
+    let mesh = b.mesh(&positions, Some(&[n, n, n]), Some(&[0, 1, 2]), None);
+    let node = b.node(json::Node { mesh: Some(mesh), scale: Some([2.0, 1.0, 1.0]), ..Default::default() });
+    let dir = folder("normals");
+    let path = write(&dir, "n.glb", &b.to_glb(vec![node]));
+    let asset = load_asset(&path, Affine3A::IDENTITY, None).unwrap();
+    let TriangleNormals(normals) = asset.primitives[0].triangles[0].normals.unwrap();
+    assert!((normals[0] - Vec3::new(-1.0, 2.0, 0.0).normalize()).length() < 1e-5, "{}", normals[0]);
+    // Without a material the specification's default (white) applies.
+    assert_eq!(asset.primitives[0].material as usize, asset.materials.len() - 1);
+}
+
+#[test]
+fn cameras_and_punctual_lights_in_radiometric_units() {
+    use json::extensions::scene::khr_lights_punctual::Type;
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    let geometry = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    // A Blender export of a 100 W spot: 100·683/(4π) cd, 60° outer and 45° inner half-angles.
+    let candela = 100.0 * 683.0 / (4.0 * std::f32::consts::PI);
+    let spot = b.light(Type::Spot, Vec3::ONE, candela, Some((45f32.to_radians(), 60f32.to_radians())));
+    let down = looking(-Vec3::Y, Vec3::Z);
+    let spot = b.node(GltfBuilder::light_node(spot, Vec3::new(0.0, 3.0, 0.0), down));
+    // A 2 W/m² sun: 1366 lux, shining down.
+    let sun = b.light(Type::Directional, Vec3::new(1.0, 0.5, 0.25), 2.0 * 683.0, None);
+    let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, down));
+    let camera = b.camera(0.5, Some(2.0));
+    let camera = b.node(json::Node { camera: Some(camera), translation: Some([0.0, 0.0, 4.0]), ..Default::default() });
+    let dir = folder("lights");
+    let path = write(&dir, "l.glb", &b.to_glb(vec![geometry, spot, sun, camera]));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    match &scene.lights[0] {
+        Light::Spot { position, axis, intensity, cutoff, falloff_start } => {
+            assert!((*position - Vec3::new(0.0, 3.0, 0.0)).length() < 1e-6);
+            assert!((*axis + Vec3::Y).length() < 1e-6, "axis {axis}");
+            // 100 W of a point light: 100/(4π) W/sr.
+            let expected = 100.0 / (4.0 * std::f32::consts::PI);
+            assert!((intensity.x / expected - 1.0).abs() < 1e-6, "{intensity} vs {expected}");
+            assert!((cutoff.to_degrees() - 60.0).abs() < 1e-4 && (falloff_start.to_degrees() - 45.0).abs() < 1e-4);
+        }
+        other => panic!("expected a spot, got {other:?}"),
+    }
+    assert!(matches!(scene.lights[1], Light::Directional { .. }), "{:?}", scene.lights[1]);
+    assert!((scene.lights[1].emission() - Vec3::new(2.0, 1.0, 0.5)).length() < 1e-6);
+    // yfov 0.5 rad, aspect 2: 1024×512 looking down −z from (0, 0, 4).
+    let c = &scene.camera;
+    assert_eq!((c.width, c.height), (1024, 512));
+    assert!((c.fov_y - 0.5f32.to_degrees()).abs() < 1e-4);
+    assert!((c.position - Vec3::new(0.0, 0.0, 4.0)).length() < 1e-6);
+    assert!((c.forward() + Vec3::Z).length() < 1e-6);
+    assert!(scene.notes.is_empty(), "{:?}", scene.notes);
+}
+
+#[test]
+fn a_bare_model_gets_a_white_environment_and_a_framing_camera() {
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let dir = folder("bare");
+    let path = write(&dir, "bare.glb", &b.to_glb(vec![node]));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.lights.len(), 1);
+    assert!(matches!(scene.lights[0], Light::Environment { .. }));
+    assert_eq!(scene.notes.len(), 2, "{:?}", scene.notes);
+    assert!(scene.notes[0].contains("no lights") && scene.notes[1].contains("no camera"), "{:?}", scene.notes);
+    // The triangle's centre projects inside the image.
+    let c = &scene.camera;
+    let to_centre = (Vec3::new(0.33, 0.33, 0.0) - c.position).normalize();
+    assert!(to_centre.dot(c.forward()) > (c.fov_y.to_radians() * 0.5).cos());
+}
+
+#[test]
+fn an_emissive_primitive_is_a_mesh_light() {
+    let mut b = GltfBuilder::new();
+    let m = b.material(&PbrMaterial {
+        base_color: Vec3::splat(0.5),
+        emission: Vec3::new(4.0, 2.0, 1.0),
+        double_sided: false,
+        ..Default::default()
+    });
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let dir = folder("emissive");
+    let path = write(&dir, "e.glb", &b.to_glb(vec![node]));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(scene.lights.len(), 1, "the emissive triangle lights the scene: no default environment");
+    assert!(matches!(scene.lights[0], Light::Mesh(_)));
+    assert_eq!(scene.surfaces[0].emitter, Some(0));
+    assert_eq!(scene.lights[0].emission(), Vec3::new(4.0, 2.0, 1.0));
+    // It reflects as well as it glows.
+    assert!(scene.materials[scene.surfaces[0].material as usize].is_diffuse());
+}
+
+/// Loads `bytes` written as `name` and returns the error's text.
+fn error_of(tag: &str, files: &[(&str, &[u8])]) -> String {
+    let dir = folder(tag);
+    for (name, bytes) in files {
+        write(&dir, name, bytes);
+    }
+    let path = dir.join(files[0].0);
+    match crate::scene::Scene::load(path.to_str().unwrap()) {
+        Ok(_) => panic!("{tag}: loaded"),
+        Err(e) => {
+            assert!(e.to_string().starts_with(&path.display().to_string()), "{e}");
+            e.to_string()
+        }
+    }
+}
+
+fn assert_says(text: &str, words: &[&str]) {
+    for w in words {
+        assert!(text.contains(w), "`{text}` does not say `{w}`");
+    }
+}
+
+/// A valid one-triangle document to break.
+fn valid() -> (json::Root, Vec<u8>) {
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    b.finish(vec![node])
+}
+
+#[test]
+fn broken_files_are_located_errors() {
+    let (root, bin) = valid();
+    let whole = glb(&root, bin.clone());
+
+    let e = error_of("truncated", &[("t.glb", &whole[..whole.len() - 20])]);
+    assert_says(&e, &["binary glTF"]);
+
+    let e = error_of("garbage", &[("g.gltf", b"{ \"asset\": ")]);
+    assert_says(&e, &["invalid glTF JSON"]);
+    let e = error_of("not-binary", &[("g.glb", b"{ \"asset\": {} }")]);
+    assert_says(&e, &["not a binary glTF file", "magic"]);
+
+    // A .gltf whose buffer file is missing.
+    let mut r = root.clone();
+    r.buffers[0].uri = Some("missing.bin".into());
+    let e = error_of("missing-buffer", &[("m.gltf", &r.to_vec().unwrap())]);
+    assert_says(&e, &["buffers[0]", "missing.bin"]);
+
+    // A buffer shorter than its byteLength.
+    let mut r = root.clone();
+    r.buffers[0].uri = Some("short.bin".into());
+    let e = error_of("short-buffer", &[("s.gltf", &r.to_vec().unwrap()), ("short.bin", &bin[..8])]);
+    assert_says(&e, &["buffers[0]", "truncated"]);
+
+    // An accessor reading past its view.
+    let mut r = root.clone();
+    r.accessors[0].count = json::validation::USize64(1000);
+    let e = error_of("accessor", &[("a.glb", &glb(&r, bin.clone()))]);
+    assert_says(&e, &["meshes[0].primitives[0].attributes.POSITION", "out of range"]);
+
+    // A NaN position.
+    let mut nan_bin = bin.clone();
+    nan_bin[12..16].copy_from_slice(&f32::NAN.to_le_bytes());
+    let e = error_of("nan", &[("n.glb", &glb(&root, nan_bin))]);
+    assert_says(&e, &["meshes[0].primitives[0].attributes.POSITION", "vertex 1", "not finite"]);
+
+    // An extension hikari does not read, required.
+    let mut r = root.clone();
+    r.extensions_used.push("KHR_draco_mesh_compression".into());
+    r.extensions_required.push("KHR_draco_mesh_compression".into());
+    let e = error_of("extension", &[("x.glb", &glb(&r, bin.clone()))]);
+    assert_says(&e, &["extensionsRequired[0]", "KHR_draco_mesh_compression"]);
+
+    // Lines are not surfaces.
+    let mut r = root.clone();
+    r.meshes[0].primitives[0].mode = json::validation::Checked::Valid(json::mesh::Mode::Lines);
+    let e = error_of("lines", &[("l.glb", &glb(&r, bin.clone()))]);
+    assert_says(&e, &["meshes[0].primitives[0].mode", "Lines"]);
+
+    // A reference to a node that does not exist (the crate's validation).
+    let mut r = root.clone();
+    r.scenes[0].nodes.push(json::Index::new(7));
+    let e = error_of("index", &[("i.glb", &glb(&r, bin.clone()))]);
+    assert_says(&e, &["scenes[0].nodes[1]"]);
+
+    // A texture in a format hikari cannot decode is refused once textures are read;
+    // an unknown camera name is refused now.
+    let dir = folder("camera-name");
+    let path = write(&dir, "c.glb", &whole);
+    let options = LoadOptions { camera: Some("Front".into()) };
+    let e = crate::scene::Scene::load_with(path.to_str().unwrap(), &options).err().unwrap().to_string();
+    assert_says(&e, &["cameras", "\"Front\""]);
+}
+
+#[test]
+fn indices_beyond_the_vertices_are_refused() {
+    let mut b = GltfBuilder::new();
+    let mesh = b.mesh(&TRIANGLE, None, Some(&[0, 1, 3]), None);
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let e = error_of("indices", &[("i.glb", &b.to_glb(vec![node]))]);
+    assert_says(&e, &["meshes[0].primitives[0].indices", "index 2 is 3"]);
+}
+
+#[test]
+fn unused_optional_extensions_are_one_note() {
+    let (mut root, bin) = valid();
+    root.extensions_used.push("KHR_texture_transform".into());
+    root.extensions_used.push("KHR_materials_clearcoat".into());
+    let dir = folder("optional");
+    let path = write(&dir, "o.glb", &glb(&root, bin));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    let ext_notes: Vec<&String> = scene.notes.iter().filter(|n| n.contains("extensions ignored")).collect();
+    assert_eq!(ext_notes.len(), 1);
+    assert_says(ext_notes[0], &["KHR_texture_transform", "KHR_materials_clearcoat"]);
+}
+
+#[test]
+fn a_toml_scene_places_a_gltf_object() {
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let dir = folder("toml");
+    write(&dir, "tri.glb", &b.to_glb(vec![node]));
+    let toml = r#"
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+
+[[object]]
+gltf = "tri.glb"
+scale = 2.0
+rotate_y = 90.0
+translate = [1.0, 0.0, 0.0]
+
+[[light]]
+type = "point"
+position = [0.0, 2.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+    let scene = crate::scene::Scene::from_toml(toml, "t.toml", Some(&dir)).unwrap();
+    let (t, _) = scene.accel.triangles().next().unwrap();
+    // (1, 0, 0) scaled by 2 and turned 90° about +y is (0, 0, −2), then moved by (1, 0, 0).
+    assert!(t.v.iter().any(|v| (*v - Vec3::new(1.0, 0.0, -2.0)).length() < 1e-5), "{:?}", t.v);
+    assert_eq!(scene.materials.len(), 2, "the file's material and the default");
+
+    let bad = toml.replace("scale = 2.0", "scale = 2.0\nmaterial = \"white\"");
+    let e = crate::scene::Scene::from_toml(&bad, "t.toml", Some(&dir)).err().unwrap().to_string();
+    assert_says(&e, &["t.toml:", "[[object]] #1", "`material` does not apply to a glTF object"]);
+    let missing = toml.replace("tri.glb", "nothing.glb");
+    let e = crate::scene::Scene::from_toml(&missing, "t.toml", Some(&dir)).err().unwrap().to_string();
+    assert_says(&e, &["t.toml:", "nothing.glb", "cannot read glTF file"]);
+}
