@@ -25,6 +25,7 @@
 //! * `beta`: path throughput; `power`/`flux`: watts per RGB channel.
 //! * Normals "facing" a direction have been flipped to that side.
 
+pub mod bsdf;
 pub mod camera;
 pub mod estimate;
 pub mod fuzz;

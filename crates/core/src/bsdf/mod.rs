@@ -1,0 +1,618 @@
+//! Surface reflection: the glTF 2.0 metallic–roughness BRDF, as pure
+//! functions of directions in the local shading frame.
+//!
+//! # The model
+//!
+//! glTF 2.0, Appendix B ("BRDF Implementation"), with KHR_materials_specular's
+//! `specularFactor` s scaling the dielectric's Fresnel:
+//!
+//! ```text
+//! f          = mix(dielectric, metal, metallic)
+//! dielectric = (1 − s·F_d)·base/π + s·F_d·D·V     F_d = 0.04 + 0.96 (1 − |v·h|)^5
+//! metal      = F_m·D·V                            F_m = base + (1 − base)(1 − |v·h|)^5
+//! ```
+//!
+//! with h the half vector, D the Trowbridge–Reitz (GGX) distribution of
+//! α = roughness² and V = G2/(4 |n·l| |n·v|) ([`ggx`]). Appendix B prints the
+//! separable Smith masking–shadowing G1(l)·G1(v); hikari uses the
+//! height-correlated G2 = 1/(1 + Λ(v) + Λ(l)) (Heitz 2014), as Khronos' sample
+//! renderer does: it is the more accurate of the two and never darker.
+//!
+//! Old materials are settings of this one: `Bsdf::diffuse(ρ)` (metallic 0,
+//! roughness 1, specular 0) is exactly Lambertian ρ/π, `Bsdf::mirror(f0)`
+//! (metallic 1, roughness 0) a perfect mirror tinted by Schlick's Fresnel.
+//! This BRDF reflects only; transmission (glass) is handled elsewhere.
+//!
+//! # Frames and names
+//!
+//! Everything here works in the local shading frame, normal +z
+//! ([`ShadingFrame`] converts). `wo` points toward the viewer (for photons:
+//! where the light goes next), `wi` toward the light (for photons: where it
+//! came from); both are unit and point away from the surface. Directions
+//! below the surface (z ≤ 0) reflect nothing.
+//!
+//! # Smooth surfaces
+//!
+//! Below [`SMOOTH_ROUGHNESS`] the specular lobe is a perfect mirror (a delta
+//! distribution): `f` and `pdf` then hold only the diffuse lobe, and `sample`
+//! returns the mirror direction with `is_delta` set.
+//!
+//! # Sampling
+//!
+//! `sample` picks the diffuse lobe (cosine-weighted) or the specular lobe
+//! (GGX visible normals, Heitz 2018) with probabilities proportional to the
+//! channel means of their weights at `wo`, (1 − metallic)(1 − s·F_d)·base
+//! against the specular Fresnel, and returns the one-sample mixture density of
+//! both (what MIS needs), so `weight = f·cos/pdf` stays bounded whichever lobe
+//! produced the direction.
+//!
+//! # WGSL twin
+//!
+//! The GPU renderer will carry a WGSL version of `f`, `pdf` and `sample`; a
+//! test will pin it to these functions on random inputs (not written yet).
+//! Hence plain f32 arithmetic only: no lookup tables, powers written as
+//! products, and the sampler's angles through `sampling::unit_circle`.
+
+pub mod ggx;
+
+use crate::material::{Rgb, mean};
+use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, orthonormal_basis};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Perceptual roughness below which the specular lobe is a perfect mirror.
+///
+/// 0.05 is α = 0.0025: the reflected lobe's half-width (about 2α) is then
+/// 0.3°, and its peak D ≈ 1/(πα²) ≈ 5·10⁴ sr⁻¹. No photon gather radius or
+/// light sample resolves such a spike, while tracing it as a mirror is
+/// exact to the eye and costs nothing; the energy it reflects differs from
+/// the mirror's by under 0.1% (`smooth_threshold_is_nearly_continuous`).
+/// For comparison pbrt-v4 treats α < 10⁻³ (roughness 0.032) as smooth and
+/// Filament never shades below roughness 0.045.
+pub const SMOOTH_ROUGHNESS: f32 = 0.05;
+
+/// Floor on α in the microfacet path, for numerical safety only: above
+/// `SMOOTH_ROUGHNESS` α ≥ 0.0025 anyway; the floor keeps D, Λ and the
+/// sampler finite should the threshold ever be lowered.
+pub const ALPHA_MIN: f32 = 1e-4;
+
+/// glTF's dielectric reflectance at normal incidence (index of refraction 1.5).
+pub const DIELECTRIC_F0: f32 = 0.04;
+
+/// The glTF metallic–roughness material at one surface point (textures
+/// already looked up). All four parameters lie in [0, 1] (`new` clamps).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bsdf {
+    pub base_color: Rgb,
+    pub metallic: f32,
+    /// Perceptual roughness r; the GGX width is α = r².
+    pub roughness: f32,
+    /// KHR_materials_specular's specularFactor: 1 is glTF's default
+    /// (F0 = 0.04), 0 removes the dielectric's specular lobe.
+    pub specular: f32,
+}
+
+/// A direction drawn by [`Bsdf::sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// Toward the light (local frame).
+    pub wi: Vec3,
+    /// The BRDF value f(wo, wi); for a delta sample the mirror's F/|cos θi|.
+    pub f: Rgb,
+    /// Mixture density of `wi` per steradian (equal to `Bsdf::pdf`); for a
+    /// delta sample the probability of having chosen the mirror.
+    pub pdf: f32,
+    /// f·|cos θi|/pdf: the factor a path's `beta` is multiplied by.
+    pub weight: Rgb,
+    /// The mirror lobe produced `wi`: `f` and `pdf` are not densities, so no
+    /// MIS against light sampling.
+    pub is_delta: bool,
+}
+
+/// Schlick's (1 − cos)^5, as products.
+fn schlick_weight(cos: f32) -> f32 {
+    let m = (1.0 - cos).clamp(0.0, 1.0);
+    let m2 = m * m;
+    m2 * m2 * m
+}
+
+/// Smallest lobe-selection weight of a lobe that carries anything, so that a
+/// lobe whose Fresnel vanishes at this `wo` (a black metal at normal
+/// incidence) is still sampled now and then: `pdf` must cover `f`.
+const MIN_LOBE_WEIGHT: f32 = 1e-4;
+
+impl Bsdf {
+    /// The material with every parameter clamped to [0, 1] (and base colour to ≥ 0).
+    pub fn new(base_color: Rgb, metallic: f32, roughness: f32, specular: f32) -> Self {
+        Bsdf {
+            base_color: base_color.max(Rgb::ZERO),
+            metallic: metallic.clamp(0.0, 1.0),
+            roughness: roughness.clamp(0.0, 1.0),
+            specular: specular.clamp(0.0, 1.0),
+        }
+    }
+
+    /// Lambertian reflectance `albedo`: f = albedo/π exactly.
+    pub fn diffuse(albedo: Rgb) -> Self {
+        Bsdf { base_color: albedo, metallic: 0.0, roughness: 1.0, specular: 0.0 }
+    }
+
+    /// Perfect mirror with Schlick's conductor Fresnel of reflectance `f0` at
+    /// normal incidence.
+    pub fn mirror(f0: Rgb) -> Self {
+        Bsdf { base_color: f0, metallic: 1.0, roughness: 0.0, specular: 1.0 }
+    }
+
+    /// GGX width α = roughness², at least `ALPHA_MIN`.
+    pub fn alpha(&self) -> f32 {
+        (self.roughness * self.roughness).max(ALPHA_MIN)
+    }
+
+    fn is_smooth(&self) -> bool {
+        self.roughness < SMOOTH_ROUGHNESS
+    }
+
+    /// The specular lobe carries anything (metals always do: F_m → 1 at grazing).
+    pub fn has_specular(&self) -> bool {
+        self.metallic > 0.0 || self.specular > 0.0
+    }
+
+    /// The specular lobe is a perfect mirror (and is present).
+    pub fn is_delta(&self) -> bool {
+        self.is_smooth() && self.has_specular()
+    }
+
+    /// The diffuse lobe carries anything: photon maps store photons here.
+    pub fn has_diffuse(&self) -> bool {
+        self.metallic < 1.0 && self.base_color.max_element() > 0.0
+    }
+
+    /// Fresnel of the specular lobe, (1 − metallic)·s·F_d + metallic·F_m, at
+    /// `cos` = |v·h|.
+    fn specular_fresnel(&self, cos: f32) -> Rgb {
+        let w = schlick_weight(cos);
+        let f_dielectric = self.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * w);
+        let f_metal = self.base_color + (Rgb::ONE - self.base_color) * w;
+        Rgb::splat((1.0 - self.metallic) * f_dielectric) + self.metallic * f_metal
+    }
+
+    /// (1 − metallic)(1 − s·F_d)·base at `cos` = |v·h|: π times the diffuse lobe.
+    fn diffuse_reflectance(&self, cos: f32) -> Rgb {
+        let f_dielectric = DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * schlick_weight(cos);
+        self.base_color * ((1.0 - self.metallic) * (1.0 - self.specular * f_dielectric))
+    }
+
+    /// Probability of sampling the specular lobe at `wo`; None when neither
+    /// lobe reflects anything.
+    fn specular_probability(&self, cos_o: f32) -> Option<f32> {
+        let diffuse = if self.has_diffuse() { mean(self.diffuse_reflectance(cos_o)).max(MIN_LOBE_WEIGHT) } else { 0.0 };
+        let specular = if self.has_specular() { mean(self.specular_fresnel(cos_o)).max(MIN_LOBE_WEIGHT) } else { 0.0 };
+        let total = diffuse + specular;
+        (total > 0.0).then(|| specular / total)
+    }
+
+    /// The diffuse and specular (microfacet) parts of f; the specular one is
+    /// zero on smooth surfaces, whose mirror is a delta.
+    fn f_lobes(&self, wo: Vec3, wi: Vec3) -> (Rgb, Rgb) {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (Rgb::ZERO, Rgb::ZERO);
+        }
+        let h = (wo + wi).normalize();
+        // |v·h| = |l·h|; averaging the two makes f(wo, wi) = f(wi, wo) to the bit.
+        let cos = 0.5 * (wo.dot(h) + wi.dot(h));
+        let diffuse = self.diffuse_reflectance(cos) / PI;
+        if self.is_smooth() || !self.has_specular() {
+            return (diffuse, Rgb::ZERO);
+        }
+        let alpha = self.alpha();
+        (diffuse, self.specular_fresnel(cos) * (ggx::d(h, alpha) * ggx::visibility(wo, wi, alpha)))
+    }
+
+    /// f(wo, wi) per steradian, without the mirror of smooth surfaces.
+    pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let (diffuse, specular) = self.f_lobes(wo, wi);
+        diffuse + specular
+    }
+
+    /// Density per steradian with which `sample` returns the non-delta
+    /// direction `wi`.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return 0.0;
+        }
+        let Some(p_specular) = self.specular_probability(wo.z) else { return 0.0 };
+        let mut pdf = (1.0 - p_specular) * cosine_hemisphere_pdf(wi.z);
+        if p_specular > 0.0 && !self.is_smooth() {
+            pdf += p_specular * ggx::reflection_pdf(wo, (wo + wi).normalize(), self.alpha());
+        }
+        pdf
+    }
+
+    /// A direction toward the light for viewer direction `wo`: `u_lobe`
+    /// chooses the lobe, `u` the direction within it. None when `wo` is
+    /// below the surface, the material is black, or the microfacet
+    /// reflection points below the surface (energy the single-scattering
+    /// model loses).
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let p_specular = self.specular_probability(wo.z)?;
+        let wi = if u_lobe < p_specular {
+            if self.is_smooth() {
+                // Perfect mirror: h = n, so |v·h| = cos θo.
+                let fresnel = self.specular_fresnel(wo.z);
+                return Some(BsdfSample {
+                    wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                    f: fresnel / wo.z,
+                    pdf: p_specular,
+                    weight: fresnel / p_specular,
+                    is_delta: true,
+                });
+            }
+            ggx::reflect(wo, ggx::sample_visible_normal(wo, self.alpha(), u))
+        } else {
+            cosine_hemisphere(u)
+        };
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let pdf = self.pdf(wo, wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        let f = self.f(wo, wi);
+        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false })
+    }
+
+    /// A rough directional albedo for Russian roulette: the lobe weights
+    /// averaged over cosine-weighted viewing directions, using
+    /// ∫ F(μ) 2μ dμ = F0 + (1 − F0)/21 for Schlick's F. It ignores the energy
+    /// rough microfacets lose to single scattering (up to 69% for a metal at
+    /// roughness 1, see the furnace tests), so it overestimates rough
+    /// materials; it is ≤ 1 per channel whenever base_color is.
+    pub fn albedo_estimate(&self) -> Rgb {
+        let average = |f0: Rgb| f0 + (Rgb::ONE - f0) / 21.0;
+        let f_dielectric = self.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+        let diffuse = self.base_color * ((1.0 - self.metallic) * (1.0 - f_dielectric));
+        let specular = Rgb::splat((1.0 - self.metallic) * f_dielectric) + self.metallic * average(self.base_color);
+        diffuse + specular
+    }
+}
+
+/// An orthonormal frame whose z axis is the shading normal; the same basis as
+/// `sampling::local_to_world`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingFrame {
+    pub tangent: Vec3,
+    pub bitangent: Vec3,
+    pub normal: Vec3,
+}
+
+impl ShadingFrame {
+    /// The frame around unit `normal`.
+    pub fn new(normal: Vec3) -> Self {
+        let (tangent, bitangent) = orthonormal_basis(normal);
+        ShadingFrame { tangent, bitangent, normal }
+    }
+
+    pub fn to_local(&self, world: Vec3) -> Vec3 {
+        Vec3::new(world.dot(self.tangent), world.dot(self.bitangent), world.dot(self.normal))
+    }
+
+    pub fn to_world(&self, local: Vec3) -> Vec3 {
+        self.tangent * local.x + self.bitangent * local.y + self.normal * local.z
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ggx::tests::{direction_at, integrate_half_vectors};
+    use super::*;
+    use crate::sampling::chi2::assert_direction_distribution;
+    use crate::sampling::{Rng, local_to_world, uniform_sphere};
+    use std::cell::RefCell;
+    use std::f64::consts::PI as PI64;
+
+    fn white(metallic: f32, roughness: f32) -> Bsdf {
+        Bsdf { base_color: Rgb::ONE, metallic, roughness, specular: 1.0 }
+    }
+
+    fn mirror_direction(wo: Vec3) -> Vec3 {
+        Vec3::new(-wo.x, -wo.y, wo.z)
+    }
+
+    /// ∫ g(w) dω over the sphere by the midpoint rule in polar coordinates
+    /// (ψ, φ) about `axis`, with ψ = π s³: points crowd near the axis (a
+    /// lobe of width 0.003 rad still gets about 100 of them in ψ) and still
+    /// cover the rest of the sphere at 0.003 rad or finer. Independent of
+    /// the sampling code and of the half-vector parametrisation.
+    fn integrate_about(axis: Vec3, g: impl Fn(Vec3) -> f64) -> f64 {
+        const N_S: usize = 1000;
+        const N_PHI: usize = 512;
+        let frame = ShadingFrame::new(axis);
+        let mut sum = 0.0;
+        for i in 0..N_S {
+            let s = (i as f64 + 0.5) / N_S as f64;
+            let psi = PI64 * s * s * s;
+            let weight = psi.sin() * 3.0 * PI64 * s * s / N_S as f64 * (2.0 * PI64 / N_PHI as f64);
+            for j in 0..N_PHI {
+                let phi = (j as f64 + 0.5) / N_PHI as f64 * 2.0 * PI64;
+                let local = Vec3::new((psi.sin() * phi.cos()) as f32, (psi.sin() * phi.sin()) as f32, psi.cos() as f32);
+                sum += g(frame.to_world(local)) * weight;
+            }
+        }
+        sum
+    }
+
+    /// Directional albedo ∫ f cos θi dωi (channel mean) by quadrature about
+    /// the mirror direction; a smooth surface's mirror adds its Fresnel.
+    fn albedo_by_quadrature(bsdf: &Bsdf, wo: Vec3) -> f64 {
+        let lobes = integrate_about(mirror_direction(wo), |wi| (mean(bsdf.f(wo, wi)) * wi.z.max(0.0)) as f64);
+        let mirror = if bsdf.is_delta() { mean(bsdf.specular_fresnel(wo.z)) as f64 } else { 0.0 };
+        lobes + mirror
+    }
+
+    /// Directional albedo as the mean sample weight (zero for no sample):
+    /// (mean, standard error).
+    fn albedo_by_sampling(bsdf: &Bsdf, wo: Vec3, n: usize, seed: u64) -> (f64, f64) {
+        let mut rng = Rng::for_item(seed, 0);
+        let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let u_lobe = rng.next_f32();
+            let w = bsdf.sample(wo, u_lobe, rng.next_2d()).map_or(0.0, |s| mean(s.weight) as f64);
+            sum += w;
+            sum2 += w * w;
+        }
+        let m = sum / n as f64;
+        (m, ((sum2 / n as f64 - m * m).max(0.0) / n as f64).sqrt())
+    }
+
+    #[test]
+    fn mixed_material_samples_match_its_pdf() {
+        let bsdf = Bsdf { base_color: Rgb::new(0.8, 0.5, 0.2), metallic: 0.5, roughness: 0.4, specular: 1.0 };
+        for deg in [30.0, 70.0] {
+            let wo = direction_at(deg);
+            // `sample` gives up on microfacet reflections below the surface;
+            // the helper wants a direction per draw, so draws repeat until
+            // one succeeds and the density is divided by the probability of
+            // success, ∫ pdf over the hemisphere.
+            let p_valid = integrate_about(mirror_direction(wo), |wi| bsdf.pdf(wo, wi) as f64) as f32;
+            println!("theta_o {deg}°: P(sample succeeds) = {p_valid:.5}");
+            assert!(p_valid <= 1.0 + 1e-4);
+            let rng = RefCell::new(Rng::for_item(0xB5DF, deg as u64));
+            let sample = |mut u: Vec2| loop {
+                let u_lobe = rng.borrow_mut().next_f32();
+                if let Some(s) = bsdf.sample(wo, u_lobe, u) {
+                    assert!(!s.is_delta && s.pdf == bsdf.pdf(wo, s.wi) && s.f == bsdf.f(wo, s.wi));
+                    return s.wi;
+                }
+                u = rng.borrow_mut().next_2d();
+            };
+            assert_direction_distribution(sample, |wi| bsdf.pdf(wo, wi) / p_valid);
+        }
+    }
+
+    #[test]
+    fn white_furnace() {
+        // Base colour 1: the directional albedo by quadrature and by sampling
+        // agree everywhere. Tolerances: quadrature error well under 1e-3 (the
+        // known values below agree to 1e-5); sampling 4.5 standard errors of
+        // 100 000 samples. Metals never exceed 1. The dielectric does beyond
+        // θo ≈ 44°: that is glTF's model, not this code (see
+        // `dielectric_over_lambert_energy`), so it is held to 1 at 0° and 30°.
+        let mut seed = 0;
+        for metallic in [0.0, 1.0] {
+            for roughness in [0.0, 0.1, 0.3, 0.6, 1.0] {
+                for deg in [0.0, 30.0, 60.0, 80.0] {
+                    let bsdf = white(metallic, roughness);
+                    let wo = direction_at(deg);
+                    let quadrature = albedo_by_quadrature(&bsdf, wo);
+                    seed += 1;
+                    let (mc, se) = albedo_by_sampling(&bsdf, wo, 100_000, seed);
+                    println!(
+                        "metallic {metallic}, roughness {roughness}, theta_o {deg:>2}°: \
+                         albedo {quadrature:.4} (quadrature), {mc:.4} ± {se:.4} (sampling)"
+                    );
+                    assert!(
+                        (quadrature - mc).abs() <= 4.5 * se + 1e-3,
+                        "quadrature {quadrature} vs sampling {mc} ± {se}"
+                    );
+                    if metallic == 1.0 || deg <= 30.0 {
+                        assert!(quadrature <= 1.0 + 1e-3, "albedo {quadrature} > 1");
+                        assert!(mc <= 1.0 + 4.5 * se + 1e-3, "sampled albedo {mc} ± {se} > 1");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rough_metal_loses_the_known_energy() {
+        // A white metal (F = 1) at α = 1 reflects, with single scattering only,
+        // E(wo) = ∫ D G2 (wo·h)/(n·wo) dω_h over the h whose reflection stays
+        // above the surface. At normal incidence D = 1/π and
+        // G2 = cos 2θ / cos²θ (Λ = (1/cos θ − 1)/2 at α = 1), so
+        // E = 2 ∫₀^{π/4} cos 2θ tan θ dθ = 1 − ln 2 ≈ 0.307: half the
+        // projected microfacets send normally incident light below the
+        // horizon, and G2 removes more: 69% of the energy is lost (55% at
+        // 60°, 33% at 80°, per `white_furnace`). This is the single-
+        // scattering loss that Kulla & Conty 2017 ("Revisiting Physically
+        // Based Shading at Imageworks") put at roughly half the energy for
+        // α = 1 and compensate with a multiple-scattering lobe; hikari does
+        // not compensate it (yet).
+        let bsdf = white(1.0, 1.0);
+        let normal = albedo_by_quadrature(&bsdf, Vec3::Z);
+        let expected_normal = 1.0 - std::f64::consts::LN_2;
+        // At 60° by a 2-D quadrature in half-vector space, with G2 from Λ
+        // rather than the visibility form that `f` uses.
+        let wo = direction_at(60.0);
+        let grazing = albedo_by_quadrature(&bsdf, wo);
+        let expected_grazing = integrate_half_vectors(1.0, |h| {
+            let wi = ggx::reflect(wo, h);
+            if wi.z <= 0.0 || wo.dot(h) <= 0.0 {
+                return 0.0;
+            }
+            (ggx::d(h, 1.0) * ggx::g2(wo, wi, 1.0) * wo.dot(h) / wo.z) as f64
+        });
+        println!(
+            "E(0°) = {normal:.5} (1 − ln 2 = {expected_normal:.5}); E(60°) = {grazing:.5} (half-vector quadrature {expected_grazing:.5})"
+        );
+        assert!((normal - expected_normal).abs() < 1e-3);
+        assert!((grazing - expected_grazing).abs() < 1e-3);
+    }
+
+    #[test]
+    fn dielectric_over_lambert_energy() {
+        // Metallic 0, specular 1, white base. glTF's fresnel_mix dims the
+        // diffuse base by 1 − F(|v·h|), with h the half vector of the pair,
+        // while the coat reflects about F(cos θo): toward grazing views the
+        // coat reflects much more than the base gives up, and the sum
+        // exceeds 1 (beyond θo ≈ 44° when smooth; its cosine-weighted mean
+        // over views is 1.039 smooth, 1.029 at roughness 0.3, 0.975 at 1).
+        // Up to 40° it stays below 1; the excess beyond is pinned here so
+        // that a change of the model is noticed.
+        for roughness in [0.0, 0.1, 0.3, 0.6, 1.0] {
+            let bsdf = white(0.0, roughness);
+            let albedos: Vec<f64> =
+                [0.0, 20.0, 40.0].map(|deg| albedo_by_quadrature(&bsdf, direction_at(deg))).to_vec();
+            println!("roughness {roughness}: albedo at 0°, 20°, 40°: {albedos:.4?}");
+            assert!(albedos.iter().all(|&a| a <= 1.0 + 1e-3), "{albedos:?}");
+        }
+        for (roughness, deg, expected) in
+            [(0.0, 80.0, 1.3539), (0.0, 89.0, 1.8534), (0.6, 80.0, 1.0453), (1.0, 89.0, 1.0101)]
+        {
+            let albedo = albedo_by_quadrature(&white(0.0, roughness), direction_at(deg));
+            println!("roughness {roughness}, theta_o {deg}°: albedo {albedo:.4}");
+            assert!((albedo - expected).abs() < 2e-3, "roughness {roughness}, {deg}°: {albedo} (was {expected})");
+        }
+    }
+
+    #[test]
+    fn reciprocity() {
+        let mut rng = Rng::for_item(21, 0);
+        for _ in 0..10_000 {
+            let base = Rgb::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let bsdf = Bsdf::new(base, rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let wo = cosine_hemisphere(rng.next_2d());
+            let wi = cosine_hemisphere(rng.next_2d());
+            let (a, b) = (bsdf.f(wo, wi), bsdf.f(wi, wo));
+            assert!(
+                (a - b).abs().max_element() <= 1e-5 * a.max_element(),
+                "{bsdf:?}: f(wo, wi) = {a}, f(wi, wo) = {b}"
+            );
+        }
+    }
+
+    #[test]
+    fn lambertian_setting_is_exactly_lambert() {
+        let rho = Rgb::new(0.7, 0.4, 0.1);
+        let bsdf = Bsdf::diffuse(rho);
+        assert_eq!(bsdf, Bsdf { base_color: rho, metallic: 0.0, roughness: 1.0, specular: 0.0 });
+        assert!(bsdf.has_diffuse() && !bsdf.has_specular() && !bsdf.is_delta());
+        let mut rng = Rng::for_item(3, 0);
+        for _ in 0..10_000 {
+            let wo = uniform_sphere(rng.next_2d());
+            let wi = uniform_sphere(rng.next_2d());
+            let above = wo.z > 0.0 && wi.z > 0.0;
+            assert_eq!(bsdf.f(wo, wi), if above { rho / PI } else { Rgb::ZERO });
+            assert_eq!(bsdf.pdf(wo, wi), if above { cosine_hemisphere_pdf(wi.z) } else { 0.0 });
+            if wo.z > 0.0 {
+                let u = rng.next_2d();
+                let s = bsdf.sample(wo, rng.next_f32(), u).unwrap();
+                assert!(!s.is_delta && s.wi == cosine_hemisphere(u));
+                assert!((s.weight - rho).abs().max_element() < 1e-6, "weight {}", s.weight);
+            }
+        }
+    }
+
+    #[test]
+    fn smooth_metal_is_a_schlick_mirror() {
+        let f0 = Rgb::new(0.95, 0.64, 0.54);
+        let mut rng = Rng::for_item(4, 0);
+        for roughness in [0.0, 0.04] {
+            let bsdf = Bsdf { roughness, ..Bsdf::mirror(f0) };
+            assert!(bsdf.is_delta() && !bsdf.has_diffuse());
+            for deg in [0.0, 20.0, 45.0, 70.0, 89.0] {
+                let wo = direction_at(deg);
+                let cos = wo.z;
+                let schlick = f0 + (Rgb::ONE - f0) * (1.0 - cos).powi(5);
+                for _ in 0..100 {
+                    let s = bsdf.sample(wo, rng.next_f32(), rng.next_2d()).unwrap();
+                    assert!(s.is_delta && s.pdf == 1.0);
+                    assert!((s.wi - mirror_direction(wo)).length() < 1e-6);
+                    assert!((s.weight - schlick).abs().max_element() < 1e-6, "{deg}°: {} vs {schlick}", s.weight);
+                    assert!((s.f * s.wi.z / s.pdf - s.weight).abs().max_element() < 1e-6);
+                }
+                // The mirror is not in f or pdf; nothing else reflects.
+                assert_eq!(bsdf.f(wo, mirror_direction(wo)), Rgb::ZERO);
+                assert_eq!(bsdf.pdf(wo, mirror_direction(wo)), 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn smooth_threshold_is_nearly_continuous() {
+        // Just below the threshold the mirror reflects F(cos θo); just at it
+        // the α = 0.0025 microfacet lobe reflects nearly the same.
+        let base = Rgb::new(0.9, 0.6, 0.3);
+        for metallic in [0.0, 1.0] {
+            for deg in [0.0, 45.0, 80.0] {
+                let wo = direction_at(deg);
+                let below = Bsdf { base_color: base, metallic, roughness: SMOOTH_ROUGHNESS * 0.999, specular: 1.0 };
+                let at = Bsdf { roughness: SMOOTH_ROUGHNESS, ..below };
+                assert!(below.is_delta() && !at.is_delta());
+                let (a_below, a_at) = (albedo_by_quadrature(&below, wo), albedo_by_quadrature(&at, wo));
+                println!("metallic {metallic}, theta_o {deg}°: albedo {a_below:.5} (mirror), {a_at:.5} (GGX)");
+                assert!((a_below - a_at).abs() < 1e-3 * a_below);
+            }
+        }
+    }
+
+    #[test]
+    fn nothing_below_the_surface() {
+        let bsdf = Bsdf { base_color: Rgb::splat(0.5), metallic: 0.3, roughness: 0.5, specular: 1.0 };
+        let (up, down) = (direction_at(30.0), -direction_at(50.0));
+        assert_eq!(bsdf.sample(down, 0.5, Vec2::splat(0.5)), None);
+        for (wo, wi) in [(up, down), (down, up), (down, down)] {
+            assert_eq!(bsdf.f(wo, wi), Rgb::ZERO);
+            assert_eq!(bsdf.pdf(wo, wi), 0.0);
+        }
+        assert_eq!(Bsdf::diffuse(Rgb::ZERO).sample(up, 0.5, Vec2::splat(0.5)), None);
+    }
+
+    #[test]
+    fn albedo_estimate_averages_the_lobe_weights() {
+        let rho = Rgb::new(0.7, 0.4, 0.1);
+        assert_eq!(Bsdf::diffuse(rho).albedo_estimate(), rho);
+        for (metallic, specular) in [(0.0, 1.0), (0.5, 0.5), (1.0, 1.0)] {
+            // White: whatever is not reflected specularly is reflected diffusely.
+            let estimate = Bsdf { specular, ..white(metallic, 0.5) }.albedo_estimate();
+            assert!((estimate - Rgb::ONE).abs().max_element() < 1e-6, "{estimate}");
+        }
+        // A mirror: the cosine-weighted mean of its sampled weight.
+        let f0 = Rgb::new(0.95, 0.64, 0.54);
+        let n = 10_000;
+        let mut average = Rgb::ZERO;
+        for i in 0..n {
+            let mu = ((i as f32 + 0.5) / n as f32).sqrt(); // cosine-weighted: μ = √u
+            let wo = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+            average += Bsdf::mirror(f0).sample(wo, 0.5, Vec2::ZERO).unwrap().weight / n as f32;
+        }
+        let estimate = Bsdf::mirror(f0).albedo_estimate();
+        assert!((average - estimate).abs().max_element() < 1e-4, "{average} vs {estimate}");
+    }
+
+    #[test]
+    fn shading_frame_round_trips() {
+        let mut rng = Rng::for_item(8, 0);
+        for _ in 0..1000 {
+            let n = uniform_sphere(rng.next_2d());
+            let frame = ShadingFrame::new(n);
+            let w = uniform_sphere(rng.next_2d());
+            assert!((frame.to_world(frame.to_local(w)) - w).length() < 1e-5);
+            assert!((frame.to_world(w) - local_to_world(w, n)).length() < 1e-6);
+            assert!((frame.to_local(n) - Vec3::Z).length() < 1e-5);
+        }
+    }
+}
