@@ -389,3 +389,66 @@ fn gltf_files_render_and_broken_ones_are_located_errors() {
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert_fails_with(&out, &dir, &["box.glb", "cameras", "\"Nope\""]);
 }
+
+/// A floor and a box under a sun and a sky, in TOML.
+const SUN_AND_SKY: &str = r#"
+[camera]
+position = [0.0, 1.2, 2.5]
+look_at = [0.0, 0.2, 0.0]
+resolution = [32, 32]
+
+[[material]]
+name = "grey"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[object]]
+shape = "quad"
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "grey"
+
+[[object]]
+shape = "box"
+center = [0.0, 0.3, 0.0]
+size = [0.6, 0.6, 0.6]
+material = "grey"
+
+[[light]]
+type = "directional"
+direction = [0.5, -0.866, -0.2]
+irradiance = [3.0, 3.0, 3.0]
+
+[environment]
+radiance = [0.3, 0.4, 0.5]
+"#;
+
+/// Suns, skies and emissive surfaces render on the GPU: a TOML scene under
+/// a sun and a sky without a line about falling back; glTF files (the
+/// Cornell box with its light as an emissive surface, one without lights,
+/// which the loader lights with a white sky) for their lights neither
+/// (their glossy glTF materials may still send `render` to photon-cpu, with
+/// that reason).
+#[test]
+fn suns_skies_and_emissive_surfaces_render_on_the_gpu() {
+    use hikari_core::scene::gltf::export::scene_to_glb;
+    let dir = scratch_dir("distant-gpu");
+    std::fs::write(dir.join("sun-and-sky.toml"), SUN_AND_SKY).unwrap();
+    let mesh_light = scene_to_glb(&hikari_core::test_scenes::cornell_quad_light(32)).unwrap();
+    std::fs::write(dir.join("mesh-light.glb"), mesh_light).unwrap();
+    std::fs::write(dir.join("unlit.glb"), unlit_glb()).unwrap();
+    for file in ["sun-and-sky.toml", "mesh-light.glb", "unlit.glb"] {
+        let out = hikari(&["render", file, "--resolution", "32", "--photons", "5000", "-o", "g.exr"], &dir);
+        let err = stderr(&out);
+        assert!(out.status.success(), "{file}: {err}");
+        let fell_back = err.lines().find(|l| l.contains("rendering with photon-cpu instead"));
+        match fell_back {
+            Some(line) if file.ends_with(".glb") => assert!(line.contains("material"), "{file}: {line}"),
+            Some(line) => panic!("{file} fell back: {line}"),
+            None => {}
+        }
+        let image = hikari_core::output::read_exr(&dir.join("g.exr")).unwrap();
+        assert!(image.mean() > 0.0, "{file}: a black image");
+    }
+}

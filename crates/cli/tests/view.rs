@@ -189,6 +189,33 @@ wait $pid
     assert!(reloaded > broken, "{err}");
 }
 
+/// glTF files lit as the GPU renderer could not light them before: one
+/// without lights (the loader's white sky, seen past the floor's edge) and
+/// the Cornell box lit by an emissive surface open in the window and draw
+/// their light.
+#[test]
+fn view_opens_gltf_files_under_a_sky_or_an_emissive_surface() {
+    let _display = one_display();
+    let dir = scratch_dir("view-gltf");
+    std::fs::write(dir.join("unlit.glb"), unlit_glb()).unwrap();
+    let mesh_light =
+        hikari_core::scene::gltf::export::scene_to_glb(&hikari_core::test_scenes::cornell_quad_light(32)).unwrap();
+    std::fs::write(dir.join("mesh-light.glb"), mesh_light).unwrap();
+    let common = ["--size", "32x32", "--photons", "3000", "--frames", "2"];
+    let text = view(&dir, &[&["unlit.glb"], &common[..], &["--screenshot", "sky.exr"]].concat());
+    assert!(text.contains("view: 2 frames"), "{text}");
+    let sky = exr(&dir, "sky.exr");
+    // The top row looks over the floor's far edge: the white sky, radiance 1.
+    assert!(sky[..32].iter().all(|p| p.iter().all(|&c| (c - 1.0).abs() < 1e-3)), "{:?}", &sky[..4]);
+    assert!(image_mean(&sky[32 * 16..]) > 0.1, "the floor is dark");
+    view(&dir, &[&["mesh-light.glb"], &common[..], &["--screenshot", "mesh.exr"]].concat());
+    let mesh = exr(&dir, "mesh.exr");
+    // The light itself (radiance 12) in view, and the box lit.
+    let brightest = mesh.iter().map(|p| p[0]).fold(0.0f32, f32::max);
+    assert!((brightest - 12.0).abs() < 0.1, "the light shows {brightest}");
+    assert!(image_mean(&mesh) > 0.1, "the box is dark: {}", image_mean(&mesh));
+}
+
 /// Runs `hikari view ARGS` under Xvfb in `dir`; returns its summary line.
 fn view(dir: &std::path::Path, args: &[&str]) -> String {
     let out = Command::new("xvfb-run")

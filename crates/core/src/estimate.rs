@@ -77,6 +77,28 @@ pub fn fixed_radius_radiance(
     radiance_per_power(albedo, params) * power * map.power_unit
 }
 
+/// The same estimate for any BRDF: Σ f_r(ω_p) ΔΦ_p / (π r²) over the
+/// accepted photons of `map`, each weighted by `brdf` at its own incoming
+/// direction (−`photon.direction()`, toward where it came from). With
+/// f_r = albedo/π it equals [`fixed_radius_radiance`].
+pub fn fixed_radius_radiance_brdf(
+    map: &PhotonMap,
+    x: Vec3,
+    normal: Vec3,
+    params: &FixedRadius,
+    brdf: impl Fn(Vec3) -> Rgb,
+) -> Rgb {
+    let photons = map.photons();
+    let mut sum = Rgb::ZERO;
+    map.for_each_index_within(x, params.radius, |i, d2| {
+        let p = &photons[i];
+        if photon_accepted(d2, p.direction(), normal, params) {
+            sum += brdf(-p.direction()) * map.power_in_units(i);
+        }
+    });
+    sum * (map.power_unit / (PI * params.radius * params.radius))
+}
+
 /// In-scattered radiance reaching the eye along the segment `origin +
 /// t·dir`, t in [0, length], from a volume photon map (eq. 5.21–5.24 with an
 /// exact chord): for each photon p whose radius-r sphere the segment crosses,

@@ -43,3 +43,4 @@ pub mod sampling;
 pub mod scene;
 #[doc(hidden)]
 pub mod test_scenes;
+pub mod texture;

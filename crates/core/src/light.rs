@@ -144,6 +144,13 @@ impl EmissiveMesh {
         *self.cumulative_area.last().expect("an emissive mesh has triangles")
     }
 
+    /// Entry i: the total area of triangles 0..=i, as `emit` and
+    /// `sample_incident` search it (the GPU's photon tracer searches the
+    /// same numbers, so it picks the same triangles).
+    pub fn cumulative_areas(&self) -> &[f32] {
+        &self.cumulative_area
+    }
+
     /// The same mesh with every vertex mapped by `f`, which must keep areas
     /// (a rigid motion), so the area table stays valid.
     fn map_vertices(&self, f: impl Fn(Vec3) -> Vec3) -> EmissiveMesh {

@@ -1,14 +1,19 @@
 //! Surface materials: a closed set, as in METHOD.md §2.
 //!
-//! `Diffuse` is Lambertian with an optional perfect-mirror part
-//! (ρ_d + ρ_s ≤ 1 per channel). `Mirror` is a perfect mirror, `Glass` a
-//! smooth dielectric with Fresnel reflection/refraction.
+//! `Pbr` is the glTF 2.0 metallic–roughness model ([`crate::bsdf::Bsdf`]:
+//! Lambert plus a GGX lobe), which glTF files use. `Diffuse` is Lambertian
+//! with an optional perfect-mirror part (ρ_d + ρ_s ≤ 1 per channel),
+//! `Mirror` a perfect mirror (both the `Bsdf` settings `diffuse` and
+//! `mirror` up to the mirror's Fresnel; they stay separate variants until the
+//! GPU renderer evaluates `Bsdf`), `Glass` a smooth dielectric with Fresnel
+//! reflection/refraction.
 
+use crate::bsdf::Bsdf;
 use glam::Vec3;
 
 pub type Rgb = Vec3;
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
     Diffuse {
         albedo: Rgb,
@@ -20,6 +25,8 @@ pub enum Material {
     Glass {
         ior: f32,
     },
+    /// The glTF metallic–roughness BRDF.
+    Pbr(Bsdf),
     /// Black, non-reflecting surface: the body of an area light.
     Emitter,
 }
@@ -33,26 +40,45 @@ pub enum Event {
 }
 
 impl Material {
+    /// The glTF BRDF `bsdf` as a material: `Pbr`, or `Diffuse` when it is
+    /// exactly Lambertian (a dielectric without specular lobe: f = base/π
+    /// whatever the roughness), which every renderer, the GPU's included,
+    /// draws exactly.
+    pub fn from_bsdf(bsdf: Bsdf) -> Material {
+        if bsdf.metallic == 0.0 && bsdf.specular == 0.0 {
+            Material::Diffuse { albedo: bsdf.base_color, specular: Rgb::ZERO }
+        } else {
+            Material::Pbr(bsdf)
+        }
+    }
+
     /// Diffuse reflectance ρ_d (zero for purely specular materials).
+    /// For `Pbr`, the diffuse lobe's reflectance at normal incidence.
     pub fn diffuse_albedo(&self) -> Rgb {
         match self {
             Material::Diffuse { albedo, .. } => *albedo,
+            Material::Pbr(bsdf) => bsdf.lambert_albedo(),
             _ => Rgb::ZERO,
         }
     }
 
-    /// Mirror reflectance ρ_s of diffuse/mirror materials.
+    /// Mirror reflectance ρ_s of diffuse/mirror materials; for a smooth
+    /// `Pbr` lobe, its reflectance at normal incidence.
     pub fn mirror_reflectance(&self) -> Rgb {
         match self {
             Material::Diffuse { specular, .. } => *specular,
             Material::Mirror { reflectance } => *reflectance,
+            Material::Pbr(bsdf) if bsdf.is_delta() => bsdf.normal_reflectance(),
             _ => Rgb::ZERO,
         }
     }
 
     /// Has a diffuse part, so photons are stored here and the estimate applies.
     pub fn is_diffuse(&self) -> bool {
-        self.diffuse_albedo().max_element() > 0.0
+        match self {
+            Material::Pbr(bsdf) => bsdf.stores_photons(),
+            _ => self.diffuse_albedo().max_element() > 0.0,
+        }
     }
 
     /// Russian roulette over diffuse/specular/absorbed with the RGB rule of

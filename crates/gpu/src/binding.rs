@@ -52,10 +52,12 @@ pub fn storage_texture_rgba32f() -> wgpu::BindingType {
 /// wgpu's OpenGL backend makes every square texture whose layers are a
 /// multiple of 6 a cube map (its heuristic, wgpu issues #1574 and #1614),
 /// and then renders nothing into its layers as 2D views (measured: the shadow
-/// maps of a point light stayed zero); one spare layer keeps it an array.
+/// maps of a point light stayed zero), and a texture of one layer a plain 2D
+/// texture, which reads as zeros through an array view (measured: a sun's
+/// one shadow view shadowed everything); one spare layer keeps either an array.
 pub fn array_layers(width: u32, height: u32, layers: u32) -> u32 {
     let layers = layers.max(1);
-    if width == height && layers % 6 == 0 { layers + 1 } else { layers }
+    if layers == 1 || (width == height && layers % 6 == 0) { layers + 1 } else { layers }
 }
 
 /// The layout of a pipeline with one bind group (every pass has one).
@@ -200,11 +202,12 @@ pub fn color_pass<'a>(
 #[cfg(test)]
 mod tests {
     #[test]
-    fn array_textures_are_never_cube_compatible() {
+    fn array_textures_are_never_cube_compatible_nor_single() {
         assert_eq!(super::array_layers(64, 64, 6), 7);
         assert_eq!(super::array_layers(64, 64, 12), 13);
         assert_eq!(super::array_layers(64, 32, 6), 6);
         assert_eq!(super::array_layers(64, 64, 8), 8);
-        assert_eq!(super::array_layers(64, 64, 0), 1);
+        assert_eq!(super::array_layers(64, 64, 0), 2);
+        assert_eq!(super::array_layers(64, 32, 1), 2);
     }
 }

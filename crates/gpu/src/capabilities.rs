@@ -34,10 +34,11 @@ pub fn required_limits() -> wgpu::Limits {
         // Four Rgba32Float G-buffer targets.
         max_color_attachments: 4,
         max_color_attachment_bytes_per_sample: 64,
-        // The specular pass: BVH nodes and primitives, surfaces, photon
-        // grids, region triangles, lights, light samples, shadow views,
-        // its accumulation buffer and its status words.
-        max_storage_buffers_per_shader_stage: 10,
+        // The photon tracer: BVH nodes, primitives and shading normals,
+        // surfaces, lights, media, photon records, counts, status words,
+        // region triangles and emissive triangles (the specular pass binds
+        // 10).
+        max_storage_buffers_per_shader_stage: 11,
         max_storage_textures_per_shader_stage: 1,
         max_bindings_per_bind_group: 16,
         max_compute_invocations_per_workgroup: 256,
@@ -255,7 +256,7 @@ mod tests {
     fn shortfalls_name_the_limit() {
         let offered = wgpu::Limits { max_storage_buffers_per_shader_stage: 4, ..wgpu::Limits::default() };
         let short = limit_shortfalls(&offered, &required_limits());
-        assert!(short.iter().any(|s| s.contains("max_storage_buffers_per_shader_stage 4 < 10")), "{short:?}");
+        assert!(short.iter().any(|s| s.contains("max_storage_buffers_per_shader_stage 4 < 11")), "{short:?}");
         assert!(limit_shortfalls(&required_limits(), &required_limits()).is_empty());
     }
 

@@ -194,24 +194,6 @@ fn specular_inputs<'a>(
     }
 }
 
-/// Why the GPU passes cannot draw `scene`'s lights, if so: they shade
-/// point, spot, sphere and quad lights only. Checked by
-/// `GpuRenderer::unsupported` (so by `check_fits`, `new` and `set_scene`)
-/// and by the GPU tracer before either sees such a light.
-pub fn unsupported_lights(scene: &Scene) -> Option<String> {
-    use hikari_core::light::Light;
-    scene
-        .lights
-        .iter()
-        .any(|l| matches!(l, Light::Directional { .. } | Light::Environment { .. } | Light::Mesh(_)))
-        .then(|| UNSUPPORTED_LIGHTS.to_string())
-}
-
-/// The reason [`unsupported_lights`] gives (and GPU code that cannot be
-/// reached with such a light panics with).
-pub(crate) const UNSUPPORTED_LIGHTS: &str =
-    "directional lights, environments and emissive meshes are not yet on the GPU renderer";
-
 /// The rasterizing passes' projection for `camera` in a scene within `bounds`.
 fn clip_from_world(camera: &hikari_core::camera::Camera, bounds: (Vec3, Vec3)) -> glam::Mat4 {
     let (near, far) = depth_range(bounds, camera.position);
@@ -232,9 +214,6 @@ impl GpuRenderer {
     /// optical depths off by 8e-4 where they are 0, fog frames off by more
     /// than 2%).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
-        if let Some(why) = unsupported_lights(scene) {
-            return Some(why);
-        }
         (!ctx.float32_blend && !scene.media.is_empty())
             .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string())
     }
@@ -326,7 +305,7 @@ impl GpuRenderer {
             indirect: radiance_target("indirect radiance"),
             caustic: radiance_target("caustic radiance"),
             volume: radiance_target("volume radiance"),
-            shadow_maps: shadow_pass.create_maps(device, &lights.views, settings.shadow_map_size, scene.accel.bounds()),
+            shadow_maps: shadow_pass.create_maps(device, &lights, settings.shadow_map_size, scene.accel.bounds()),
         };
         let scene_buffers = SceneBuffers::upload(device, scene);
         let global_photons = traced.indirect();
@@ -368,6 +347,7 @@ impl GpuRenderer {
             &t.volume,
             &t.gbuffer,
             &media,
+            lights.sky_radiance,
         );
         GpuRenderer {
             resolve_pass,
@@ -484,10 +464,11 @@ impl GpuRenderer {
         self.gbuffer_binding = self.gbuffer_pass.bind(device, &self.scene, &self.targets.gbuffer);
         self.bounds = scene.accel.bounds();
         let lights = GpuLights::new(scene, self.settings.area_light_samples);
-        if !self.targets.shadow_maps.update(queue, &lights.views, self.bounds) {
+        if !self.targets.shadow_maps.update(queue, &lights, self.bounds) {
             self.targets.shadow_maps =
-                self.shadow_pass.create_maps(device, &lights.views, self.settings.shadow_map_size, self.bounds);
+                self.shadow_pass.create_maps(device, &lights, self.settings.shadow_map_size, self.bounds);
         }
+        self.resolve_pass.set_sky(queue, lights.sky_radiance);
         self.direct_binding = self.direct_pass.bind(
             device,
             &self.targets.gbuffer,
@@ -875,25 +856,5 @@ impl GpuRenderer {
             }
         }
         Ok((image, nonfinite))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use hikari_core::test_scenes::{cornell_quad_light, quad_lights_as_meshes, sky_floor, sunlit_floor};
-
-    /// Suns, skies and emissive meshes are refused with one reason, before
-    /// any pass sees them; sizing a frame skips them rather than panicking.
-    #[test]
-    fn distant_and_mesh_lights_are_refused() {
-        let sun = sunlit_floor(30.0, 1.0, 0.5, false);
-        let sky = sky_floor(1.0, "name = \"floor\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]");
-        let mesh = quad_lights_as_meshes(&cornell_quad_light(8));
-        for scene in [&sun, &sky, &mesh] {
-            assert_eq!(unsupported_lights(scene).as_deref(), Some(UNSUPPORTED_LIGHTS));
-        }
-        assert_eq!(unsupported_lights(&cornell_quad_light(8)), None);
-        assert!(GpuLights::new(&sun, 4).lights.is_empty());
     }
 }

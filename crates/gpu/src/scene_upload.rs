@@ -33,13 +33,16 @@ pub mod kind {
 pub struct GpuSurface {
     pub albedo: [f32; 3],
     pub kind: u32,
-    /// Radiance emitted toward the side the geometric normal faces.
+    /// Radiance emitted toward the side the geometric normal faces (area
+    /// lights' bodies, emissive meshes), or toward both sides when
+    /// `two_sided` is 1: `Light::emitted_radiance`.
     pub emission: [f32; 3],
     /// Index of refraction (glass).
     pub ior: f32,
     /// Mirror reflectance ρ_s of diffuse + mirror materials.
     pub specular: [f32; 3],
-    pub _pad: u32,
+    /// 1 where `emission` leaves both faces (two-sided emissive meshes).
+    pub two_sided: u32,
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -129,6 +132,34 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
     }
 }
 
+/// Why the GPU's image of `scene` is not exact, or None: the GPU passes do
+/// not evaluate the glTF BRDF yet, so a `Pbr` material with a specular lobe
+/// is drawn as its Lambert part (and a smooth lobe as a mirror of its
+/// normal-incidence reflectance). Nor do they sample textures: textured
+/// materials are drawn in their factors and cut-outs (`alphaMode` MASK)
+/// opaque. `hikari render` then renders with photon-cpu; the viewer draws
+/// the approximation and says so.
+pub fn approximated_materials(scene: &Scene) -> Option<String> {
+    let glossy = scene.materials.iter().filter(|m| matches!(m, Material::Pbr(b) if b.has_specular())).count();
+    let textures = scene.texturing.as_ref().map(|t| t.materials.iter().flatten());
+    let textured = textures.clone().map_or(0, |t| t.filter(|m| m.is_textured()).count());
+    let masked = textures.map_or(0, |t| t.filter(|m| m.alpha_cutoff.is_some()).count());
+    let mut why = Vec::new();
+    if glossy > 0 {
+        why.push(format!(
+            "{glossy} glossy (metallic-roughness) material(s) are drawn by the GPU renderer as their diffuse part \
+             (a smooth lobe as a mirror) until it evaluates the glTF BRDF"
+        ));
+    }
+    if textured > 0 {
+        why.push(format!("{textured} textured material(s) are drawn by the GPU renderer in their factors"));
+    }
+    if masked > 0 {
+        why.push(format!("{masked} cut-out (alphaMode MASK) material(s) are drawn opaque by the GPU renderer"));
+    }
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
 pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
     scene
         .surfaces
@@ -140,11 +171,16 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 Material::Mirror { reflectance } => (kind::MIRROR, *reflectance, 1.0),
                 Material::Glass { ior } => (kind::GLASS, Vec3::ONE, *ior),
                 Material::Emitter => (kind::EMITTER, Vec3::ZERO, 1.0),
+                // Until the GPU evaluates the BRDF: its Lambert part, and a
+                // smooth lobe as a mirror (`renderer::approximated_materials`).
+                Material::Pbr(_) => (kind::DIFFUSE, material.diffuse_albedo(), 1.0),
             };
-            let emission = s.emitter.map_or(Vec3::ZERO, |l| match &scene.lights[l as usize] {
+            // What the eye sees besides what the surface reflects.
+            let (emission, two_sided) = s.emitter.map_or((Vec3::ZERO, false), |l| match &scene.lights[l as usize] {
                 hikari_core::light::Light::Sphere { radiance, .. }
-                | hikari_core::light::Light::Quad { radiance, .. } => *radiance,
-                _ => Vec3::ZERO,
+                | hikari_core::light::Light::Quad { radiance, .. } => (*radiance, false),
+                hikari_core::light::Light::Mesh(mesh) => (mesh.radiance, mesh.two_sided),
+                _ => (Vec3::ZERO, false),
             });
             GpuSurface {
                 albedo: albedo.to_array(),
@@ -152,7 +188,7 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 emission: emission.to_array(),
                 ior,
                 specular: if kind == kind::DIFFUSE { material.mirror_reflectance().to_array() } else { [0.0; 3] },
-                _pad: 0,
+                two_sided: two_sided as u32,
             }
         })
         .collect()

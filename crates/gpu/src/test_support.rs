@@ -42,3 +42,77 @@ pub fn eye_near_the_floor(size: u32) -> hikari_core::camera::Camera {
     )
     .expect("a valid camera")
 }
+
+/// An open 4×4 floor at y = 0 (albedo 0.5) with `objects` on it and
+/// `lights`, seen at `size`² from above and in front, so that the top rows
+/// see past the floor's far edge (the sky, where there is one).
+fn open_floor(size: u32, objects: &str, lights: &str) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 1.2, 2.5]
+look_at = [0.0, 0.2, 0.0]
+fov_y = 40.0
+resolution = [{size}, {size}]
+
+[[material]]
+name = "floor"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[material]]
+name = "grey"
+type = "diffuse"
+albedo = [0.6, 0.55, 0.5]
+
+[[material]]
+name = "mirror"
+type = "mirror"
+reflectance = [0.9, 0.9, 0.9]
+
+[[object]]
+shape = "quad"
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "floor"
+
+{objects}
+{lights}"#
+    );
+    Scene::from_toml(&text, "open-floor", None).expect("a valid test scene")
+}
+
+/// A grey box floating over an open floor under a sun 30° from the zenith:
+/// its hard shadow, its lit top and the light it reflects are in view.
+pub fn sun_over_a_box(size: u32) -> Scene {
+    open_floor(
+        size,
+        "[[object]]\nshape = \"box\"\ncenter = [-0.2, 0.5, 0.0]\nsize = [0.4, 0.3, 0.4]\nmaterial = \"grey\"\n",
+        "[[light]]\ntype = \"directional\"\ndirection = [0.5, -0.866, -0.2]\nirradiance = [3.0, 3.0, 3.0]\n",
+    )
+}
+
+/// A grey box and a mirror ball on an open floor under a uniform sky of
+/// radiance 1: the box's soft shadow, the sky seen past the floor and in
+/// the ball.
+pub fn sky_over_a_box(size: u32) -> Scene {
+    open_floor(
+        size,
+        "[[object]]\nshape = \"box\"\ncenter = [-0.35, 0.25, 0.0]\nsize = [0.5, 0.5, 0.5]\nmaterial = \"grey\"\n\n\
+         [[object]]\nshape = \"sphere\"\ncenter = [0.45, 0.25, 0.3]\nradius = 0.25\nmaterial = \"mirror\"\n",
+        "[environment]\nradiance = [1.0, 1.0, 1.0]\n",
+    )
+}
+
+/// [`sun_over_a_box`] also under a sky, in absorbing and scattering fog
+/// that fills the scene: distant lights in a medium.
+pub fn sun_and_sky_in_fog(size: u32) -> Scene {
+    open_floor(
+        size,
+        "[[object]]\nshape = \"box\"\ncenter = [-0.2, 0.5, 0.0]\nsize = [0.4, 0.3, 0.4]\nmaterial = \"grey\"\n",
+        "[[light]]\ntype = \"directional\"\ndirection = [0.5, -0.866, -0.2]\nirradiance = [3.0, 3.0, 3.0]\n\n\
+         [environment]\nradiance = [0.3, 0.4, 0.5]\n\n\
+         [[medium]]\nsigma_a = [0.02, 0.03, 0.04]\nsigma_s = [0.1, 0.1, 0.1]\nphase = \"hg\"\ng = 0.3\n",
+    )
+}

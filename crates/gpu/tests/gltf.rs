@@ -38,3 +38,21 @@ fn gltf_cornell_box_renders_as_the_toml_one_on_the_gpu() {
     eprintln!("{differing} of {} pixels differ beyond rounding", a.len());
     assert!(differing <= a.len() / 100, "{differing} pixels differ");
 }
+
+/// The showcase (a sun through a window, a glowing strip, a spot, metal
+/// and glass) renders on the GPU: every pass takes its sun and its
+/// emissive mesh, and the frame is finite and lit.
+#[test]
+fn the_showcase_renders_on_the_gpu() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb");
+    let mut scene = Scene::load(path).unwrap();
+    scene.camera = scene.camera.with_resolution(48, 32).unwrap();
+    use hikari_core::light::Light;
+    assert!(scene.lights.iter().any(|l| matches!(l, Light::Directional { .. })));
+    assert!(scene.lights.iter().any(|l| matches!(l, Light::Mesh(_))));
+    let pixels = frame(&scene);
+    assert!(pixels.iter().all(|p| p.is_finite()));
+    let mean = pixels.iter().map(|p| p.truncate().element_sum() as f64 / 3.0).sum::<f64>() / pixels.len() as f64;
+    eprintln!("showcase: mean radiance {mean:.4}");
+    assert!(mean > 0.01, "a dark showcase: {mean}");
+}

@@ -19,7 +19,7 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("present.wgsl", hikari_gpu::present::shader_source()),
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
         ("estimate.wgsl", hikari_gpu::wgsl::compose(&[&hikari_gpu::wgsl::ESTIMATE])),
-        ("shadow.wgsl", hikari_gpu::shadow::SHADER.to_string()),
+        ("shadow.wgsl", hikari_gpu::shadow::shader_source()),
         ("direct.wgsl", hikari_gpu::direct::shader_source()),
         ("lod.wgsl", hikari_gpu::lod::shader_source()),
         ("specular.wgsl", hikari_gpu::specular::shader_source()),
@@ -80,14 +80,14 @@ macro_rules! assert_layout {
 fn shared_structs_match_wgsl_layouts() {
     let gbuffer = hikari_gpu::gbuffer::shader_source();
     assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
-    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
+    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, two_sided]);
     let splat = hikari_gpu::splat::shader_source();
     assert_layout!(splat, "SplatParams", SplatParams, [clip_from_world, radius, power_unit, normal_test, _pad]);
-    let shadow = hikari_gpu::shadow::SHADER.to_string();
-    assert_layout!(shadow, "ShadowViewParams", ShadowViewParams, [clip_from_world, light_position]);
+    let shadow = hikari_gpu::shadow::shader_source();
+    assert_layout!(shadow, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
     let direct = hikari_gpu::direct::shader_source();
     assert_layout!(direct, "DirectParams", DirectParams, [light_count, shadow_size, bias, _pad]);
-    assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position]);
+    assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
     assert_layout!(
         direct,
         "Light",
@@ -102,12 +102,12 @@ fn shared_structs_match_wgsl_layouts() {
             edge_v,
             cutoff,
             falloff_start,
-            _pad0,
-            _pad1,
-            _pad2
+            sample_area,
+            two_sided,
+            _pad
         ]
     );
-    assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, view_count, _pad0, _pad1, _pad2]);
+    assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, direction, view_count]);
     let specular = hikari_gpu::specular::shader_source();
     assert_layout!(
         specular,
@@ -141,12 +141,14 @@ fn shared_structs_match_wgsl_layouts() {
             volume_min,
             jitter_x,
             volume_max,
-            jitter_y
+            jitter_y,
+            sky_radiance,
+            _pad
         ]
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
-    assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, _pad]);
+    assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, two_sided]);
     assert_layout!(specular, "SliceParams", hikari_gpu::specular::SliceParams, [index, count, iteration_budget, _pad]);
     let resolve = hikari_gpu::resolve::shader_source();
     let (size, members) = wgsl_layout(&resolve, "Terms");
@@ -178,11 +180,12 @@ fn shared_structs_match_wgsl_layouts() {
             region_triangles,
             phases,
             image_size,
-            jitter
+            jitter,
+            distant_disc
         ]
     );
     assert_layout!(volume, "RegionTriangle", hikari_gpu::media::RegionTriangle, [a, b, c, sigma_t]);
-    use hikari_gpu::trace::{CompactParams, PhotonRecord, TraceLight, TraceMedium, TraceParams};
+    use hikari_gpu::trace::{CompactParams, PhotonRecord, TraceLight, TraceMedium, TraceParams, TraceTriangle};
     let trace = hikari_gpu::trace::trace_shader_source();
     assert_layout!(
         trace,
@@ -201,7 +204,8 @@ fn shared_structs_match_wgsl_layouts() {
             medium_count,
             global_mask,
             region_triangles,
-            _pad0
+            _pad0,
+            distant_disc
         ]
     );
     assert_layout!(
@@ -220,10 +224,16 @@ fn shared_structs_match_wgsl_layouts() {
             power,
             falloff_start,
             probability,
-            _pad0,
-            _pad1,
-            _pad2
+            first_triangle,
+            triangle_count,
+            two_sided
         ]
+    );
+    assert_layout!(
+        trace,
+        "TraceTriangle",
+        TraceTriangle,
+        [v0, cumulative_area, v1, start_area, v2, _pad0, normal, _pad1]
     );
     assert_layout!(
         trace,

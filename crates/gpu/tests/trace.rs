@@ -10,8 +10,9 @@ use hikari_core::progressive::compare;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
+use hikari_core::test_scenes::{cornell_quad_light, quad_lights_as_meshes};
 use hikari_gpu::GpuContext;
-use hikari_gpu::test_support::test_context;
+use hikari_gpu::test_support::{sky_over_a_box, sun_and_sky_in_fog, sun_over_a_box, test_context};
 use hikari_gpu::trace::GpuTracer;
 use hikari_gpu::wgsl::{Module, PHOTON_ENCODING, RANDOM, SAMPLING, compose};
 use std::collections::HashMap;
@@ -360,7 +361,24 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("fog-stage-layered", Scene::load("fog-stage-layered").unwrap()),
         ("features", feature_scene(false)),
         ("features + media", feature_scene(true)),
+        ("sun over a box", sun_over_a_box(32)),
+        ("sky over a box", sky_over_a_box(32)),
+        ("sun and sky in fog", sun_and_sky_in_fog(32)),
+        ("cornell mesh light", quad_lights_as_meshes(&cornell_quad_light(16))),
+        ("cornell two-sided mesh light", two_sided(quad_lights_as_meshes(&cornell_quad_light(16)))),
     ]
+}
+
+/// `scene` with its emissive meshes made two-sided.
+fn two_sided(mut scene: Scene) -> Scene {
+    use hikari_core::light::{EmissiveMesh, Light};
+    for light in &mut scene.lights {
+        if let Light::Mesh(mesh) = light {
+            let both = EmissiveMesh::new(mesh.triangles().to_vec(), mesh.radiance, true).unwrap();
+            *light = Light::Mesh(std::sync::Arc::new(both));
+        }
+    }
+    scene
 }
 
 /// With the same seed the GPU takes the CPU's paths: nearly every photon
@@ -421,9 +439,15 @@ fn stored_flux_matches_per_class_and_bounce() {
         let gpu = gpu_trace(&ctx, &scene, &TraceSettings { photons, seed: 22, ..Default::default() });
         assert_flux_per_class(name, &gpu, &cpu);
         let per_bounce = |t: &TracedPhotons| t.stats.stored_flux_per_bounce.clone();
+        let first = per_bounce(&cpu)[0].max_element();
         for (k, (g, c)) in per_bounce(&gpu).iter().zip(per_bounce(&cpu).iter()).enumerate().take(3) {
             let rel = ((*g - *c) / *c).abs().max_element();
             eprintln!("{name} bounce {k}: GPU {g} CPU {c}");
+            // Open scenes lose most photons to the sky: a bounce with under
+            // 2% of the first one's flux holds too few photons to compare.
+            if c.max_element() < 0.02 * first {
+                continue;
+            }
             assert!(rel < 0.05, "{name} bounce {k}: GPU {g} vs CPU {c}");
         }
         let volume = |t: &TracedPhotons| t.volume.iter().map(|p| p.power_in_units().element_sum() as f64).sum::<f64>();

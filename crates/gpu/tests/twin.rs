@@ -183,3 +183,20 @@ fn gpu_passes_equal_cpu_estimates_at_their_radii() {
         assert_twin(&format!("{name}, caustic map"), &caustic, 20);
     }
 }
+
+/// Photons from a sky and from an emissive mesh (traced from their discs
+/// and triangles) splat to the CPU's estimate as any others do.
+#[test]
+fn gpu_splat_equals_cpu_estimate_under_a_sky_and_an_emissive_mesh() {
+    use hikari_core::test_scenes::{cornell_quad_light, quad_lights_as_meshes};
+    let scenes = [
+        ("sky over a box", hikari_gpu::test_support::sky_over_a_box(64), 50_000, 500),
+        ("emissive mesh", quad_lights_as_meshes(&cornell_quad_light(64)), 20_000, 2000),
+    ];
+    for (name, scene, photons, min_lit) in scenes {
+        for estimator in ESTIMATORS {
+            let (indirect, _) = twin_scene(scene.clone(), photons, false, estimator).expect("a twin");
+            assert_twin(&format!("{name} indirect ({estimator:?})"), &indirect, min_lit);
+        }
+    }
+}

@@ -65,3 +65,11 @@ type = "point"
 position = [0.0, 2.0, 2.0]
 intensity = [5.0, 5.0, 5.0]
 "#;
+
+/// A glTF file of `hikari_gpu::test_support::sun_over_a_box` without its
+/// sun: the loader lights it with a white sky.
+pub fn unlit_glb() -> Vec<u8> {
+    let mut scene = hikari_gpu::test_support::sun_over_a_box(32);
+    scene.lights.clear();
+    hikari_core::scene::gltf::export::scene_to_glb(&scene).unwrap()
+}

@@ -76,6 +76,14 @@ pub const SMOOTH_ROUGHNESS: f32 = 0.05;
 /// sampler finite should the threshold ever be lowered.
 pub const ALPHA_MIN: f32 = 1e-4;
 
+/// Perceptual roughness from which a specular lobe is estimated from the
+/// photon maps like the diffuse one (each photon weighted by f for its own
+/// direction). Smoother lobes are followed by the eye instead, one sampled
+/// direction per eye ray (so progressive passes converge): at roughness
+/// 0.35 (α ≈ 0.12) the lobe's half-width is about 14°, and a photon
+/// estimate of a narrower lobe has few photons inside it.
+pub const GATHER_ROUGHNESS: f32 = 0.35;
+
 /// glTF's dielectric reflectance at normal incidence (index of refraction 1.5).
 pub const DIELECTRIC_F0: f32 = 0.04;
 
@@ -107,6 +115,10 @@ pub struct BsdfSample {
     /// The mirror lobe produced `wi`: `f` and `pdf` are not densities, so no
     /// MIS against light sampling.
     pub is_delta: bool,
+    /// The specular (microfacet or mirror) lobe produced `wi`, not the
+    /// diffuse one: photon paths count such bounces as specular on surfaces
+    /// smoother than `GATHER_ROUGHNESS`.
+    pub specular: bool,
 }
 
 /// Schlick's (1 − cos)^5, as products.
@@ -238,7 +250,8 @@ impl Bsdf {
             return None;
         }
         let p_specular = self.specular_probability(wo.z)?;
-        let wi = if u_lobe < p_specular {
+        let specular = u_lobe < p_specular;
+        let wi = if specular {
             if self.is_smooth() {
                 // Perfect mirror: h = n, so |v·h| = cos θo.
                 let fresnel = self.specular_fresnel(wo.z);
@@ -248,6 +261,7 @@ impl Bsdf {
                     pdf: p_specular,
                     weight: fresnel / p_specular,
                     is_delta: true,
+                    specular: true,
                 });
             }
             ggx::reflect(wo, ggx::sample_visible_normal(wo, self.alpha(), u))
@@ -262,7 +276,69 @@ impl Bsdf {
             return None;
         }
         let f = self.f(wo, wi);
-        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false })
+        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, specular })
+    }
+
+    /// π times the diffuse lobe at normal incidence: its Lambert albedo.
+    pub fn lambert_albedo(&self) -> Rgb {
+        self.diffuse_reflectance(1.0)
+    }
+
+    /// The specular lobe's Fresnel at normal incidence.
+    pub fn normal_reflectance(&self) -> Rgb {
+        self.specular_fresnel(1.0)
+    }
+
+    /// The diffuse lobe alone, f_d(wo, wi) (its Fresnel dimming included).
+    pub fn f_diffuse(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.f_lobes(wo, wi).0
+    }
+
+    /// The microfacet lobe alone (zero on smooth surfaces, whose mirror is a delta).
+    pub fn f_specular(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.f_lobes(wo, wi).1
+    }
+
+    /// The photon maps stand for this surface's whole BRDF: its specular
+    /// lobe, if any, is at least `GATHER_ROUGHNESS` rough.
+    pub fn gathers_specular(&self) -> bool {
+        self.roughness >= GATHER_ROUGHNESS
+    }
+
+    /// Photons are stored here: some lobe is estimated from the photon maps.
+    pub fn stores_photons(&self) -> bool {
+        self.has_diffuse() || (self.has_specular() && self.gathers_specular())
+    }
+
+    /// A direction from the specular lobe alone, for an eye path that
+    /// follows it (surfaces smoother than `GATHER_ROUGHNESS`): `weight` is
+    /// f_s·cos/pdf_s, the mirror's Fresnel on smooth surfaces. None when the
+    /// lobe is absent or the sampled reflection points below the surface.
+    pub fn sample_specular(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+        if wo.z <= 0.0 || !self.has_specular() {
+            return None;
+        }
+        if self.is_smooth() {
+            let fresnel = self.specular_fresnel(wo.z);
+            let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+            return Some(BsdfSample {
+                wi,
+                f: fresnel / wo.z,
+                pdf: 1.0,
+                weight: fresnel,
+                is_delta: true,
+                specular: true,
+            });
+        }
+        let alpha = self.alpha();
+        let h = ggx::sample_visible_normal(wo, alpha, u);
+        let wi = ggx::reflect(wo, h);
+        let pdf = ggx::reflection_pdf(wo, h, alpha);
+        if wi.z <= 0.0 || pdf <= 0.0 {
+            return None;
+        }
+        let f = self.f_specular(wo, wi);
+        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, specular: true })
     }
 
     /// A rough directional albedo for Russian roulette: the lobe weights

@@ -44,7 +44,44 @@ pub fn seed_files() -> Vec<Vec<u8>> {
     let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(Vec3::new(0.3, -1.0, 0.2), Vec3::Y)));
     let camera = b.camera(0.8, Some(1.0));
     let camera = b.node(json::Node { camera: Some(camera), translation: Some([0.0, 1.0, 4.0]), ..Default::default() });
-    vec![scene_to_glb(&cornell).expect("cornell-box is triangles"), b.to_glb(vec![root, point, spot, sun, camera])]
+    let lit = b.to_glb(vec![root, point, spot, sun, camera]);
+    vec![scene_to_glb(&cornell).expect("cornell-box is triangles"), lit, textured()]
+}
+
+/// A quad with a base-colour texture cut out by its alpha (MASK), over a
+/// floor with a metallic-roughness texture, under the default sky: the
+/// image decoder, the texture lookups and the masked traversal.
+fn textured() -> Vec<u8> {
+    use crate::scene::gltf::export::{GltfBuilder, PbrMaterial, png};
+    use glam::{Vec2, Vec3};
+    use gltf::json;
+    use gltf::json::texture::WrappingMode::{ClampToEdge, Repeat};
+    let mut b = GltfBuilder::new();
+    let rgba: Vec<u8> =
+        (0..16).flat_map(|i| [(i * 16) as u8, 255 - (i * 16) as u8, 90, if i % 3 == 0 { 0 } else { 255 }]).collect();
+    let image = b.image(&png(4, 4, &rgba), "image/png");
+    let repeat = b.texture(image, Repeat, Repeat);
+    let clamp = b.texture(image, ClampToEdge, Repeat);
+    let cutout =
+        b.material(&PbrMaterial { base_color_texture: Some(repeat), alpha_cutoff: Some(0.5), ..Default::default() });
+    let floor =
+        b.material(&PbrMaterial { metallic: 1.0, metallic_roughness_texture: Some(clamp), ..Default::default() });
+    let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].map(|uv| uv * 3.0);
+    let screen =
+        [Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0), Vec3::new(1.0, 1.0, 0.0), Vec3::new(-1.0, 1.0, 0.0)];
+    let ground = [
+        Vec3::new(-1.0, -0.5, 1.0),
+        Vec3::new(1.0, -0.5, 1.0),
+        Vec3::new(1.0, -0.5, -1.0),
+        Vec3::new(-1.0, -0.5, -1.0),
+    ];
+    let screen = b.textured_mesh(&screen, None, Some(&uvs), Some(&[0, 1, 2, 0, 2, 3]), Some(cutout));
+    let ground = b.textured_mesh(&ground, None, Some(&uvs), Some(&[0, 1, 2, 0, 2, 3]), Some(floor));
+    let nodes = vec![
+        b.node(json::Node { mesh: Some(screen), ..Default::default() }),
+        b.node(json::Node { mesh: Some(ground), ..Default::default() }),
+    ];
+    b.to_glb(nodes)
 }
 
 /// Applies 1 to 4 random mutations to a `.glb`. A file that is not a valid

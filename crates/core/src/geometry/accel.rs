@@ -5,8 +5,10 @@
 //! Each primitive carries the id of the surface (object) it belongs to.
 
 use super::{Ray, Sphere, Triangle};
-use glam::{UVec2, Vec3, Vec3A};
+use crate::texture::Texturing;
+use glam::{UVec2, Vec2, Vec3, Vec3A};
 use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
+use std::sync::Arc;
 
 /// What a closest-hit query found.
 #[derive(Clone, Copy, Debug)]
@@ -19,6 +21,12 @@ pub struct Hit {
     /// Unit shading normal on the same side as `geometric_normal`.
     pub shading_normal: Vec3,
     pub surface: u32,
+    /// The primitive hit, in the joint index space (triangles, then spheres):
+    /// what per-triangle side tables (texture coordinates) are indexed by.
+    pub prim: u32,
+    /// Barycentric weights of the triangle's vertices 1 and 2 at the hit
+    /// (zero for spheres).
+    pub barycentrics: Vec2,
 }
 
 struct PrimBounds(Aabb);
@@ -31,11 +39,17 @@ struct PackedPrim {
     a: Vec3,
     b: Vec3,
     c: Vec3,
-    /// Index in the joint primitive space; `SPHERE_BIT` marks spheres.
+    /// Index in the joint primitive space; `SPHERE_BIT` marks spheres,
+    /// `MASKED_BIT` triangles of `alphaMode` MASK cut-outs.
     prim: u32,
 }
 
 const SPHERE_BIT: u32 = 1 << 31;
+/// The triangle is a cut-out: a hit counts only where its alpha reaches
+/// the cutoff (`Texturing::opaque_at`). Only flagged primitives pay for the
+/// test, so scenes without cut-outs cost nothing more.
+const MASKED_BIT: u32 = 1 << 30;
+const INDEX_BITS: u32 = MASKED_BIT - 1;
 
 /// What the hit record needs per primitive, precomputed so that a hit costs
 /// no normalisation: the unit geometric normal of a triangle (unused for
@@ -96,6 +110,8 @@ pub struct Accel {
     pub epsilon: f32,
     bounds_min: Vec3,
     bounds_max: Vec3,
+    /// The textures of cut-outs, when the scene has any (`set_alpha_mask`).
+    alpha: Option<Arc<Texturing>>,
 }
 
 impl Accel {
@@ -171,7 +187,41 @@ impl Accel {
             epsilon: super::ray_epsilon(scale),
             bounds_min: lo,
             bounds_max: hi,
+            alpha: None,
         }
+    }
+
+    /// Makes the triangles of `texturing`'s MASK cut-out surfaces
+    /// transparent where their alpha is below the cutoff, for closest-hit
+    /// and occlusion queries alike (None, or a texturing without cut-outs:
+    /// every primitive is opaque).
+    pub fn set_alpha_mask(&mut self, texturing: Option<Arc<Texturing>>) {
+        let texturing = texturing.filter(|t| t.has_masks());
+        let n_tri = self.triangles.len();
+        for p in &mut self.packed {
+            let i = (p.prim & INDEX_BITS) as usize;
+            let masked = p.prim & SPHERE_BIT == 0
+                && i < n_tri
+                && texturing.as_ref().is_some_and(|t| t.is_masked(self.info[i].surface));
+            p.prim = if masked { p.prim | MASKED_BIT } else { p.prim & !MASKED_BIT };
+        }
+        self.alpha = texturing;
+    }
+
+    /// The texturing set by [`Accel::set_alpha_mask`], if the scene has cut-outs.
+    pub fn alpha_mask(&self) -> Option<&Arc<Texturing>> {
+        self.alpha.as_ref()
+    }
+
+    /// Whether a candidate hit on packed primitive `prim` (with its bits)
+    /// counts: always, unless it is a cut-out transparent there.
+    #[inline(always)]
+    fn counts(&self, prim: u32, b1: f32, b2: f32) -> bool {
+        if prim & MASKED_BIT == 0 {
+            return true;
+        }
+        let i = prim & INDEX_BITS;
+        self.alpha.as_ref().is_none_or(|t| t.opaque_at(self.info[i as usize].surface, i, Vec2::new(b1, b2)))
     }
 
     pub fn bounds(&self) -> (Vec3, Vec3) {
@@ -216,8 +266,8 @@ impl Accel {
         obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_test_ray, state.oct_inv4), {
             let packed = &self.packed[state.primitive_id as usize];
             let (t, b1, b2) = packed.intersect(&prim_ray, eps);
-            if t < prim_ray.t_max {
-                best = (packed.prim & !SPHERE_BIT, b1, b2);
+            if t < prim_ray.t_max && self.counts(packed.prim, b1, b2) {
+                best = (packed.prim & INDEX_BITS, b1, b2);
                 prim_ray.t_max = t;
                 node_test_ray.tmax = t;
             }
@@ -241,7 +291,15 @@ impl Accel {
         } else {
             (info.normal, info.normal)
         };
-        Some(Hit { t, point, geometric_normal, shading_normal, surface: info.surface })
+        Some(Hit {
+            t,
+            point,
+            geometric_normal,
+            shading_normal,
+            surface: info.surface,
+            prim: prim as u32,
+            barycentrics: Vec2::new(b1, b2),
+        })
     }
 
     /// True if anything blocks the open segment (epsilon, ray.t_max).
@@ -256,7 +314,9 @@ impl Accel {
         let mut blocked = false;
         'search: {
             obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_ray, state.oct_inv4), {
-                if self.packed[state.primitive_id as usize].intersect(ray, eps).0 < ray.t_max {
+                let packed = &self.packed[state.primitive_id as usize];
+                let (t, b1, b2) = packed.intersect(ray, eps);
+                if t < ray.t_max && self.counts(packed.prim, b1, b2) {
                     blocked = true;
                     break 'search;
                 }

@@ -4,6 +4,7 @@
 //! number of threads.
 
 use super::{PathClass, Photon};
+use crate::bsdf::ShadingFrame;
 use crate::geometry::Ray;
 use crate::material::{Event, Material, Rgb, dielectric_split, mean, reflect};
 use crate::medium::Flight;
@@ -182,7 +183,7 @@ impl PathTracer<'_> {
                 }
             }
             let Some(hit) = hit else { return };
-            let material = self.scene.material(&hit);
+            let material = &self.scene.material_at(&hit);
             // Normals on the side the photon arrives from.
             let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
             let (ng, ns) = (hit.geometric_normal * facing, hit.shading_normal * facing);
@@ -196,6 +197,28 @@ impl PathTracer<'_> {
                         Some(t) if rng.next_f32() >= split.reflectance => t,
                         _ => split.reflected,
                     }
+                }
+                Material::Pbr(bsdf) => {
+                    if bsdf.stores_photons() {
+                        self.store(hit.point, power, ray.dir, diffuse_bounces, specular_bounces);
+                    }
+                    // The bounce samples the whole BRDF; Russian roulette on
+                    // the sample's weight keeps photons near constant power.
+                    let frame = ShadingFrame::new(ns);
+                    let Some(s) = bsdf.sample(frame.to_local(-ray.dir), rng.next_f32(), rng.next_2d()) else { return };
+                    let survive = mean(s.weight).min(1.0);
+                    if !(rng.next_f32() < survive) {
+                        return;
+                    }
+                    power *= s.weight / survive;
+                    // A bounce off a lobe the eye follows (smoother than the
+                    // gather threshold) makes caustics, as a mirror does.
+                    if s.specular && !bsdf.gathers_specular() {
+                        specular_bounces += 1;
+                    } else {
+                        diffuse_bounces += 1;
+                    }
+                    frame.to_world(s.wi)
                 }
                 Material::Diffuse { .. } | Material::Mirror { .. } => {
                     if material.is_diffuse() {

@@ -1,4 +1,5 @@
-//! Direct light at a diffuse point with shadow rays (the L D paths).
+//! Direct light at a surface point with shadow rays (the L D paths, and
+//! L G paths through glossy lobes).
 
 use crate::geometry::Ray;
 use crate::material::Rgb;
@@ -11,6 +12,20 @@ use std::f32::consts::PI;
 /// light (point, spot, sun) by one shadow ray, each area light and the sky
 /// by `area_samples` samples. `normal` faces the viewer.
 pub fn direct_diffuse(scene: &Scene, x: Vec3, normal: Vec3, albedo: Rgb, area_samples: u32, rng: &mut Rng) -> Rgb {
+    direct_reflected(scene, x, normal, |_| albedo / PI, area_samples, rng)
+}
+
+/// Reflected radiance ∫ f_r(ω_i) L_i cos θ dω from all lights, sampled as
+/// [`direct_diffuse`] does; `brdf` is f_r for the world direction ω_i
+/// toward the light (the viewer's direction fixed by the caller).
+pub fn direct_reflected(
+    scene: &Scene,
+    x: Vec3,
+    normal: Vec3,
+    brdf: impl Fn(Vec3) -> Rgb,
+    area_samples: u32,
+    rng: &mut Rng,
+) -> Rgb {
     let mut sum = Rgb::ZERO;
     for light in &scene.lights {
         let samples = if light.is_delta() { 1 } else { area_samples.max(1) };
@@ -27,10 +42,10 @@ pub fn direct_diffuse(scene: &Scene, x: Vec3, normal: Vec3, albedo: Rgb, area_sa
             shadow.t_max = s.distance * (1.0 - 1e-4);
             if !scene.accel.occluded(&shadow) {
                 let transmittance = scene.media.transmittance(x, s.wi, s.distance);
-                light_sum += s.radiance * transmittance * (cos / s.pdf);
+                light_sum += brdf(s.wi) * s.radiance * transmittance * (cos / s.pdf);
             }
         }
         sum += light_sum / samples as f32;
     }
-    albedo / PI * sum
+    sum
 }

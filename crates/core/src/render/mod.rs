@@ -7,7 +7,7 @@ pub mod path;
 pub mod photon_cpu;
 
 pub use self::image::Image;
-pub use direct::direct_diffuse;
+pub use direct::{direct_diffuse, direct_reflected};
 
 use crate::camera::Camera;
 use crate::material::Rgb;

@@ -14,6 +14,7 @@
 //! the light and the rare ones close to it are fireflies.
 
 use super::{Image, render_pixels};
+use crate::bsdf::ShadingFrame;
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
 use crate::medium::{Flight, Phase};
@@ -84,11 +85,11 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
             l += beta * sky(scene, &ray, previous);
             break;
         };
-        let material = scene.material(&hit);
+        let material = scene.material_at(&hit);
         // Emitted light, MIS-weighted against the light sampling of the last
         // vertex. An emissive mesh's surface then reflects like any other.
         if let Some(light) = scene.emitter(&hit) {
-            let le = light.emitted_radiance(ray.dir, hit.geometric_normal);
+            let le = scene.emitted_radiance(&hit, ray.dir).unwrap_or_default();
             let weight = match previous {
                 Previous::Specular => 1.0,
                 Previous::Diffuse { point, pdf } => {
@@ -105,12 +106,27 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
         let next_dir = match material {
             Material::Emitter => break,
             Material::Glass { ior } => {
-                let split = dielectric_split(ray.dir, hit.geometric_normal, *ior);
+                let split = dielectric_split(ray.dir, hit.geometric_normal, ior);
                 previous = Previous::Specular;
                 match split.refracted {
                     Some(t) if rng.next_f32() >= split.reflectance => t,
                     _ => split.reflected,
                 }
+            }
+            Material::Pbr(bsdf) => {
+                let frame = ShadingFrame::new(ns);
+                let wo = frame.to_local(-ray.dir);
+                // Light sampling finds nothing through a mirror alone.
+                if bsdf.has_diffuse() || !bsdf.is_delta() {
+                    let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
+                    let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
+                    l += beta * next_event(scene, hit.point, ns, brdf, pdf, rng);
+                }
+                let Some(s) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) else { break };
+                beta *= s.weight;
+                previous =
+                    if s.is_delta { Previous::Specular } else { Previous::Diffuse { point: hit.point, pdf: s.pdf } };
+                frame.to_world(s.wi)
             }
             Material::Diffuse { .. } | Material::Mirror { .. } => {
                 let (albedo, specular) = (material.diffuse_albedo(), material.mirror_reflectance());
@@ -124,7 +140,8 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
                 // throughput's roulette below ends paths instead.
                 let p_diffuse = p_d / (p_d + p_s);
                 if p_d > 0.0 {
-                    l += beta * next_event(scene, hit.point, ns, albedo, p_diffuse, rng);
+                    let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
+                    l += beta * next_event(scene, hit.point, ns, |_| albedo / PI, pdf, rng);
                 }
                 if rng.next_f32() < p_diffuse {
                     beta *= albedo / p_diffuse;
@@ -181,9 +198,17 @@ fn sky(scene: &Scene, ray: &Ray, previous: Previous) -> Rgb {
     sum
 }
 
-/// Direct light at a diffuse vertex: one sample per light, MIS-weighted
-/// against the diffuse sampling (chosen with probability `p_diffuse`).
-fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng: &mut Rng) -> Rgb {
+/// Direct light at a vertex: one sample per light, MIS-weighted against
+/// the vertex's own sampling. `brdf` and `pdf` are f_r and the density with
+/// which the vertex samples the world direction ω_i toward the light.
+fn next_event(
+    scene: &Scene,
+    x: Vec3,
+    n: Vec3,
+    brdf: impl Fn(Vec3) -> Rgb,
+    pdf: impl Fn(Vec3) -> f32,
+    rng: &mut Rng,
+) -> Rgb {
     let mut sum = Rgb::ZERO;
     for light in &scene.lights {
         let Some(s) = light.sample_incident(x, rng.next_2d()) else {
@@ -198,9 +223,9 @@ fn next_event(scene: &Scene, x: Vec3, n: Vec3, albedo: Rgb, p_diffuse: f32, rng:
         if scene.accel.occluded(&shadow) {
             continue;
         }
-        let weight = if s.is_delta { 1.0 } else { power_heuristic(s.pdf, p_diffuse * cos / PI) };
+        let weight = if s.is_delta { 1.0 } else { power_heuristic(s.pdf, pdf(s.wi)) };
         let transmittance = scene.media.transmittance(x, s.wi, s.distance);
-        sum += albedo / PI * s.radiance * transmittance * (cos * weight / s.pdf);
+        sum += brdf(s.wi) * s.radiance * transmittance * (cos * weight / s.pdf);
     }
     sum
 }

@@ -6,8 +6,9 @@
 //! (from the eye or a mirror or glass) see the sky; emissive surfaces seen
 //! add their light to what their material reflects.
 
-use super::{Image, direct_diffuse, render_pixels};
-use crate::estimate::{FixedRadius, fixed_radius_radiance};
+use super::{Image, direct_diffuse, direct_reflected, render_pixels};
+use crate::bsdf::ShadingFrame;
+use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf};
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, dielectric_split, reflect};
 use crate::medium::MediaAlong;
@@ -149,14 +150,42 @@ impl<'a> PhotonCpuRenderer<'a> {
         l
     }
 
+    /// The photon-map part of the light a `Pbr` surface reflects toward
+    /// `wo` (local frame `frame`): each photon weighted by `brdf` for its
+    /// own direction (the whole BRDF where the photon maps stand for it,
+    /// else the diffuse lobe).
+    fn photon_radiance_brdf(&self, x: glam::Vec3, frame: &ShadingFrame, brdf: impl Fn(glam::Vec3) -> Rgb) -> Rgb {
+        let c = self.settings.components;
+        let f = |wi: glam::Vec3| brdf(frame.to_local(wi));
+        let mut l = Rgb::ZERO;
+        if c.indirect {
+            l += fixed_radius_radiance_brdf(&self.global, x, frame.normal, &self.global_params, f);
+        }
+        if c.caustic {
+            l += fixed_radius_radiance_brdf(&self.caustic, x, frame.normal, &self.caustic_params, f);
+        }
+        l
+    }
+
     /// Radiance arriving along `ray`, with `depth` specular bounces so far:
     /// the surface's, attenuated by the medium, plus in-scattered light.
     pub fn radiance(&self, ray: &Ray, depth: u32, rng: &mut Rng) -> Rgb {
+        self.radiance_seen(ray, depth, true, rng)
+    }
+
+    /// [`Self::radiance`], counting the light that emitters (and the sky)
+    /// send straight along `ray` only if `with_emission`: a ray following a
+    /// glossy lobe leaves it out, since the shadow rays at its start already
+    /// counted direct light through that lobe.
+    fn radiance_seen(&self, ray: &Ray, depth: u32, with_emission: bool, rng: &mut Rng) -> Rgb {
         let hit = self.scene.accel.intersect(ray);
         // Direct light at diffuse points comes from shadow rays, so only
         // these specular or eye rays see the sky itself.
-        let surface =
-            hit.map_or_else(|| self.scene.escaped_radiance(ray.dir), |h| self.surface_radiance(ray, &h, depth, rng));
+        let surface = match hit {
+            None if with_emission => self.scene.escaped_radiance(ray.dir),
+            None => Rgb::ZERO,
+            Some(h) => self.surface_radiance(ray, &h, depth, with_emission, rng),
+        };
         let media = &self.scene.media;
         if media.is_empty() {
             return surface;
@@ -176,19 +205,37 @@ impl<'a> PhotonCpuRenderer<'a> {
 
     /// Radiance leaving the surface at `hit` toward the ray's origin:
     /// emitted, plus reflected unless the surface is a light's black body.
-    fn surface_radiance(&self, ray: &Ray, hit: &crate::geometry::Hit, depth: u32, rng: &mut Rng) -> Rgb {
-        let emitted = self.scene.emitter(hit).map_or(Rgb::ZERO, |l| l.emitted_radiance(ray.dir, hit.geometric_normal));
-        if matches!(self.scene.material(hit), Material::Emitter) {
+    fn surface_radiance(
+        &self,
+        ray: &Ray,
+        hit: &crate::geometry::Hit,
+        depth: u32,
+        with_emission: bool,
+        rng: &mut Rng,
+    ) -> Rgb {
+        let emitted = match self.scene.emitted_radiance(hit, ray.dir) {
+            Some(le) if with_emission => le,
+            _ => Rgb::ZERO,
+        };
+        // The material with its textures, looked up once for this point.
+        let material = self.scene.material_at(hit);
+        if matches!(material, Material::Emitter) {
             return emitted;
         }
-        emitted + self.reflected_radiance(ray, hit, depth, rng)
+        emitted + self.reflected_radiance(ray, hit, &material, depth, rng)
     }
 
     /// Radiance the surface at `hit` reflects toward the ray's origin.
-    fn reflected_radiance(&self, ray: &Ray, hit: &crate::geometry::Hit, depth: u32, rng: &mut Rng) -> Rgb {
+    fn reflected_radiance(
+        &self,
+        ray: &Ray,
+        hit: &crate::geometry::Hit,
+        material: &Material,
+        depth: u32,
+        rng: &mut Rng,
+    ) -> Rgb {
         let hit = *hit;
         let can_recurse = depth < self.settings.max_specular_depth;
-        let material = self.scene.material(&hit);
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let ns = hit.shading_normal * facing;
         match material {
@@ -204,6 +251,32 @@ impl<'a> PhotonCpuRenderer<'a> {
                 l
             }
             Material::Emitter => Rgb::ZERO,
+            Material::Pbr(bsdf) => {
+                let frame = ShadingFrame::new(ns);
+                let wo = frame.to_local(-ray.dir);
+                let whole = bsdf.gathers_specular();
+                // The lobes the photon maps and shadow rays stand for: all of
+                // f on rough surfaces, the diffuse one on smoother ones.
+                let part = |wi: glam::Vec3| if whole { bsdf.f(wo, wi) } else { bsdf.f_diffuse(wo, wi) };
+                let mut l = Rgb::ZERO;
+                if self.settings.components.direct {
+                    // Direct light through every non-delta lobe, by shadow rays.
+                    let f = |wi: glam::Vec3| bsdf.f(wo, frame.to_local(wi));
+                    l += direct_reflected(self.scene, hit.point, ns, f, self.settings.area_light_samples, rng);
+                }
+                l += self.photon_radiance_brdf(hit.point, &frame, part);
+                // A lobe smoother than the gather threshold is followed, one
+                // sampled direction per eye ray. A glossy (non-delta) one
+                // leaves out what it sees emitted: its shadow rays counted that.
+                if !whole
+                    && can_recurse
+                    && let Some(s) = bsdf.sample_specular(wo, rng.next_2d())
+                {
+                    let next = Ray::new(hit.point, frame.to_world(s.wi));
+                    l += s.weight * self.radiance_seen(&next, depth + 1, s.is_delta, rng);
+                }
+                l
+            }
             Material::Diffuse { .. } | Material::Mirror { .. } => {
                 let mut l = Rgb::ZERO;
                 let albedo = material.diffuse_albedo();

@@ -88,14 +88,31 @@ pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
 
 /// Power heuristic (β = 2) weight for a sample from strategy `f` against `g`.
 pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
-    let (f2, g2) = (pdf_f * pdf_f, pdf_g * pdf_g);
-    if f2 + g2 == 0.0 { 0.0 } else { f2 / (f2 + g2) }
+    // As a ratio of the two, so that densities whose squares overflow (a
+    // light of tiny area has a solid-angle density near 1e20) give a weight
+    // instead of inf/inf.
+    if pdf_f >= pdf_g {
+        if pdf_f == 0.0 { 0.0 } else { 1.0 / (1.0 + (pdf_g / pdf_f).powi(2)) }
+    } else {
+        let r = pdf_f / pdf_g;
+        r * r / (1.0 + r * r)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::chi2::{assert_direction_distribution, assert_unit_density};
     use super::*;
+
+    #[test]
+    fn power_heuristic_weights_sum_to_one_even_for_huge_densities() {
+        for (a, b) in [(1.0f32, 1.0f32), (2.0, 1.0), (0.0, 3.0), (1e20, 3.0), (1e30, 1e29), (5.0, 0.0)] {
+            let (wa, wb) = (power_heuristic(a, b), power_heuristic(b, a));
+            assert!(wa.is_finite() && wb.is_finite() && (wa + wb - 1.0).abs() < 1e-6, "{a} {b}: {wa} {wb}");
+        }
+        assert!((power_heuristic(2.0, 1.0) - 0.8).abs() < 1e-6);
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+    }
 
     #[test]
     fn unit_circle_matches_sin_cos() {

@@ -142,7 +142,8 @@ impl Scene {
             .spheres()
             .map(|(sphere, s)| (Sphere { center: moved(s).transform_point3(sphere.center), radius: sphere.radius }, s))
             .unzip();
-        let accel = Accel::build(triangles, triangle_surfaces, spheres, sphere_surfaces);
+        let mut accel = Accel::build(triangles, triangle_surfaces, spheres, sphere_surfaces);
+        accel.set_alpha_mask(self.accel.alpha_mask().cloned());
         // The sun and sky cover the scene where it now is.
         crate::light::fit_distant_lights(&mut lights, accel.bounds());
         Scene {
@@ -156,6 +157,7 @@ impl Scene {
             names: self.names.clone(),
             animations: self.animations.clone(),
             notes: self.notes.clone(),
+            texturing: self.texturing.clone(),
         }
     }
 }

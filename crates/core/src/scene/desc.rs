@@ -59,6 +59,11 @@ pub struct MaterialDesc {
     pub specular_reflectance: Option<V3>,
     pub reflectance: Option<V3>,
     pub ior: Option<f32>,
+    /// The glTF metallic–roughness model (`type = "pbr"`).
+    pub base_color: Option<V3>,
+    pub metallic: Option<f32>,
+    pub roughness: Option<f32>,
+    pub specular: Option<f32>,
 }
 
 #[derive(Deserialize, Debug)]

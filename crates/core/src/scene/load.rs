@@ -127,11 +127,17 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         Ok(Some(name.clone()))
     };
     let mut lights = Vec::new();
+    let mut texturing = crate::texture::Texturing::default();
     for (i, o) in desc.object.iter().enumerate() {
         let p = place(o.span(), format!("[[object]] #{}", i + 1));
         let obj = o.get_ref();
         if let Some(file) = &obj.gltf {
-            let mut parts = SceneParts { materials: &mut materials, lights: &mut lights, names: &mut names };
+            let mut parts = SceneParts {
+                materials: &mut materials,
+                lights: &mut lights,
+                names: &mut names,
+                texturing: &mut texturing,
+            };
             load_gltf_object(obj, file, &p, base_dir, &mut geometry, &mut parts)?;
             continue;
         }
@@ -232,7 +238,14 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
 
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = geometry.triangles.into_iter().unzip();
     let (spheres, sphere_surfaces): (Vec<_>, Vec<_>) = geometry.spheres.into_iter().unzip();
-    let accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
+    let mut accel = Accel::build(triangles, tri_surfaces, spheres, sphere_surfaces);
+    // The textures of glTF objects, if any.
+    let texturing = texturing.materials.iter().any(Option::is_some).then(|| {
+        texturing.materials.resize(materials.len(), None);
+        texturing.surface_materials = geometry.surfaces.iter().map(|s| s.material).collect();
+        std::sync::Arc::new(texturing)
+    });
+    accel.set_alpha_mask(texturing.clone());
     crate::light::fit_distant_lights(&mut lights, accel.bounds());
     Ok(Scene {
         source: file.to_string(),
@@ -245,6 +258,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         names,
         animations,
         notes: Vec::new(),
+        texturing,
     })
 }
 
@@ -252,6 +266,9 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
 struct SceneParts<'a> {
     materials: &'a mut Vec<Material>,
     lights: &'a mut Vec<Light>,
+    /// Images, material textures (by scene material) and texture coordinates
+    /// (by triangle) of the glTF objects so far.
+    texturing: &'a mut crate::texture::Texturing,
     names: &'a mut Names,
 }
 
@@ -287,6 +304,19 @@ fn load_gltf_object(
     let asset = super::gltf::load_asset(&path, world_from_file, None).map_err(|e| p.error(e.to_string()))?;
     let first_material = parts.materials.len() as u32;
     parts.materials.extend(asset.materials);
+    // The file's images after those of earlier objects.
+    let t = &mut *parts.texturing;
+    let first_image = t.images.len() as u32;
+    t.images.extend(asset.images);
+    t.materials.resize(first_material as usize, None);
+    t.materials.extend(asset.material_textures.into_iter().map(|m| {
+        m.map(|mut m| {
+            for r in [&mut m.base_color, &mut m.metallic_roughness, &mut m.emissive].into_iter().flatten() {
+                r.image += first_image;
+            }
+            m
+        })
+    }));
     for (_, light) in asset.lights {
         parts.lights.push(light);
         parts.names.lights.push(None);
@@ -299,6 +329,9 @@ fn load_gltf_object(
             parts.lights.len() as u32 - 1
         });
         let surface = geo.add_surface(Surface { material: first_material + primitive.material, emitter });
+        if let Some(uvs) = &primitive.uvs {
+            parts.texturing.uvs.push_run(geo.triangles.len() as u32, uvs);
+        }
         geo.triangles.extend(primitive.triangles.into_iter().map(|t| (t, surface)));
     }
     if geo.counts() == start {
@@ -384,6 +417,10 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
         ("specular_reflectance", m.specular_reflectance.is_some()),
         ("reflectance", m.reflectance.is_some()),
         ("ior", m.ior.is_some()),
+        ("base_color", m.base_color.is_some()),
+        ("metallic", m.metallic.is_some()),
+        ("roughness", m.roughness.is_some()),
+        ("specular", m.specular.is_some()),
     ];
     match m.kind.as_str() {
         "diffuse" => {
@@ -405,7 +442,17 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
             p.only("a glass material", &given, &["ior"])?;
             Ok(Material::Glass { ior: p.in_range("ior", m.ior.unwrap_or(1.5), limits::IOR)? })
         }
-        other => Err(p.error(format!("unknown material type \"{other}\" (expected diffuse, mirror or glass)"))),
+        "pbr" => {
+            p.only("a pbr material", &given, &["base_color", "metallic", "roughness", "specular"])?;
+            let unit = |field: &str, v: Option<f32>, default: f32| p.in_range(field, v.unwrap_or(default), (0.0, 1.0));
+            Ok(Material::from_bsdf(crate::bsdf::Bsdf::new(
+                p.color("base_color", p.required("base_color", m.base_color)?, 1.0)?,
+                unit("metallic", m.metallic, 0.0)?,
+                unit("roughness", m.roughness, 0.5)?,
+                unit("specular", m.specular, 1.0)?,
+            )))
+        }
+        other => Err(p.error(format!("unknown material type \"{other}\" (expected diffuse, mirror, glass or pbr)"))),
     }
 }
 

@@ -46,6 +46,11 @@ pub struct Scene {
     /// One-line notes from the loader on what it ignored, approximated or
     /// added (a glTF file's unused extensions, a default light or camera).
     pub notes: Vec<String>,
+    /// Images, texture coordinates and what materials take from them;
+    /// None for an untextured scene. Read through [`Scene::material_at`]
+    /// and [`Scene::emitted_radiance`]; the BVH holds it too for cut-outs
+    /// (`Accel::set_alpha_mask`).
+    pub texturing: Option<std::sync::Arc<crate::texture::Texturing>>,
 }
 
 impl Scene {
@@ -87,12 +92,39 @@ impl Scene {
         load::parse(text, name, base_dir)
     }
 
+    /// The material of the surface hit, as the file gives it (its
+    /// factors, no texture): what the GPU renderer uploads per surface.
     pub fn material(&self, hit: &Hit) -> &Material {
         &self.materials[self.surfaces[hit.surface as usize].material as usize]
     }
 
+    /// The material at the point hit, its textures looked up there (pbrt's
+    /// `MaterialEvalContext`): what the CPU renderers shade with.
+    pub fn material_at(&self, hit: &Hit) -> Material {
+        let index = self.surfaces[hit.surface as usize].material;
+        let material = self.materials[index as usize];
+        match &self.texturing {
+            Some(t) => t.apply(material, index, hit.prim, hit.barycentrics),
+            None => material,
+        }
+    }
+
     pub fn emitter(&self, hit: &Hit) -> Option<&Light> {
         self.surfaces[hit.surface as usize].emitter.map(|l| &self.lights[l as usize])
+    }
+
+    /// Radiance the emissive surface at `hit` sends along `dir`
+    /// (propagation direction), or None if the surface is not a light. An
+    /// emissive texture is read here, at the point: its light
+    /// (`Light::Mesh`) emits the texture's mean uniformly, so photons,
+    /// shadow rays and light sampling see that mean (docs/scene-format.md).
+    pub fn emitted_radiance(&self, hit: &Hit, dir: glam::Vec3) -> Option<crate::material::Rgb> {
+        let light = self.emitter(hit)?;
+        let le = light.emitted_radiance(dir, hit.geometric_normal);
+        Some(match &self.texturing {
+            Some(t) => le * t.emission_scale(self.surfaces[hit.surface as usize].material, hit.prim, hit.barycentrics),
+            None => le,
+        })
     }
 
     /// Scene size used to derive default radii and offsets.

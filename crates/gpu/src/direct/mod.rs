@@ -11,7 +11,7 @@ use wgpu::util::DeviceExt;
 pub static LIGHT_EVAL: crate::wgsl::Module = crate::wgsl::Module {
     name: "light_eval.wgsl",
     source: include_str!("light_eval.wgsl"),
-    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::SPOT],
+    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::SPOT, &crate::shadow::SHADOW_VIEW],
 };
 
 pub fn shader_source() -> String {
@@ -21,8 +21,10 @@ pub fn shader_source() -> String {
 }
 
 /// Loop iterations one pixel of the direct pass runs at most: per light,
-/// the cap test's 4 corners, then per sample the region triangles crossed
-/// on the way to the light (light_eval.wgsl's `direct_radiance`).
+/// the quad's 4 corners, then per sample (every light's, the sky's
+/// directions and a mesh's points included) the region triangles crossed
+/// on the way to the light (light_eval.wgsl's `direct_radiance` and
+/// `sampled_irradiance`).
 pub fn loop_iterations(lights: &GpuLights, region_triangles: usize) -> u64 {
     lights.lights.iter().map(|l| 1 + 4 + l.sample_count as u64 * (1 + region_triangles as u64)).sum()
 }

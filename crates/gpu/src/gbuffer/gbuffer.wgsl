@@ -45,7 +45,7 @@ struct GBufferOut {
     @location(1) normal: vec4<f32>,
     // rgb: diffuse albedo (mirror reflectance for mirrors); a: material kind.
     @location(2) albedo: vec4<f32>,
-    // rgb: radiance emitted toward the eye (area lights).
+    // rgb: radiance emitted toward the eye (area lights, emissive meshes).
     @location(3) emission: vec4<f32>,
 }
 
@@ -64,6 +64,6 @@ fn shade(in: VertexOut) -> GBufferOut {
     out.position = vec4<f32>(in.world, 1.0);
     out.normal = vec4<f32>(normalize(in.normal) * side, f32(in.surface));
     out.albedo = vec4<f32>(surface.albedo, f32(surface.kind));
-    out.emission = vec4<f32>(select(vec3<f32>(0.0), surface.emission, front), 0.0);
+    out.emission = vec4<f32>(select(vec3<f32>(0.0), surface.emission, front || surface.two_sided != 0u), 0.0);
     return out;
 }

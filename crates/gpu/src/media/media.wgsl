@@ -25,6 +25,20 @@ struct MediaParams {
     image_size: vec2<f32>,
     // The camera's sub-pixel jitter (hikari_core::camera::Camera::jitter).
     jitter: vec2<f32>,
+    // The disc distant lights' photons start from: xyz its centre, w its
+    // radius (0 without distant lights).
+    distant_disc: vec4<f32>,
+}
+
+// How far a ray from o along unit d that hits nothing crosses the media
+// (hikari_core::scene::Scene::escape_distance, photon-cpu's eye rays): to
+// the plane of the distant lights' disc, else `max_distance`.
+fn escape_distance(o: vec3<f32>, d: vec3<f32>) -> f32 {
+    let disc = media.distant_disc;
+    if (disc.w > 0.0) {
+        return max(disc.w - dot(o - disc.xyz, d), 0.0);
+    }
+    return media.max_distance;
 }
 
 // A triangle of a region mesh, wound with its normal out of the medium, and
@@ -50,7 +64,7 @@ fn phase_eval(slot: u32, mu: f32) -> f32 {
 }
 
 // The view ray through a pixel: unit direction (xyz) and the distance to the
-// visible surface (w), or `max_distance` where the pixel sees no surface.
+// visible surface (w), or `escape_distance` where the pixel sees no surface.
 fn view_ray(gbuffer_pos: vec4<f32>, frag_xy: vec2<f32>) -> vec4<f32> {
     if (gbuffer_pos.w != 0.0) {
         let d = gbuffer_pos.xyz - media.camera_position;
@@ -61,7 +75,8 @@ fn view_ray(gbuffer_pos: vec4<f32>, frag_xy: vec2<f32>) -> vec4<f32> {
     let p = frag_xy + media.jitter;
     let x = (2.0 * p.x / size.x - 1.0) * media.tan_half_fov * media.aspect;
     let y = (1.0 - 2.0 * p.y / size.y) * media.tan_half_fov;
-    return vec4<f32>(normalize(media.forward + media.right * x + media.up * y), media.max_distance);
+    let dir = normalize(media.forward + media.right * x + media.up * y);
+    return vec4<f32>(dir, escape_distance(media.camera_position, dir));
 }
 
 // ∫ σ_t along origin + t·dir, t in [0, len]: Σ over region crossings ahead of

@@ -45,6 +45,10 @@ pub struct MediaParams {
     pub image_size: [f32; 2],
     /// The camera's sub-pixel jitter (`Camera::jitter`).
     pub jitter: [f32; 2],
+    /// The disc the distant lights' photons start from: centre and radius
+    /// (radius 0 without distant lights). Rays that see no surface end at
+    /// its plane (`escape_distance` in media.wgsl).
+    pub distant_disc: [f32; 4],
 }
 
 /// Mirrors `RegionTriangle` in media.wgsl.
@@ -57,10 +61,15 @@ pub struct RegionTriangle {
     pub sigma_t: [f32; 4],
 }
 
-/// Length of view rays that see no surface: photon-cpu's, so both estimate
-/// the same in-scattering there.
+/// Length of view rays that see no surface in a scene without distant
+/// lights: photon-cpu's, so both estimate the same in-scattering there.
 pub fn max_view_distance(scene: &Scene) -> f32 {
     scene.diagonal() * 2.0
+}
+
+/// The distant lights' disc as `MediaParams::distant_disc` holds it.
+fn distant_disc(scene: &Scene) -> [f32; 4] {
+    scene.lights.iter().find_map(|l| l.distant_disc()).map_or([0.0; 4], |d| d.center.extend(d.radius).to_array())
 }
 
 impl MediaParams {
@@ -105,6 +114,7 @@ impl MediaParams {
             phases,
             image_size: [camera.width as f32, camera.height as f32],
             jitter: camera.jitter.to_array(),
+            distant_disc: distant_disc(scene),
         }
     }
 }
@@ -165,9 +175,11 @@ impl GpuMedia {
     }
 
     /// Follows a moved `scene` (its media and regions unchanged): view rays
-    /// that see no surface end at the new scene's `max_view_distance`.
+    /// that see no surface end at the new scene's `max_view_distance`, or
+    /// its distant lights' disc.
     pub fn set_scene(&mut self, queue: &wgpu::Queue, scene: &Scene) {
         self.params.max_distance = max_view_distance(scene);
+        self.params.distant_disc = distant_disc(scene);
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
     }
 

@@ -37,18 +37,22 @@ pub struct ResolvePass {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
     terms: wgpu::Buffer,
+    /// The sky's radiance (rgb), seen where a pixel sees no surface.
+    sky: wgpu::Buffer,
     pub output: wgpu::Texture,
 }
 
 impl ResolvePass {
     /// `inputs`: emission, direct, indirect, caustic, specular (same size);
-    /// `volume`: the volume splat's target.
+    /// `volume`: the volume splat's target; `sky`: the radiance of pixels
+    /// that see no surface.
     pub fn new(
         device: &wgpu::Device,
         inputs: [&wgpu::Texture; 5],
         volume: &wgpu::Texture,
         gbuffer: &crate::gbuffer::GBuffer,
         media: &crate::media::GpuMedia,
+        sky: glam::Vec3,
     ) -> Self {
         let (width, height) = (inputs[0].width(), inputs[0].height());
         use crate::binding::{entry, storage, storage_texture_rgba32f, texture, uniform};
@@ -66,6 +70,7 @@ impl ResolvePass {
         entries.push(entry(9, stage, storage(true)));
         entries.push(entry(10, stage, texture(wgpu::TextureViewDimension::D2Array)));
         entries.push(entry(11, stage, uniform()));
+        entries.push(entry(12, stage, uniform()));
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = crate::binding::pipeline_layout(device, "resolve", &layout);
@@ -95,12 +100,25 @@ impl ResolvePass {
             mapped_at_creation: false,
         });
         bind_entries.push(wgpu::BindGroupEntry { binding: 11, resource: terms.as_entire_binding() });
+        use wgpu::util::DeviceExt;
+        let sky = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("resolve sky"),
+            contents: bytemuck::bytes_of(&sky.extend(0.0).to_array()),
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        });
+        bind_entries.push(wgpu::BindGroupEntry { binding: 12, resource: sky.as_entire_binding() });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &layout,
             entries: &bind_entries,
         });
-        ResolvePass { pipeline, bind_group, terms, output }
+        ResolvePass { pipeline, bind_group, terms, sky, output }
+    }
+
+    /// Shows `sky` where pixels see no surface from the next frame on (an
+    /// edited sky).
+    pub fn set_sky(&self, queue: &wgpu::Queue, sky: glam::Vec3) {
+        queue.write_buffer(&self.sky, 0, bytemuck::bytes_of(&sky.extend(0.0).to_array()));
     }
 
     /// Sums the terms `terms` selects (written now) into `output`.

@@ -1,6 +1,7 @@
 // Resolve: the frame's linear radiance: the surface light (emission + direct
-// + indirect + caustics + specular) attenuated by the media between the eye
-// and the surface, plus the light the media scatter toward the eye. Tone
+// + indirect + caustics + specular), or the sky where the pixel sees no
+// surface, attenuated by the media between the eye and the surface, plus
+// the light the media scatter toward the eye. Tone
 // mapping happens on output (hikari_core::output), the same for every
 // renderer. Prepended with media.wgsl and view_depth.wgsl.
 
@@ -28,6 +29,8 @@ struct Terms {
     _pad2: f32,
 }
 @group(0) @binding(11) var<uniform> terms: Terms;
+// rgb: radiance of rays that leave the scene (the sky's; zero without one).
+@group(0) @binding(12) var<uniform> sky: vec4<f32>;
 
 // Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
 override WORKGROUP: u32;
@@ -39,10 +42,14 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let p = vec2<i32>(id.xy);
-    let surface = textureLoad(emission, p, 0).rgb + terms.direct * textureLoad(direct, p, 0).rgb
+    var surface = textureLoad(emission, p, 0).rgb + terms.direct * textureLoad(direct, p, 0).rgb
         + terms.indirect * textureLoad(indirect, p, 0).rgb + terms.caustic * textureLoad(caustic, p, 0).rgb
         + terms.specular * textureLoad(specular, p, 0).rgb;
-    let ray = view_ray(textureLoad(gbuffer_position, p, 0), vec2<f32>(p) + 0.5);
+    let position = textureLoad(gbuffer_position, p, 0);
+    let ray = view_ray(position, vec2<f32>(p) + 0.5);
+    if (position.w == 0.0) {
+        surface += sky.rgb;
+    }
     let transmittance = exp(-view_optical_depth(p, ray.w, ray.w));
     let sum = transmittance * surface + terms.volume * textureLoad(volume, p, 0).rgb;
     textureStore(output, p, vec4<f32>(sum, 1.0));

@@ -1,6 +1,8 @@
 //! The shadow pass: renders, for every light sample, the distance to the
 //! nearest surface into layers of one float texture array (a cube of six
-//! layers for point and area samples, one layer for narrow spots).
+//! layers for point and area samples, one layer for narrow spots), or for
+//! a distant light's sample, in one orthographic layer, the distance along
+//! its direction from the plane its photons start from.
 //!
 //! The distance is stored divided by the view's `range` (in
 //! `light_position.w`), so it lies in [0, 1]: then `R16Float`, which
@@ -15,31 +17,55 @@ use crate::gbuffer::DEPTH_FORMAT;
 use crate::scene_upload::{GpuVertex, SceneBuffers};
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
-use light_samples::ShadowView;
+use light_samples::{GpuLights, MeshOccluders, ShadowView};
 use wgpu::util::DeviceExt;
 
-pub const SHADER: &str = include_str!("shadow.wgsl");
+/// `ShadowView` and the depth a view stores (shared with light_eval.wgsl).
+pub static SHADOW_VIEW: crate::wgsl::Module =
+    crate::wgsl::Module { name: "shadow_view.wgsl", source: include_str!("shadow_view.wgsl"), requires: &[] };
+
+pub fn shader_source() -> String {
+    use crate::wgsl::{Module, compose};
+    static SHADOW: Module =
+        Module { name: "shadow.wgsl", source: include_str!("shadow.wgsl"), requires: &[&SHADOW_VIEW] };
+    compose(&[&SHADOW])
+}
 /// The shadow-map format: `R32Float` where it is renderable, else `R16Float`.
 pub fn map_format(r32_renderable: bool) -> wgpu::TextureFormat {
     if r32_renderable { wgpu::TextureFormat::R32Float } else { wgpu::TextureFormat::R16Float }
 }
 
-/// Mirrors `ShadowViewParams` in shadow.wgsl and `ShadowView` in direct.wgsl.
+/// Mirrors `ShadowView` in shadow_view.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct ShadowViewParams {
     pub clip_from_world: [[f32; 4]; 4],
+    /// xyz: the light sample (perspective) or a point of the start plane
+    /// (orthographic); w: the range.
     pub light_position: [f32; 4],
+    /// Orthographic views: the unit direction light travels and the view's
+    /// width; zero for perspective views.
+    pub direction: [f32; 4],
 }
 
 impl ShadowViewParams {
-    /// The view of `v`, storing distances as fractions of `range`, the
+    /// The view of `v`, storing depths as fractions of its range: the
     /// distance from the light sample to the farthest corner of the scene
-    /// bounds `(lo, hi)` (so every surface's distance fits in [0, 1]).
+    /// bounds `(lo, hi)`, or for an orthographic view the farthest corner's
+    /// depth along its direction (so every surface's depth fits in [0, 1]).
     pub fn new(v: &ShadowView, (lo, hi): (Vec3, Vec3)) -> Self {
+        let (range, direction) = match v.orthographic {
+            None => (shadow_range(v.light_position, lo, hi), [0.0; 4]),
+            Some((dir, width)) => {
+                let corner = Vec3::select(dir.cmpge(Vec3::ZERO), hi, lo);
+                let depth = (corner - v.light_position).dot(dir);
+                ((depth * 1.01).max(1e-20), dir.extend(width).to_array())
+            }
+        };
         ShadowViewParams {
             clip_from_world: v.clip_from_world.to_cols_array_2d(),
-            light_position: v.light_position.extend(shadow_range(v.light_position, lo, hi)).to_array(),
+            light_position: v.light_position.extend(range).to_array(),
+            direction,
         }
     }
 }
@@ -63,14 +89,24 @@ pub struct ShadowMaps {
     view_buffers: Vec<wgpu::Buffer>,
     /// All views, for the direct pass's lookups.
     pub views_buffer: wgpu::Buffer,
+    /// The light each view belongs to.
+    view_lights: Vec<u32>,
+    /// The emissive meshes' triangles (None without any) and their ranges.
+    mesh_vertices: Option<wgpu::Buffer>,
+    occluders: MeshOccluders,
 }
 
 impl ShadowMaps {
-    /// Moves the views to `views` (lights moved) in a scene now within
-    /// `bounds`, from the next frame on. False, with nothing written, when
-    /// the number of views differs: then the maps must be created anew.
-    pub fn update(&self, queue: &wgpu::Queue, views: &[ShadowView], bounds: (Vec3, Vec3)) -> bool {
-        if views.len() != self.view_buffers.len() || views.is_empty() {
+    /// Moves the views to those of `lights` (lights moved) in a scene now
+    /// within `bounds`, from the next frame on. False, with nothing written,
+    /// when the number of views or of mesh-light vertices differs: then the
+    /// maps must be created anew.
+    pub fn update(&self, queue: &wgpu::Queue, lights: &GpuLights, bounds: (Vec3, Vec3)) -> bool {
+        let views = &lights.views;
+        if views.len() != self.view_buffers.len()
+            || views.is_empty()
+            || lights.occluders.vertices.len() != self.occluders.vertices.len()
+        {
             return false;
         }
         let params: Vec<ShadowViewParams> = views.iter().map(|v| ShadowViewParams::new(v, bounds)).collect();
@@ -78,6 +114,9 @@ impl ShadowMaps {
             queue.write_buffer(buffer, 0, bytemuck::bytes_of(p));
         }
         queue.write_buffer(&self.views_buffer, 0, bytemuck::cast_slice(&params));
+        if let Some(buffer) = &self.mesh_vertices {
+            queue.write_buffer(buffer, 0, bytemuck::cast_slice(&lights.occluders.vertices));
+        }
         true
     }
 }
@@ -93,7 +132,7 @@ impl ShadowPass {
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow view"),
@@ -128,14 +167,15 @@ impl ShadowPass {
         ShadowPass { pipeline, layout, format }
     }
 
-    /// One layer per view of `views`, each `size²`, for a scene within `bounds`.
+    /// One layer per view of `lights`, each `size²`, for a scene within `bounds`.
     pub fn create_maps(
         &self,
         device: &wgpu::Device,
-        views: &[ShadowView],
+        lights: &GpuLights,
         size: u32,
         bounds: (Vec3, Vec3),
     ) -> ShadowMaps {
+        let views = &lights.views;
         let layers = views.len().max(1) as u32;
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow maps"),
@@ -188,7 +228,26 @@ impl ShadowPass {
             contents: bytemuck::cast_slice(if params.is_empty() { &zero[..] } else { &params }),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         });
-        ShadowMaps { size, layers, texture, depth, view_bind_groups, view_buffers, views_buffer }
+        let occluders = lights.occluders.clone();
+        let mesh_vertices = (!occluders.vertices.is_empty()).then(|| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("mesh light occluders"),
+                contents: bytemuck::cast_slice(&occluders.vertices),
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            })
+        });
+        ShadowMaps {
+            size,
+            layers,
+            texture,
+            depth,
+            view_bind_groups,
+            view_buffers,
+            views_buffer,
+            view_lights: views.iter().map(|v| v.light).collect(),
+            mesh_vertices,
+            occluders,
+        }
     }
 
     /// Renders every shadow view of `maps`.
@@ -226,6 +285,13 @@ impl ShadowPass {
             pass.set_bind_group(0, bind_group, &[]);
             pass.set_vertex_buffer(0, scene.vertices.slice(..));
             pass.draw(0..scene.occluder_count, 0..1);
+            // Emissive meshes are scene surfaces: they shadow every light but themselves.
+            if let Some(mesh_vertices) = &maps.mesh_vertices {
+                pass.set_vertex_buffer(0, mesh_vertices.slice(..));
+                for range in maps.occluders.drawn_by(maps.view_lights[layer]) {
+                    pass.draw(range, 0..1);
+                }
+            }
         }
     }
 }

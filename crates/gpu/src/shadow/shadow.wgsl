@@ -1,13 +1,8 @@
 // Shadow views: each layer of the shadow-map array stores, per texel, the
-// distance from the light sample to the nearest surface seen through it,
-// divided by the view's range (light_position.w) so it fits in [0, 1].
+// depth of the nearest surface seen through it (shadow_view.wgsl's
+// `shadow_depth`), divided by the view's range so it fits in [0, 1].
 
-struct ShadowViewParams {
-    clip_from_world: mat4x4<f32>,
-    light_position: vec4<f32>,
-}
-
-@group(0) @binding(0) var<uniform> view: ShadowViewParams;
+@group(0) @binding(0) var<uniform> view: ShadowView;
 
 struct VertexOut {
     @builtin(position) clip: vec4<f32>,
@@ -24,5 +19,5 @@ fn vs_main(@location(0) position: vec3<f32>) -> VertexOut {
 
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    return vec4<f32>(distance(in.world, view.light_position.xyz) / view.light_position.w, 0.0, 0.0, 0.0);
+    return vec4<f32>(shadow_depth(view, in.world) / view.light_position.w, 0.0, 0.0, 0.0);
 }

@@ -83,6 +83,9 @@ pub struct SpecularParams {
     pub jitter_x: f32,
     pub volume_max: [f32; 3],
     pub jitter_y: f32,
+    /// Radiance of rays that leave the scene (the sky's; zero without one).
+    pub sky_radiance: [f32; 3],
+    pub _pad: u32,
 }
 
 /// Mirrors `SliceParams` in specular.wgsl: which share of the photon
@@ -362,6 +365,7 @@ impl SpecularPass {
             normal_test: inputs.global.normal_test as u32,
             jitter_x: scene.camera.jitter.x,
             jitter_y: scene.camera.jitter.y,
+            sky_radiance: lights.sky_radiance.to_array(),
             ..grid_params
         };
         let storage_usage = wgpu::BufferUsages::STORAGE;
@@ -479,6 +483,7 @@ impl SpecularPass {
         lights: &GpuLights,
         maps: &ShadowMaps,
     ) {
+        let sky_radiance = lights.sky_radiance.to_array();
         let SceneData { nodes, prims, direct, lights, samples } =
             SceneData::upload(device, scene, lights, maps, self.shadow_bias);
         let b = &mut self.bindings;
@@ -490,6 +495,7 @@ impl SpecularPass {
             ..Default::default()
         });
         self.params.epsilon = scene.accel.epsilon;
+        self.params.sky_radiance = sky_radiance;
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         self.enabled = has_specular_surfaces(scene);
         self.bind_group = self.bindings.bind_group(device, &self.grid);

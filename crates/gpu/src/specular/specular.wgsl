@@ -4,7 +4,8 @@
 // total internal reflection) through the scene BVH up to `max_depth`
 // bounces, and shade each diffuse hit, weighted by its throughput, with
 // direct light (light_eval.wgsl) and fixed-radius gathers over both photon
-// maps (estimate.wgsl). In media every segment of the path is attenuated
+// maps (estimate.wgsl). Emitting surfaces add their light, rays that leave
+// the scene the sky's. In media every segment of the path is attenuated
 // and adds the in-scattering along it from the volume map, as photon-cpu's
 // recursion does. Composed with estimate.wgsl, media.wgsl,
 // light_eval.wgsl, loop_budget.wgsl, bvh.wgsl and optics.wgsl.
@@ -46,6 +47,9 @@ struct SpecularParams {
     jitter_x: f32,
     volume_max: vec3<f32>,
     jitter_y: f32,
+    // Radiance of rays that leave the scene (the sky's; zero without one).
+    sky_radiance: vec3<f32>,
+    _pad: u32,
 }
 
 
@@ -274,15 +278,19 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let b = stack[top];
         let hit = trace_bvh(b.origin, b.dir, params.epsilon);
         // Media along this segment (photon-cpu's `radiance`): a ray that
-        // hits nothing still crosses `max_distance` of them. The segment from
-        // the eye (depth 0) is the raster passes' (volume splat, resolve).
+        // hits nothing still crosses `escape_distance` of them. The segment
+        // from the eye (depth 0) is the raster passes' (volume splat, resolve).
         var weight = b.weight;
         if (b.depth > 0u && has_media()) {
-            let len = select(hit.t, media.max_distance, hit.t >= NO_HIT);
+            let len = select(hit.t, escape_distance(b.origin, b.dir), hit.t >= NO_HIT);
             radiance += b.weight * volume_along(b.origin, b.dir, len);
             weight *= transmittance_along(b.origin, b.dir, len);
         }
         if (hit.t >= NO_HIT) {
+            // Out of the scene: the sky (a primary ray's is the resolve's).
+            if (b.depth > 0u && slice.index == 0u) {
+                radiance += weight * params.sky_radiance;
+            }
             continue;
         }
         let p = prims[hit.prim];
@@ -295,6 +303,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let front = dot(b.dir, ng) < 0.0;
         let n = select(-ng, ng, front);
         let can_bounce = b.depth < params.max_depth;
+        // Emitted light (Light::emitted_radiance), besides what the surface
+        // reflects; a primary hit's is the G-buffer's.
+        if ((b.depth > 0u || s.kind == 3u) && slice.index == 0u && (front || s.two_sided != 0u)) {
+            radiance += weight * s.emission;
+        }
         switch s.kind {
             case 0u: {
                 // A diffuse primary hit is shaded by the raster passes; here
@@ -337,9 +350,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
             default: {
-                if (front && slice.index == 0u) {
-                    radiance += weight * s.emission;
-                }
+                // An area light's black body: its emission only (added above).
             }
         }
     }

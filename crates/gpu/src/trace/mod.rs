@@ -74,6 +74,8 @@ pub struct TraceParams {
     pub global_mask: u32,
     pub region_triangles: u32,
     pub _pad0: u32,
+    /// The distant lights' disc: centre and radius (0 without distant lights).
+    pub distant_disc: [f32; 4],
 }
 
 /// Mirrors `TraceLight` in trace.wgsl.
@@ -91,9 +93,26 @@ pub struct TraceLight {
     pub power: [f32; 3],
     pub falloff_start: f32,
     pub probability: f32,
+    /// An emissive mesh's triangles in the tracer's triangle buffer.
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    pub two_sided: u32,
+}
+
+/// Mirrors `TraceTriangle` in trace.wgsl: a triangle of an emissive mesh
+/// with its mesh's cumulative area up to it and before it, and its unit
+/// winding normal.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct TraceTriangle {
+    pub v0: [f32; 3],
+    pub cumulative_area: f32,
+    pub v1: [f32; 3],
+    pub start_area: f32,
+    pub v2: [f32; 3],
     pub _pad0: u32,
+    pub normal: [f32; 3],
     pub _pad1: u32,
-    pub _pad2: u32,
 }
 
 /// Mirrors `TraceMedium` in trace.wgsl.
@@ -147,8 +166,9 @@ pub struct CompactParams {
 }
 
 /// The light as trace.wgsl emits from it, carrying `power` (each photon's
-/// starting power in power units) and its selection probability.
-fn trace_light(light: &Light, power: Rgb, probability: f32) -> TraceLight {
+/// starting power in power units) and its selection probability; an
+/// emissive mesh's triangles start at `first_triangle` of the triangle buffer.
+fn trace_light(light: &Light, power: Rgb, probability: f32, first_triangle: u32) -> TraceLight {
     let mut out = TraceLight { power: power.to_array(), probability, ..TraceLight::zeroed() };
     match *light {
         Light::Point { position, .. } => {
@@ -175,12 +195,51 @@ fn trace_light(light: &Light, power: Rgb, probability: f32) -> TraceLight {
             out.edge_v = edge_v.to_array();
             out.normal = edge_u.cross(edge_v).normalize().to_array();
         }
-        // `GpuTracer::new` and `set_scene` refuse such scenes first.
-        Light::Directional { .. } | Light::Environment { .. } | Light::Mesh(_) => {
-            unreachable!("{}", crate::renderer::UNSUPPORTED_LIGHTS)
+        Light::Directional { direction, disc, .. } => {
+            out.origin = disc.center.to_array();
+            out.kind = 4;
+            out.axis = direction.to_array();
+            out.radius = disc.radius;
+        }
+        Light::Environment { disc, .. } => {
+            out.origin = disc.center.to_array();
+            out.kind = 5;
+            out.radius = disc.radius;
+        }
+        Light::Mesh(ref mesh) => {
+            out.kind = 6;
+            // The total area exactly as `EmissiveMesh::area` gives it.
+            out.radius = mesh.area();
+            out.first_triangle = first_triangle;
+            out.triangle_count = mesh.triangles().len() as u32;
+            out.two_sided = mesh.two_sided as u32;
         }
     }
     out
+}
+
+/// Every emissive mesh's triangles, in light order, and where each light's start.
+fn trace_triangles(lights: &[Light]) -> (Vec<TraceTriangle>, Vec<u32>) {
+    let mut triangles = Vec::new();
+    let mut firsts = Vec::with_capacity(lights.len());
+    for light in lights {
+        firsts.push(triangles.len() as u32);
+        let Light::Mesh(mesh) = light else { continue };
+        let cumulative = mesh.cumulative_areas();
+        for (i, &[v0, v1, v2]) in mesh.triangles().iter().enumerate() {
+            triangles.push(TraceTriangle {
+                v0: v0.to_array(),
+                cumulative_area: cumulative[i],
+                v1: v1.to_array(),
+                start_area: if i == 0 { 0.0 } else { cumulative[i - 1] },
+                v2: v2.to_array(),
+                // As EmissiveMesh::sample_point computes it.
+                normal: (v1 - v0).cross(v2 - v0).normalize_or_zero().to_array(),
+                ..TraceTriangle::zeroed()
+            });
+        }
+    }
+    (triangles, firsts)
 }
 
 /// What the tracer reads of the scene, uploaded by `GpuTracer::set_scene`.
@@ -193,6 +252,10 @@ struct TraceScene {
     regions: wgpu::Buffer,
     region_triangles: u32,
     global_mask: u32,
+    /// The emissive meshes' triangles, and each light's first one there.
+    emissive: wgpu::Buffer,
+    first_triangles: Vec<u32>,
+    distant_disc: [f32; 4],
     lights: Vec<Light>,
     probabilities: Vec<f32>,
     total_power: f32,
@@ -250,6 +313,7 @@ impl TraceScene {
                 })
             })
             .collect();
+        let (triangles, first_triangles) = trace_triangles(&scene.lights);
         TraceScene {
             nodes: storage_buffer(device, "trace bvh nodes", bytemuck::cast_slice(nodes)),
             prims: storage_buffer(device, "trace bvh prims", bytemuck::cast_slice(&bvh.prims)),
@@ -263,6 +327,13 @@ impl TraceScene {
             regions: storage_buffer(device, "trace region triangles", bytemuck::cast_slice(&regions)),
             region_triangles: regions.len() as u32,
             global_mask: media.global_mask(),
+            emissive: storage_buffer(device, "trace emissive triangles", bytemuck::cast_slice(&triangles)),
+            first_triangles,
+            distant_disc: scene
+                .lights
+                .iter()
+                .find_map(Light::distant_disc)
+                .map_or([0.0; 4], |d| d.center.extend(d.radius).to_array()),
             lights: scene.lights.clone(),
             probabilities: scene.light_selection_probabilities(),
             total_power: scene.lights.iter().map(|l| mean(l.power())).sum(),
@@ -332,9 +403,6 @@ pub struct GpuTracer {
 
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
-        if let Some(why) = crate::renderer::unsupported_lights(scene) {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -353,6 +421,7 @@ impl GpuTracer {
                     compute(8, storage(false)),
                     compute(9, storage(false)),
                     compute(10, storage(true)),
+                    compute(11, storage(true)),
                 ],
             });
             let compact_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -418,9 +487,6 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
-        if let Some(why) = crate::renderer::unsupported_lights(scene) {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let scene = ctx.scoped(|| TraceScene::upload(&ctx.device, scene))?;
         self.scene = scene;
         // The bind groups hold the old scene's buffers.
@@ -608,6 +674,7 @@ impl GpuTracer {
                 &counts,
                 &status,
                 &s.regions,
+                &s.emissive,
             ],
         );
         let compact_bind_group = bind(
@@ -647,7 +714,8 @@ impl GpuTracer {
             .lights
             .iter()
             .zip(&s.probabilities)
-            .map(|(light, &p)| trace_light(light, light.power() / (p * n as f32) / power_unit, p))
+            .zip(&s.first_triangles)
+            .map(|((light, &p), &first)| trace_light(light, light.power() / (p * n as f32) / power_unit, p, first))
             .collect();
         let (mixed_seed, increment) = Rng::seed_constants(settings.seed);
         let words = |x: u64| [x as u32, (x >> 32) as u32];
@@ -665,6 +733,7 @@ impl GpuTracer {
             global_mask: s.global_mask,
             region_triangles: s.region_triangles,
             _pad0: 0,
+            distant_disc: s.distant_disc,
         };
         let elements = 3 * paths;
         let scan_workgroups = elements.div_ceil(crate::wgsl::SCAN_WORKGROUP);
@@ -716,7 +785,7 @@ mod tests {
             edge_v: glam::Vec3::new(0.0, 0.0, 0.5),
             radiance: Rgb::ONE,
         };
-        let t = trace_light(&light, Rgb::ONE, 1.0);
+        let t = trace_light(&light, Rgb::ONE, 1.0, 0);
         assert_eq!(t.kind, 3);
         assert_eq!(t.normal, [0.0, -1.0, 0.0]);
     }

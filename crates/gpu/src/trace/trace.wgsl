@@ -26,16 +26,22 @@ struct TraceParams {
     global_mask: u32,
     region_triangles: u32,
     _pad0: u32,
+    // The disc distant lights' photons start from (xyz centre, w radius;
+    // w = 0 without distant lights): photons that leave the scene fly
+    // through the media up to its plane (Scene::escape_distance).
+    distant_disc: vec4<f32>,
 }
 
 // A light as the tracer emits from it (trace::TraceLight).
 struct TraceLight {
-    // Point or spot position, sphere centre, or quad corner.
+    // Point or spot position, sphere centre, quad corner, or the centre of
+    // a distant light's disc.
     origin: vec3<f32>,
-    // 0 point, 1 spot, 2 sphere, 3 quad.
+    // 0 point, 1 spot, 2 sphere, 3 quad, 4 sun, 5 sky, 6 emissive mesh.
     kind: u32,
-    // Spot axis, or the quad's edge_u.
+    // Spot axis, the quad's edge_u, or the direction the sun's light travels.
     axis: vec3<f32>,
+    // Sphere radius, a distant light's disc radius, or a mesh's area.
     radius: f32,
     edge_v: vec3<f32>,
     cos_cutoff: f32,
@@ -46,9 +52,25 @@ struct TraceLight {
     power: vec3<f32>,
     falloff_start: f32,
     probability: f32,
+    // An emissive mesh's triangles in `emissive`, and whether it emits
+    // from both faces.
+    first_triangle: u32,
+    triangle_count: u32,
+    two_sided: u32,
+}
+
+// A triangle of an emissive mesh (trace::TraceTriangle), with its mesh's
+// cumulative area up to it (EmissiveMesh::cumulative_areas) and before it.
+struct TraceTriangle {
+    v0: vec3<f32>,
+    cumulative_area: f32,
+    v1: vec3<f32>,
+    start_area: f32,
+    v2: vec3<f32>,
     _pad0: u32,
+    // Its unit winding normal, normalised on the host as Light::emit does.
+    normal: vec3<f32>,
     _pad1: u32,
-    _pad2: u32,
 }
 
 // A medium, in the order of hikari_core's Media entries (its bit in a mask).
@@ -94,6 +116,7 @@ struct FlatShading {
 // loop budget, most loop iterations one path ran].
 @group(0) @binding(9) var<storage, read_write> status: array<atomic<u32>, 4>;
 @group(0) @binding(10) var<storage, read> regions: array<TraceRegionTriangle>;
+@group(0) @binding(11) var<storage, read> emissive: array<TraceTriangle>;
 
 const GLOBAL_MAP: u32 = 0u;
 const CAUSTIC_MAP: u32 = 1u;
@@ -202,12 +225,74 @@ fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
             let dir = local_to_world(cosine_hemisphere(rng_next_2d(rng)), n);
             return Ray(l.origin + n * l.radius, dir);
         }
-        default: {
+        case 3u: {
             let u = rng_next_2d(rng);
             let dir = local_to_world(cosine_hemisphere(rng_next_2d(rng)), l.normal);
             return Ray(l.origin + l.axis * u.x + l.edge_v * u.y, dir);
         }
+        case 4u: {
+            return Ray(disc_origin(l, l.axis, rng_next_2d(rng)), l.axis);
+        }
+        case 5u: {
+            let dir = uniform_sphere(rng_next_2d(rng));
+            return Ray(disc_origin(l, dir, rng_next_2d(rng)), dir);
+        }
+        default: {
+            let point = mesh_point(l, rng_next_2d(rng));
+            // Two-sided: either face, each with half the power.
+            var n = point.normal;
+            if (l.two_sided != 0u) {
+                if (rng_next_f32(rng) < 0.5) {
+                    n = -n;
+                }
+            }
+            return Ray(point.position, local_to_world(cosine_hemisphere(rng_next_2d(rng)), n));
+        }
     }
+}
+
+// Disc::emission_origin: a uniform point of the distant light's disc turned
+// perpendicular to `dir` and set back by its radius.
+fn disc_origin(l: TraceLight, dir: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
+    let basis = orthonormal_basis(dir);
+    let p = unit_circle(u.y) * sqrt(u.x) * l.radius;
+    return l.origin - dir * l.radius + basis.t * p.x + basis.b * p.y;
+}
+
+struct MeshPoint {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+}
+
+// EmissiveMesh::sample_point: a triangle ∝ its area by binary search of the
+// cumulative areas (`partition_point`), u.x reused, rescaled, inside it.
+fn mesh_point(l: TraceLight, u: vec2<f32>) -> MeshPoint {
+    let target_area = u.x * l.radius;
+    // The first triangle whose cumulative area exceeds the target.
+    var lo = 0u;
+    var hi = l.triangle_count;
+    while (lo < hi) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let mid = (lo + hi) / 2u;
+        if (emissive[l.first_triangle + mid].cumulative_area <= target_area) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let tri = emissive[l.first_triangle + min(lo, l.triangle_count - 1u)];
+    let width = tri.cumulative_area - tri.start_area;
+    var ux = 0.5;
+    if (width > 0.0) {
+        ux = clamp((target_area - tri.start_area) / width, 0.0, 1.0);
+    }
+    // Uniform on the triangle (pbrt's square-root mapping).
+    let s = sqrt(ux);
+    let b1 = s * (1.0 - u.y);
+    let b2 = s * u.y;
+    return MeshPoint(tri.v0 * (1.0 - b1 - b2) + tri.v1 * b1 + tri.v2 * b2, tri.normal);
 }
 
 // Accel::intersect's normals at a hit on primitive `index` at x: the
@@ -275,7 +360,12 @@ fn trace_one(rng: ptr<function, Rng>) {
         let hit = trace_bvh(ray.origin, ray.dir, params.epsilon);
         // Free flight through the media (eq. 5.10–5.12).
         if (params.medium_count > 0u) {
-            let flight = sample_flight(ray.origin, ray.dir, hit.t, rng_next_f32(rng));
+            var t_max = hit.t;
+            let disc = params.distant_disc;
+            if (hit.t >= NO_HIT && disc.w > 0.0) {
+                t_max = max(disc.w - dot(ray.origin - disc.xyz, ray.dir), 0.0);
+            }
+            let flight = sample_flight(ray.origin, ray.dir, t_max, rng_next_f32(rng));
             if (flight.interaction) {
                 let scattering = media_scattering(flight.mask);
                 if (rng_next_f32(rng) >= scattering.w) {

@@ -32,14 +32,24 @@ fn unit_circle(u: f32) -> vec2<f32> {
     }
 }
 
-// sampling::local_to_world with Duff et al.'s basis (orthonormal_basis).
-fn local_to_world(local: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// Two unit tangents completing unit n to an orthonormal frame
+// (sampling::orthonormal_basis, Duff et al.).
+struct Basis {
+    t: vec3<f32>,
+    b: vec3<f32>,
+}
+
+fn orthonormal_basis(n: vec3<f32>) -> Basis {
     let s = sign_bit_signum(n.z);
     let a = -1.0 / (s + n.z);
     let b = n.x * n.y * a;
-    let t = vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x);
-    let bt = vec3<f32>(b, s + n.y * n.y * a, -n.y);
-    return t * local.x + bt * local.y + n * local.z;
+    return Basis(vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x), vec3<f32>(b, s + n.y * n.y * a, -n.y));
+}
+
+// sampling::local_to_world.
+fn local_to_world(local: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let basis = orthonormal_basis(n);
+    return basis.t * local.x + basis.b * local.y + n * local.z;
 }
 
 fn uniform_sphere(u: vec2<f32>) -> vec3<f32> {

@@ -1,6 +1,8 @@
 // A surface's material as the GPU passes read it (scene_upload::GpuSurface):
 // kind 0 diffuse (albedo ρ_d, specular ρ_s), 1 mirror (albedo is its
-// reflectance), 2 glass (ior), 3 an area light's body (emission).
+// reflectance), 2 glass (ior), 3 an area light's black body. `emission`
+// leaves the front face (the geometric normal's side), or both faces when
+// `two_sided` is 1; emissive meshes emit from surfaces of any kind.
 
 struct Surface {
     albedo: vec3<f32>,
@@ -8,5 +10,5 @@ struct Surface {
     emission: vec3<f32>,
     ior: f32,
     specular: vec3<f32>,
-    _pad: u32,
+    two_sided: u32,
 }

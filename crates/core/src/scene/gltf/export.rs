@@ -7,7 +7,7 @@ use super::LUMENS_PER_WATT;
 use crate::light::Light;
 use crate::material::{Material, Rgb};
 use crate::scene::Scene;
-use glam::{Mat3, Quat, Vec3};
+use glam::{Mat3, Quat, Vec2, Vec3};
 use gltf::json::{self, Index, validation::Checked::Valid, validation::USize64};
 
 /// A glTF material in the metallic–roughness model.
@@ -22,7 +22,18 @@ pub struct PbrMaterial {
     pub emission: Rgb,
     /// Smooth glass with this index of refraction (`KHR_materials_transmission`).
     pub glass_ior: Option<f32>,
+    /// `KHR_materials_specular`'s factor: 1 is glTF's default dielectric
+    /// (F0 = 0.04), 0 a pure Lambertian.
+    pub specular: f32,
     pub double_sided: bool,
+    /// `baseColorFactor`'s alpha.
+    pub alpha: f32,
+    /// `alphaMode` MASK with this `alphaCutoff` (None: OPAQUE).
+    pub alpha_cutoff: Option<f32>,
+    /// Textures (from [`GltfBuilder::texture`]), read through TEXCOORD_0.
+    pub base_color_texture: Option<Index<json::Texture>>,
+    pub metallic_roughness_texture: Option<Index<json::Texture>>,
+    pub emissive_texture: Option<Index<json::Texture>>,
 }
 
 impl Default for PbrMaterial {
@@ -34,7 +45,13 @@ impl Default for PbrMaterial {
             roughness: 1.0,
             emission: Rgb::ZERO,
             glass_ior: None,
+            specular: 1.0,
             double_sided: true,
+            alpha: 1.0,
+            alpha_cutoff: None,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
+            emissive_texture: None,
         }
     }
 }
@@ -98,12 +115,76 @@ impl GltfBuilder {
         })
     }
 
+    /// Appends `bytes` (a PNG or JPEG file of MIME type `mime`) to the
+    /// binary buffer as an image.
+    pub fn image(&mut self, bytes: &[u8], mime: &str) -> Index<json::Image> {
+        while self.bin.len() % 4 != 0 {
+            self.bin.push(0);
+        }
+        let view = self.root.push(json::buffer::View {
+            buffer: Index::new(0),
+            byte_length: USize64::from(bytes.len()),
+            byte_offset: Some(USize64::from(self.bin.len())),
+            byte_stride: None,
+            name: None,
+            target: None,
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.bin.extend_from_slice(bytes);
+        self.root.push(json::Image {
+            buffer_view: Some(view),
+            mime_type: Some(json::image::MimeType(mime.into())),
+            name: None,
+            uri: None,
+            extensions: None,
+            extras: Default::default(),
+        })
+    }
+
+    /// A texture reading `image` with its own sampler wrapping as given (linear filtering).
+    pub fn texture(
+        &mut self,
+        image: Index<json::Image>,
+        wrap_s: json::texture::WrappingMode,
+        wrap_t: json::texture::WrappingMode,
+    ) -> Index<json::Texture> {
+        let sampler = self.root.push(json::texture::Sampler {
+            mag_filter: Some(Valid(json::texture::MagFilter::Linear)),
+            min_filter: Some(Valid(json::texture::MinFilter::Linear)),
+            name: None,
+            wrap_s: Valid(wrap_s),
+            wrap_t: Valid(wrap_t),
+            extensions: None,
+            extras: Default::default(),
+        });
+        self.root.push(json::Texture {
+            name: None,
+            sampler: Some(sampler),
+            source: image,
+            extensions: None,
+            extras: Default::default(),
+        })
+    }
+
     pub fn material(&mut self, m: &PbrMaterial) -> Index<json::Material> {
+        let info = |t: Option<Index<json::Texture>>| {
+            t.map(|index| json::texture::Info { index, tex_coord: 0, extensions: None, extras: Default::default() })
+        };
         let strength = m.emission.max_element().max(1.0);
         let mut extensions = json::extensions::material::Material::default();
         if strength > 1.0 {
             extensions.emissive_strength = Some(json::extensions::material::EmissiveStrength {
                 emissive_strength: json::extensions::material::EmissiveStrengthFactor(strength),
+            });
+        }
+        if m.specular != 1.0 {
+            extensions.specular = Some(json::extensions::material::Specular {
+                specular_factor: json::extensions::material::SpecularFactor(m.specular),
+                specular_texture: None,
+                specular_color_factor: json::extensions::material::SpecularColorFactor([1.0; 3]),
+                specular_color_texture: None,
+                extras: Default::default(),
             });
         }
         if let Some(ior) = m.glass_ior {
@@ -122,12 +203,21 @@ impl GltfBuilder {
             name: Some(m.name.clone()),
             double_sided: m.double_sided,
             pbr_metallic_roughness: json::material::PbrMetallicRoughness {
-                base_color_factor: json::material::PbrBaseColorFactor([r, g, b, 1.0]),
+                base_color_factor: json::material::PbrBaseColorFactor([r, g, b, m.alpha]),
                 metallic_factor: json::material::StrengthFactor(m.metallic),
                 roughness_factor: json::material::StrengthFactor(m.roughness),
+                base_color_texture: info(m.base_color_texture),
+                metallic_roughness_texture: info(m.metallic_roughness_texture),
                 ..Default::default()
             },
             emissive_factor: json::material::EmissiveFactor((m.emission / strength).to_array()),
+            emissive_texture: info(m.emissive_texture),
+            alpha_mode: Valid(if m.alpha_cutoff.is_some() {
+                json::material::AlphaMode::Mask
+            } else {
+                json::material::AlphaMode::Opaque
+            }),
+            alpha_cutoff: m.alpha_cutoff.map(json::material::AlphaCutoff),
             extensions: Some(extensions),
             ..Default::default()
         })
@@ -139,6 +229,18 @@ impl GltfBuilder {
         &mut self,
         positions: &[Vec3],
         normals: Option<&[Vec3]>,
+        indices: Option<&[u32]>,
+        material: Option<Index<json::Material>>,
+    ) -> Index<json::Mesh> {
+        self.textured_mesh(positions, normals, None, indices, material)
+    }
+
+    /// [`GltfBuilder::mesh`] with texture coordinates `uvs` (TEXCOORD_0, f32).
+    pub fn textured_mesh(
+        &mut self,
+        positions: &[Vec3],
+        normals: Option<&[Vec3]>,
+        uvs: Option<&[Vec2]>,
         indices: Option<&[u32]>,
         material: Option<Index<json::Material>>,
     ) -> Index<json::Mesh> {
@@ -156,6 +258,10 @@ impl GltfBuilder {
         if let Some(n) = normals {
             let acc = self.accessor(bytemuck::cast_slice(n), n.len(), Type::Vec3, ComponentType::F32, None);
             attributes.insert(Valid(json::mesh::Semantic::Normals), acc);
+        }
+        if let Some(uv) = uvs {
+            let acc = self.accessor(bytemuck::cast_slice(uv), uv.len(), Type::Vec2, ComponentType::F32, None);
+            attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), acc);
         }
         let indices =
             indices.map(|i| self.accessor(bytemuck::cast_slice(i), i.len(), Type::Scalar, ComponentType::U32, None));
@@ -272,6 +378,7 @@ impl GltfBuilder {
                 (ext.is_some_and(|e| e.transmission.is_some()), "KHR_materials_transmission"),
                 (ext.is_some_and(|e| e.ior.is_some()), "KHR_materials_ior"),
                 (ext.is_some_and(|e| e.emissive_strength.is_some()), "KHR_materials_emissive_strength"),
+                (ext.is_some_and(|e| e.specular.is_some()), "KHR_materials_specular"),
             ] {
                 if used && !self.root.extensions_used.iter().any(|e| e == name) {
                     self.root.extensions_used.push(name.into());
@@ -280,6 +387,14 @@ impl GltfBuilder {
         }
         (self.root, self.bin)
     }
+}
+
+/// An 8-bit RGBA image (`rgba`: rows from the top) as a PNG file.
+pub fn png(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
+    let image = image::RgbaImage::from_raw(width, height, rgba.to_vec()).expect("width × height × 4 bytes");
+    let mut out = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut out, image::ImageFormat::Png).expect("a PNG encodes");
+    out.into_inner()
 }
 
 /// `root` and its binary chunk as a `.glb` file.
@@ -323,13 +438,21 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
         let material = match (&scene.materials[surface.material as usize], surface.emitter) {
             (Material::Emitter, Some(l)) => PbrMaterial {
                 base_color: Rgb::ZERO,
+                specular: 0.0,
                 emission: scene.lights[l as usize].emission(),
                 double_sided: false,
                 ..Default::default()
             },
             (Material::Diffuse { albedo, specular }, _) if *specular == Rgb::ZERO => {
-                PbrMaterial { base_color: *albedo, ..Default::default() }
+                PbrMaterial { base_color: *albedo, specular: 0.0, ..Default::default() }
             }
+            (Material::Pbr(b), _) => PbrMaterial {
+                base_color: b.base_color,
+                metallic: b.metallic,
+                roughness: b.roughness,
+                specular: b.specular,
+                ..Default::default()
+            },
             (Material::Mirror { reflectance }, _) => {
                 PbrMaterial { base_color: *reflectance, metallic: 1.0, roughness: 0.0, ..Default::default() }
             }

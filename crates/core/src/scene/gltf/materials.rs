@@ -1,14 +1,17 @@
-//! glTF materials as hikari materials.
-//!
-//! Until the metallic–roughness BRDF of the glTF specification (Appendix B)
-//! is hikari's material model, each glTF material is approximated by the
-//! closest of hikari's: a transmissive one is glass, a smooth metal a
-//! mirror tinted by its base colour, everything else Lambertian with its
-//! base colour (rough metal included), and textures are not sampled (their
-//! factors are). Each approximation made is reported in one note.
+//! glTF materials as hikari materials: `pbrMetallicRoughness` is
+//! [`Material::Pbr`] (the specification's BRDF, `crate::bsdf`); a
+//! transmissive material (`KHR_materials_transmission` ≥ 0.5) is smooth
+//! glass with `KHR_materials_ior`; `KHR_materials_specular`'s factor scales
+//! the dielectric's Fresnel (its colour is ignored). Base-colour,
+//! metallic–roughness and emissive textures are read (`crate::texture`);
+//! normal and occlusion textures are not. `alphaMode` MASK makes cut-outs,
+//! BLEND is drawn opaque. Each approximation made is reported in one note.
 
+use super::textures::Images;
+use crate::bsdf::Bsdf;
 use crate::material::{Material, Rgb};
-use glam::Vec3;
+use crate::texture::{ColorSpace, MaterialTextures};
+use glam::{Vec3, Vec4Swizzles};
 
 /// Light a surface emits: `emissiveFactor` × `KHR_materials_emissive_strength`,
 /// a radiance in W/(m² sr) (Blender writes its emission strength there
@@ -20,30 +23,39 @@ pub struct Emission {
     pub two_sided: bool,
 }
 
-/// Roughness below which a metal is followed as a mirror.
-pub const MIRROR_ROUGHNESS: f32 = 0.2;
-
 /// The document's materials, then the specification's default material
-/// (white, metallic 1, roughness 1) for primitives without one, each with
-/// its emission.
-pub fn convert(doc: &gltf::Document, notes: &mut Vec<String>) -> (Vec<Material>, Vec<Option<Emission>>) {
-    let mut textured = 0;
+/// (white, metallic 1, roughness 1) for primitives without one.
+pub struct Converted {
+    pub materials: Vec<Material>,
+    pub emissions: Vec<Option<Emission>>,
+    /// What each material takes from textures (None: nothing, and opaque).
+    pub textures: Vec<Option<MaterialTextures>>,
+}
+
+/// Converts every material, reading its textures from `images`.
+pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -> Converted {
+    let mut unread_maps = 0;
+    let mut other_sets = 0;
     let mut approximated = 0;
-    let mut masked = 0;
-    let mut out: (Vec<Material>, Vec<Option<Emission>>) = doc
+    let mut blended = 0;
+    let mut coloured_specular = 0;
+    let mut textures = Vec::new();
+    let (mut materials, mut emissions): (Vec<Material>, Vec<Option<Emission>>) = doc
         .materials()
         .map(|m| {
             let pbr = m.pbr_metallic_roughness();
-            textured += [
-                pbr.base_color_texture().is_some(),
-                pbr.metallic_roughness_texture().is_some(),
-                m.emissive_texture().is_some(),
-                m.normal_texture().is_some(),
-            ]
-            .iter()
-            .any(|&t| t) as usize;
-            masked += (m.alpha_mode() != gltf::material::AlphaMode::Opaque) as usize;
-            let [r, g, b, _] = pbr.base_color_factor();
+            unread_maps += (m.normal_texture().is_some() || m.occlusion_texture().is_some()) as usize;
+            let read = [
+                pbr.base_color_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Srgb))),
+                pbr.metallic_roughness_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Linear))),
+                m.emissive_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Srgb))),
+            ];
+            other_sets += read.iter().flatten().any(|(set, _)| *set != 0) as usize;
+            let [base_color, metallic_roughness, emissive] = read.map(|r| r.and_then(|(_, t)| t));
+            blended += (m.alpha_mode() == gltf::material::AlphaMode::Blend) as usize;
+            let alpha_cutoff =
+                (m.alpha_mode() == gltf::material::AlphaMode::Mask).then(|| m.alpha_cutoff().unwrap_or(0.5));
+            let [r, g, b, alpha] = pbr.base_color_factor();
             let base = sane(Vec3::new(r, g, b), 1.0);
             let metallic = sane(Vec3::splat(pbr.metallic_factor()), 1.0).x;
             let roughness = sane(Vec3::splat(pbr.roughness_factor()), 1.0).x;
@@ -52,35 +64,56 @@ pub fn convert(doc: &gltf::Document, notes: &mut Vec<String>) -> (Vec<Material>,
                 approximated += (roughness > 0.0 || transmission < 1.0) as usize;
                 Material::Glass { ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0) }
             } else {
-                approximated += (metallic > 0.0 && metallic < 1.0 || (metallic > 0.0 && roughness > 0.0)) as usize;
-                if metallic > 0.0 && roughness < MIRROR_ROUGHNESS {
-                    Material::Diffuse { albedo: base * (1.0 - metallic), specular: base * metallic }
-                } else {
-                    Material::Diffuse { albedo: base, specular: Rgb::ZERO }
-                }
+                approximated += (transmission > 0.0) as usize;
+                // KHR_materials_specular's factor scales the dielectric's
+                // Fresnel (0: a pure Lambertian, as hikari's "diffuse").
+                let specular = m.specular().map_or(1.0, |s| s.specular_factor());
+                coloured_specular += m.specular().is_some_and(|s| s.specular_color_factor() != [1.0; 3]) as usize;
+                Material::from_bsdf(Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x))
             };
+            // An emissive texture varies the radiance over the surface; the
+            // light (uniform over its mesh) emits the texture's mean.
+            let emissive_mean = emissive.map_or(Rgb::ONE, |t| images.images[t.image as usize].mean().xyz());
             let strength = m.emissive_strength().unwrap_or(1.0);
-            let radiance = sane(Vec3::from(m.emissive_factor()), 1.0) * sane(Vec3::splat(strength), 1e6).x;
+            let radiance =
+                sane(Vec3::from(m.emissive_factor()), 1.0) * sane(Vec3::splat(strength), 1e6).x * emissive_mean;
             let emission = (radiance.max_element() > 0.0).then_some(Emission { radiance, two_sided: m.double_sided() });
+            let t = MaterialTextures {
+                base_color,
+                metallic_roughness,
+                emissive,
+                emissive_mean,
+                alpha_factor: sane(Vec3::splat(alpha), 1.0).x,
+                alpha_cutoff,
+            };
+            textures.push((t.is_textured() || alpha_cutoff.is_some()).then_some(t));
             (material, emission)
         })
         .unzip();
     // The specification's default material: metallic 1, roughness 1, white.
-    out.0.push(Material::Diffuse { albedo: Rgb::ONE, specular: Rgb::ZERO });
-    out.1.push(None);
-    if textured > 0 {
-        notes.push(format!("{textured} material(s) have textures, which are not sampled yet: their factors are used"));
+    materials.push(Material::Pbr(Bsdf::new(Rgb::ONE, 1.0, 1.0, 1.0)));
+    emissions.push(None);
+    textures.push(None);
+    if unread_maps > 0 {
+        notes.push(format!("{unread_maps} material(s) have normal or occlusion textures, which are ignored"));
+    }
+    if other_sets > 0 {
+        notes.push(format!(
+            "{other_sets} material(s) read textures through texCoord other than 0 (TEXCOORD_0): those textures are ignored"
+        ));
     }
     if approximated > 0 {
         notes.push(format!(
-            "{approximated} material(s) approximated: rough metal as diffuse, smooth metal (roughness < {MIRROR_ROUGHNESS}) \
-             as a tinted mirror, transmission as smooth glass"
+            "{approximated} material(s) approximated: transmission from 0.5 as smooth glass, below 0.5 as none"
         ));
     }
-    if masked > 0 {
-        notes.push(format!("{masked} material(s) with alphaMode MASK or BLEND are rendered opaque"));
+    if coloured_specular > 0 {
+        notes.push(format!("{coloured_specular} material(s) have a specularColorFactor, which is ignored (white)"));
     }
-    out
+    if blended > 0 {
+        notes.push(format!("{blended} material(s) with alphaMode BLEND are rendered opaque"));
+    }
+    Converted { materials, emissions, textures }
 }
 
 /// Each component made finite and clamped to [0, max] (the specification's

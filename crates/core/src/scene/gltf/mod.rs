@@ -10,13 +10,15 @@
 mod accessors;
 pub mod export;
 mod materials;
+mod textures;
 
 use super::SceneError;
 use super::limits::MAX_COORD;
 use crate::geometry::{Triangle, TriangleNormals};
 use crate::light::Light;
 use crate::material::{Material, Rgb};
-use glam::{Affine3A, Mat3, Mat4, Vec3};
+use crate::texture::{Image, MaterialTextures};
+use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3};
 use gltf::accessor::DataType;
 use gltf::mesh::Mode;
 use std::collections::HashMap;
@@ -38,6 +40,10 @@ pub struct Asset {
     /// One per glTF material, then the specification's default material
     /// (for primitives without one) last.
     pub materials: Vec<Material>,
+    /// Parallel to `materials`: what each takes from textures.
+    pub material_textures: Vec<Option<MaterialTextures>>,
+    /// The decoded images `material_textures` refer to.
+    pub images: Vec<Image>,
     pub primitives: Vec<Primitive>,
     /// Each light with its node's name.
     pub lights: Vec<(Option<String>, Light)>,
@@ -53,6 +59,9 @@ pub struct Primitive {
     /// The node's name (for the viewer and animations), if it has one.
     pub name: Option<String>,
     pub triangles: Vec<Triangle>,
+    /// Texture coordinates of each triangle's vertices, when its material
+    /// reads textures and the primitive has `TEXCOORD_0`.
+    pub uvs: Option<Vec<[Vec2; 3]>>,
     /// Index into [`Asset::materials`].
     pub material: u32,
     /// Light the surface emits, from its material.
@@ -119,16 +128,29 @@ pub fn asset_from_bytes(
     let buffers = load_buffers(&gltf, base, &file)?;
     let mut notes = Vec::new();
     check_extensions(&gltf.document, &file, &mut notes)?;
-    let (materials, emissions) = materials::convert(&gltf.document, &mut notes);
+    let images = textures::load(&gltf.document, &buffers, base, &file)?;
+    let materials::Converted { materials, emissions, textures } =
+        materials::convert(&gltf.document, &images, &mut notes);
+    let textured: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.is_textured())).collect();
     let mut walk = Walk {
         file: &file,
         buffers: &buffers,
         emissions: &emissions,
+        textured: &textured,
         camera_name: camera,
         cache: HashMap::new(),
-        asset: Asset { materials, primitives: Vec::new(), lights: Vec::new(), camera: None, notes },
+        asset: Asset {
+            materials,
+            material_textures: textures,
+            images: images.images,
+            primitives: Vec::new(),
+            lights: Vec::new(),
+            camera: None,
+            notes,
+        },
         visited: vec![false; gltf.document.nodes().len()],
         ignored_range: false,
+        without_uvs: 0,
     };
     let scene = gltf
         .document
@@ -157,6 +179,12 @@ pub fn asset_from_bytes(
     }
     if walk.ignored_range {
         walk.asset.notes.push("light `range` is ignored: lights fall off physically, as 1/d²".into());
+    }
+    if walk.without_uvs > 0 {
+        walk.asset.notes.push(format!(
+            "{} primitive(s) with textured materials have no TEXCOORD_0: their factors are used",
+            walk.without_uvs
+        ));
     }
     Ok(walk.asset)
 }
@@ -263,6 +291,8 @@ fn check_extensions(doc: &gltf::Document, file: &str, notes: &mut Vec<String>) -
 struct LocalPrimitive {
     positions: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
+    /// `TEXCOORD_0`, read only where the material reads textures.
+    uvs: Option<Vec<Vec2>>,
     /// Three vertex indices per triangle.
     triangles: Vec<[u32; 3]>,
     material: u32,
@@ -273,12 +303,16 @@ struct Walk<'a> {
     file: &'a str,
     buffers: &'a [gltf::buffer::Data],
     emissions: &'a [Option<Emission>],
+    /// Per material: does it read textures (so its primitives' UVs are kept)?
+    textured: &'a [bool],
     camera_name: Option<&'a str>,
     /// (mesh, primitive) → its triangles, read once.
     cache: HashMap<(usize, usize), std::rc::Rc<LocalPrimitive>>,
     asset: Asset,
     visited: Vec<bool>,
     ignored_range: bool,
+    /// Primitives of textured materials without `TEXCOORD_0`.
+    without_uvs: usize,
 }
 
 impl Walk<'_> {
@@ -299,7 +333,7 @@ impl Walk<'_> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
                 let local = self.local_primitive(&mesh, &primitive)?;
-                let triangles = place_triangles(&local, &world);
+                let (triangles, uvs) = place_triangles(&local, &world);
                 if let Some(v) = triangles.iter().flat_map(|t| t.v).find(|v| v.abs().max_element() > MAX_COORD) {
                     return Err(error(
                         self.file,
@@ -309,7 +343,7 @@ impl Walk<'_> {
                 }
                 let material = local.material;
                 let emission = self.emissions[material as usize];
-                self.asset.primitives.push(Primitive { name: name.clone(), triangles, material, emission });
+                self.asset.primitives.push(Primitive { name: name.clone(), triangles, uvs, material, emission });
             }
         }
         if let Some(camera) = node.camera() {
@@ -453,24 +487,51 @@ impl Walk<'_> {
             }
         };
         let material = primitive.material().index().unwrap_or(self.asset.materials.len() - 1) as u32;
-        let local = std::rc::Rc::new(LocalPrimitive { positions, normals, triangles, material });
+        let uvs = if self.textured[material as usize] {
+            self.tex_coords(primitive, positions.len()).map_err(|m| fail(".attributes.TEXCOORD_0", m))?
+        } else {
+            None
+        };
+        self.without_uvs += (self.textured[material as usize] && uvs.is_none()) as usize;
+        let local = std::rc::Rc::new(LocalPrimitive { positions, normals, uvs, triangles, material });
         self.cache.insert(key, local.clone());
         Ok(local)
     }
 }
 
+impl Walk<'_> {
+    /// `TEXCOORD_0`: f32, or normalized u8 or u16 (the specification's choices).
+    fn tex_coords(&self, primitive: &gltf::Primitive, count: usize) -> Result<Option<Vec<Vec2>>, String> {
+        let Some(a) = primitive.get(&gltf::Semantic::TexCoords(0)) else { return Ok(None) };
+        if a.data_type() != DataType::F32 && !a.normalized() {
+            return Err(format!("accessor {}'s integer components must be normalized", a.index()));
+        }
+        let uvs = accessors::read::<2>(&a, self.buffers, &[DataType::F32, DataType::U8, DataType::U16])
+            .map_err(|m| format!("accessor {} {m}", a.index()))?;
+        if uvs.len() != count {
+            return Err("has a different count than POSITION".into());
+        }
+        if let Some((i, uv)) = uvs.iter().enumerate().find(|(_, uv)| !uv.iter().all(|x| x.is_finite())) {
+            return Err(format!("coordinate {i} is not finite: {uv:?}"));
+        }
+        Ok(Some(uvs.into_iter().map(Vec2::from).collect()))
+    }
+}
+
 /// A primitive's triangles placed by `world`: normals by its inverse
 /// transpose, and the winding reversed where it mirrors (negative
-/// determinant), so the front face stays the front face. Triangles with no
-/// area in 32-bit floats are dropped.
-fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> Vec<Triangle> {
+/// determinant), so the front face stays the front face, with their
+/// texture coordinates in the same vertex order. Triangles with no area in
+/// 32-bit floats are dropped.
+fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Option<Vec<[Vec2; 3]>>) {
     let linear = Mat3::from_mat4(*world);
     let normal_matrix = linear.inverse().transpose();
     let mirrored = linear.determinant() < 0.0;
     let positions: Vec<Vec3> = local.positions.iter().map(|&p| world.transform_point3(p)).collect();
     let normals: Option<Vec<Vec3>> =
         local.normals.as_ref().map(|n| n.iter().map(|&n| (normal_matrix * n).normalize_or_zero()).collect());
-    local
+    let mut uvs = local.uvs.as_ref().map(|_| Vec::with_capacity(local.triangles.len()));
+    let triangles = local
         .triangles
         .iter()
         .filter_map(|&[a, b, c]| {
@@ -478,13 +539,20 @@ fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> Vec<Triangle> {
             let v = order.map(|i| positions[i as usize]);
             let normals = normals.as_ref().map(|n| TriangleNormals(order.map(|i| n[i as usize])));
             let tri = Triangle { v, normals };
-            tri.geometric_normal().try_normalize().is_some().then_some(tri)
+            tri.geometric_normal().try_normalize()?;
+            if let (Some(out), Some(uv)) = (uvs.as_mut(), local.uvs.as_ref()) {
+                out.push(order.map(|i| uv[i as usize]));
+            }
+            Some(tri)
         })
-        .collect()
+        .collect();
+    (triangles, uvs)
 }
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod texture_tests;
 
 /// What a user may choose when loading a file on its own.
 #[derive(Clone, Debug, Default)]
@@ -526,9 +594,13 @@ fn scene_from_asset(mut asset: Asset, file: String) -> Result<super::Scene, Scen
         light_names.push(name);
         lights.push(light);
     }
+    let mut uvs = crate::texture::TexCoords::default();
     for primitive in asset.primitives.drain(..) {
         if primitive.triangles.is_empty() {
             continue;
+        }
+        if let Some(tri_uvs) = &primitive.uvs {
+            uvs.push_run(triangles.len() as u32, tri_uvs);
         }
         let surface = surfaces.len() as u32;
         let emitter = primitive.emitted_light().map(|light| {
@@ -548,7 +620,16 @@ fn scene_from_asset(mut asset: Asset, file: String) -> Result<super::Scene, Scen
         return Err(error(&file, "", "the scene has no triangle to render"));
     }
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = triangles.into_iter().unzip();
-    let accel = crate::geometry::Accel::build(triangles, tri_surfaces, Vec::new(), Vec::new());
+    let mut accel = crate::geometry::Accel::build(triangles, tri_surfaces, Vec::new(), Vec::new());
+    let texturing = asset.material_textures.iter().any(Option::is_some).then(|| {
+        std::sync::Arc::new(crate::texture::Texturing {
+            images: std::mem::take(&mut asset.images),
+            materials: std::mem::take(&mut asset.material_textures),
+            uvs,
+            surface_materials: surfaces.iter().map(|s| s.material).collect(),
+        })
+    });
+    accel.set_alpha_mask(texturing.clone());
     if lights.is_empty() {
         asset.notes.push("the file has no lights: lit by a uniform white environment (radiance 1)".into());
         lights.push(Light::Environment { radiance: Rgb::ONE, disc: crate::light::Disc::UNIT });
@@ -574,6 +655,7 @@ fn scene_from_asset(mut asset: Asset, file: String) -> Result<super::Scene, Scen
         names,
         animations: Vec::new(),
         notes: asset.notes,
+        texturing,
     })
 }
 

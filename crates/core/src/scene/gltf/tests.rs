@@ -75,10 +75,9 @@ fn node_hierarchy_places_and_instances_triangles() {
         let n = p.triangles[0].geometric_normal().normalize();
         assert!((n - Vec3::Z).length() < 1e-5, "normal {n}");
     }
-    assert_eq!(
-        asset.materials[asset.primitives[0].material as usize],
-        Material::Diffuse { albedo: Vec3::new(0.5, 0.25, 1.0), specular: Vec3::ZERO }
-    );
+    // glTF's default dielectric: the metallic–roughness BRDF with its 4% specular lobe.
+    let expected = crate::bsdf::Bsdf::new(Vec3::new(0.5, 0.25, 1.0), 0.0, 1.0, 1.0);
+    assert_eq!(asset.materials[asset.primitives[0].material as usize], Material::Pbr(expected));
 }
 
 #[test]
@@ -265,8 +264,8 @@ fn broken_files_are_located_errors() {
     let e = error_of("index", &[("i.glb", &glb(&r, bin.clone()))]);
     assert_says(&e, &["scenes[0].nodes[1]"]);
 
-    // A texture in a format hikari cannot decode is refused once textures are read;
-    // an unknown camera name is refused now.
+    // An unknown camera name (missing and corrupt images:
+    // `texture_tests::missing_and_corrupt_images_are_located_errors`).
     let dir = folder("camera-name");
     let path = write(&dir, "c.glb", &whole);
     let options = LoadOptions { camera: Some("Front".into()) };
@@ -324,6 +323,7 @@ intensity = [1.0, 1.0, 1.0]
     // (1, 0, 0) scaled by 2 and turned 90° about +y is (0, 0, −2), then moved by (1, 0, 0).
     assert!(t.v.iter().any(|v| (*v - Vec3::new(1.0, 0.0, -2.0)).length() < 1e-5), "{:?}", t.v);
     assert_eq!(scene.materials.len(), 2, "the file's material and the default");
+    assert!(matches!(scene.materials[0], Material::Pbr(_)));
 
     let bad = toml.replace("scale = 2.0", "scale = 2.0\nmaterial = \"white\"");
     let e = crate::scene::Scene::from_toml(&bad, "t.toml", Some(&dir)).err().unwrap().to_string();

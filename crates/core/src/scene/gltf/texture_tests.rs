@@ -1,0 +1,287 @@
+//! Textures and cut-outs of glTF files written here, through the loader
+//! and the CPU renderers.
+
+use super::export::{GltfBuilder, PbrMaterial, glb, looking, png};
+use super::*;
+use crate::geometry::Ray;
+use crate::photon::{TraceSettings, trace_photons};
+use crate::progress::Silent;
+use crate::render::path::{PathSettings, radiance as path_radiance};
+use crate::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+use crate::texture::srgb_to_linear;
+use gltf::json;
+use gltf::json::texture::WrappingMode;
+use std::f32::consts::PI;
+
+fn folder(tag: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("hikari-gltf-tex-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn load(tag: &str, bytes: &[u8]) -> Scene {
+    let path = folder(tag).join("t.glb");
+    std::fs::write(&path, bytes).unwrap();
+    Scene::load(path.to_str().unwrap()).unwrap()
+}
+
+/// A quad with corners `origin`, + `eu`, + `eu` + `ev`, + `ev`: the point
+/// `origin + s·eu + t·ev` has texture coordinates `scale · (s, t)`.
+fn quad(
+    b: &mut GltfBuilder,
+    origin: Vec3,
+    eu: Vec3,
+    ev: Vec3,
+    scale: f32,
+    m: json::Index<json::Material>,
+) -> json::Index<json::Node> {
+    let positions = [origin, origin + eu, origin + eu + ev, origin + ev];
+    let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].map(|uv| uv * scale);
+    let mesh = b.textured_mesh(&positions, None, Some(&uvs), Some(&[0, 1, 2, 0, 2, 3]), Some(m));
+    b.node(json::Node { mesh: Some(mesh), ..Default::default() })
+}
+
+/// 2×2 greys, sRGB-encoded, rows from the top: 255, 0 / 128, 64.
+const GREYS: [u8; 4] = [255, 0, 128, 64];
+
+fn grey_checker(alpha: [u8; 4]) -> Vec<u8> {
+    let rgba: Vec<u8> = GREYS.iter().zip(alpha).flat_map(|(&g, a)| [g, g, g, a]).collect();
+    png(2, 2, &rgba)
+}
+
+/// Two Lambertian quads (no specular lobe) under the white sky of a file
+/// without lights, both with the grey checker in base colour: x ∈ [0, 1]
+/// with texture coordinates [0, 1]² and REPEAT, x ∈ [2, 3] with [0, 2]²
+/// and CLAMP_TO_EDGE. They lie in z = 0, with v = 0 at the top (y = 1),
+/// as glTF's texture coordinates have the image's top-left at (0, 0).
+/// `tag` names the test's own folder (tests run in parallel).
+fn checker_scene(tag: &str) -> Scene {
+    let mut b = GltfBuilder::new();
+    let image = b.image(&grey_checker([255; 4]), "image/png");
+    let repeat = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    let clamp = b.texture(image, WrappingMode::ClampToEdge, WrappingMode::ClampToEdge);
+    let mut roots = Vec::new();
+    for (x, t, scale) in [(0.0, repeat, 1.0), (2.0, clamp, 2.0)] {
+        let m = b.material(&PbrMaterial { specular: 0.0, base_color_texture: Some(t), ..Default::default() });
+        roots.push(quad(&mut b, Vec3::new(x, 1.0, 0.0), Vec3::X, -Vec3::Y, scale, m));
+    }
+    load(tag, &b.to_glb(roots))
+}
+
+/// Looking straight down −z at (x, y).
+fn down_at(x: f32, y: f32) -> Ray {
+    Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z)
+}
+
+fn albedo_at(scene: &Scene, x: f32, y: f32) -> f32 {
+    let hit = scene.accel.intersect(&down_at(x, y)).expect("the quad");
+    match scene.material_at(&hit) {
+        Material::Diffuse { albedo, .. } => {
+            assert!(albedo.x == albedo.y && albedo.y == albedo.z, "{albedo}");
+            albedo.x
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// sRGB decoding, the image's top row at v = 0, bilinear filtering between
+/// texel centres, REPEAT against CLAMP_TO_EDGE.
+#[test]
+fn a_checker_texture_is_looked_up_where_the_ray_hits() {
+    let scene = checker_scene("checker-lookup");
+    assert!(scene.notes.iter().all(|n| !n.contains("textur")), "{:?}", scene.notes);
+    let texel = GREYS.map(|g| srgb_to_linear(g as f32 / 255.0));
+    let close = |a: f32, b: f32| (a - b).abs() < 1e-5;
+    // Texel centres: (u, v) = (¼ or ¾, ¼ or ¾) is world (u, 1 − v).
+    for (x, y, t) in [(0.25, 0.75, 0), (0.75, 0.75, 1), (0.25, 0.25, 2), (0.75, 0.25, 3)] {
+        let a = albedo_at(&scene, x, y);
+        assert!(close(a, texel[t]), "({x}, {y}): {a} vs texel {t} = {}", texel[t]);
+    }
+    assert!((texel[2] - 0.2158).abs() < 1e-3, "sRGB 128 is linear 0.216");
+    // Halfway between the two top texel centres, and in the middle of all four.
+    assert!(close(albedo_at(&scene, 0.5, 0.75), (texel[0] + texel[1]) / 2.0));
+    assert!(close(albedo_at(&scene, 0.5, 0.5), texel.iter().sum::<f32>() / 4.0));
+    // At u = 0 REPEAT blends with the texel across the edge (the right column).
+    assert!(close(albedo_at(&scene, 0.001, 0.75), (texel[0] + texel[1]) / 2.0 + 0.002 * (texel[0] - texel[1])));
+    // Second quad, u = 2·s: at s = 0.625 (u = 1.25) REPEAT would show texel
+    // 0 again; CLAMP_TO_EDGE shows the last column (texel 1).
+    assert!(close(albedo_at(&scene, 2.625, 0.875), texel[1]));
+    assert!(close(albedo_at(&scene, 2.125, 0.875), texel[0]));
+    assert!(close(albedo_at(&scene, 2.875, 0.125), texel[3]));
+}
+
+/// Under the white sky (radiance 1) a Lambertian point shows its albedo:
+/// the texel, in the path tracer and in photon-cpu.
+#[test]
+fn a_checker_texture_shows_in_the_renderers() {
+    let scene = checker_scene("checker-render");
+    let texel = GREYS.map(|g| srgb_to_linear(g as f32 / 255.0));
+    let settings = PathSettings { spp: 1, ..Default::default() };
+    let traced = trace_photons(&scene, &TraceSettings { photons: 2_000, ..Default::default() }, &Silent);
+    let photon_settings = PhotonCpuSettings { area_light_samples: 64, ..Default::default() };
+    let renderer = PhotonCpuRenderer::new(&scene, &traced, &photon_settings);
+    let mut rng = Rng::for_item(7, 0);
+    for (x, y, t) in [(0.25, 0.75, 0), (0.75, 0.75, 1), (0.25, 0.25, 2), (2.625, 0.875, 1)] {
+        let n = 4_000;
+        let path: f32 =
+            (0..n).map(|_| path_radiance(&scene, down_at(x, y), &settings, &mut rng).x).sum::<f32>() / n as f32;
+        let photon: f32 = (0..200).map(|_| renderer.radiance(&down_at(x, y), 0, &mut rng).x).sum::<f32>() / 200.0;
+        eprintln!("({x}, {y}): texel {}, path {path}, photon-cpu {photon}", texel[t]);
+        for (name, l) in [("path", path), ("photon-cpu", photon)] {
+            assert!((l - texel[t]).abs() < 0.03 * texel[t] + 1e-6, "{name} at ({x}, {y}): {l} vs {}", texel[t]);
+        }
+    }
+}
+
+/// B is metallic and G roughness, each times its factor; R is ignored.
+#[test]
+fn metallic_roughness_texture_channels_reach_the_brdf() {
+    let mut b = GltfBuilder::new();
+    let image = b.image(&png(1, 1, &[255, 128, 51, 255]), "image/png");
+    let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    let m = b.material(&PbrMaterial {
+        metallic: 1.0,
+        roughness: 0.5,
+        base_color: Vec3::splat(0.8),
+        metallic_roughness_texture: Some(t),
+        ..Default::default()
+    });
+    let node = quad(&mut b, Vec3::new(0.0, 1.0, 0.0), Vec3::X, -Vec3::Y, 1.0, m);
+    let scene = load("mr", &b.to_glb(vec![node]));
+    let hit = scene.accel.intersect(&down_at(0.5, 0.5)).unwrap();
+    let Material::Pbr(bsdf) = scene.material_at(&hit) else { panic!("{:?}", scene.material_at(&hit)) };
+    assert!((bsdf.metallic - 0.2).abs() < 1e-6, "metallic 1 × B (51/255): {}", bsdf.metallic);
+    assert!((bsdf.roughness - 0.5 * 128.0 / 255.0).abs() < 1e-6, "roughness 0.5 × G (linear): {}", bsdf.roughness);
+    assert_eq!(bsdf.base_color, Vec3::splat(0.8));
+    // The factors alone, as the GPU renderer uploads them.
+    let Material::Pbr(factors) = *scene.material(&hit) else { panic!() };
+    assert_eq!((factors.metallic, factors.roughness), (1.0, 0.5));
+}
+
+/// A black cut-out quad at y = 1 over a white floor, lit by a sun straight
+/// down (E = 2 W/m²), alpha a 2×2 checker (REPEAT, cutoff 0.5): the floor
+/// is lit and seen from above exactly where alpha < 0.5, half of the quad.
+fn mask_scene() -> Scene {
+    let mut b = GltfBuilder::new();
+    let floor = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() });
+    let floor = quad(&mut b, Vec3::new(-2.0, 0.0, -2.0), 4.0 * Vec3::X, 4.0 * Vec3::Z, 1.0, floor);
+    let image = b.image(&grey_checker([255, 0, 0, 255]), "image/png");
+    let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    let cutout = b.material(&PbrMaterial {
+        base_color: Vec3::ZERO,
+        specular: 0.0,
+        alpha_cutoff: Some(0.5),
+        base_color_texture: Some(t),
+        ..Default::default()
+    });
+    let cutout = quad(&mut b, Vec3::new(-0.5, 1.0, -0.5), Vec3::X, Vec3::Z, 1.0, cutout);
+    use json::extensions::scene::khr_lights_punctual::Type;
+    let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+    let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(-Vec3::Y, Vec3::Z)));
+    load("mask", &b.to_glb(vec![floor, cutout, sun]))
+}
+
+#[test]
+fn a_cutout_lets_light_through_where_alpha_is_below_the_cutoff() {
+    let scene = mask_scene();
+    assert!(scene.notes.iter().all(|n| !n.contains("opaque")), "{:?}", scene.notes);
+    let lit = 0.5 / PI * 2.0;
+    let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, ..Default::default() }, &Silent);
+    let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings { spp: 1, ..Default::default() });
+    let settings = PathSettings { spp: 1, ..Default::default() };
+    let mut rng = Rng::for_item(3, 0);
+    let look = |x: f32, z: f32| Ray::new(Vec3::new(x, 2.0, z), -Vec3::Y);
+    // Texel centres: opaque (alpha 1) at (u, v) = (¼, ¼) and (¾, ¾), open at the others.
+    for (u, v, open) in [(0.25, 0.25, false), (0.75, 0.25, true), (0.25, 0.75, true), (0.75, 0.75, false)] {
+        let (x, z) = (u - 0.5, v - 0.5);
+        let expected = if open { lit } else { 0.0 };
+        let path = path_radiance(&scene, look(x, z), &settings, &mut rng).x;
+        let photon = renderer.radiance(&look(x, z), 0, &mut rng).x;
+        assert!((path - expected).abs() < 1e-5 && (photon - expected).abs() < 1e-5, "({u}, {v}): {path} {photon}");
+        // Shadow rays alone: from the floor up to the sun.
+        let up = Ray::new(Vec3::new(x, 0.0, z), Vec3::Y);
+        assert_eq!(scene.accel.occluded(&up), !open, "({u}, {v})");
+    }
+    // Over a grid of the quad the lit fraction is exactly ½ (bilinear alpha
+    // below ½ on half of it, by the checker's symmetry).
+    let n = 32;
+    let (mut path_sum, mut photon_sum) = (0.0, 0.0);
+    for i in 0..n * n {
+        let (x, z) = (((i % n) as f32 + 0.5) / n as f32 - 0.5, ((i / n) as f32 + 0.5) / n as f32 - 0.5);
+        path_sum += path_radiance(&scene, look(x, z), &settings, &mut rng).x;
+        photon_sum += renderer.radiance(&look(x, z), 0, &mut rng).x;
+    }
+    let (path, photon) = (path_sum / (n * n) as f32 / lit, photon_sum / (n * n) as f32 / lit);
+    assert!((path - 0.5).abs() < 1e-4 && (photon - 0.5).abs() < 1e-4, "lit fraction: path {path}, photon-cpu {photon}");
+    // Photons: the density on the floor under the quad is half that beside it.
+    let (mut under, mut beside) = (0usize, 0usize);
+    for p in &traced.global {
+        let [x, y, z] = p.position;
+        if y.abs() > 1e-3 {
+            continue;
+        }
+        let r = x.abs().max(z.abs());
+        if r < 0.5 {
+            under += 1;
+        } else if r < 1.5 {
+            beside += 1; // 8 times the area
+        }
+    }
+    let ratio = under as f32 * 8.0 / beside as f32;
+    eprintln!("photons under the cut-out {under}, beside {beside}: density ratio {ratio}");
+    assert!((ratio - 0.5).abs() < 0.05, "{ratio}");
+}
+
+/// A texture that reads an image file that is not there, or bytes that
+/// are no PNG, is an error naming `images[0]`.
+#[test]
+fn missing_and_corrupt_images_are_located_errors() {
+    let mut b = GltfBuilder::new();
+    let image = b.image(b"not a png at all", "image/png");
+    let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    let m = b.material(&PbrMaterial { base_color_texture: Some(t), ..Default::default() });
+    let node = quad(&mut b, Vec3::ZERO, Vec3::X, Vec3::Y, 1.0, m);
+    let (root, bin) = b.finish(vec![node]);
+    let dir = folder("broken-images");
+    let load_err = |name: &str, bytes: &[u8]| {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let e = Scene::load(path.to_str().unwrap()).err().expect("an error").to_string();
+        assert!(e.starts_with(&path.display().to_string()), "{e}");
+        e
+    };
+    let e = load_err("corrupt.glb", &glb(&root, bin.clone()));
+    for w in ["images[0]", "materials[0].pbrMetallicRoughness.baseColorTexture", "bufferViews["] {
+        assert!(e.contains(w), "`{e}` does not say `{w}`");
+    }
+    let mut r = root.clone();
+    r.images[0].buffer_view = None;
+    r.images[0].uri = Some("missing.png".into());
+    let e = load_err("missing.glb", &glb(&r, bin));
+    for w in ["images[0]", "missing.png"] {
+        assert!(e.contains(w), "`{e}` does not say `{w}`");
+    }
+}
+
+/// An emissive texture: the eye sees the texel × factor; the light (its
+/// power, photons and light sampling) emits the texture's mean.
+#[test]
+fn an_emissive_texture_varies_the_radiance_seen() {
+    let mut b = GltfBuilder::new();
+    let image = b.image(&grey_checker([255; 4]), "image/png");
+    let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    let m = b.material(&PbrMaterial { emission: Vec3::splat(4.0), emissive_texture: Some(t), ..Default::default() });
+    let node = quad(&mut b, Vec3::new(0.0, 1.0, 0.0), Vec3::X, -Vec3::Y, 1.0, m);
+    let scene = load("emissive", &b.to_glb(vec![node]));
+    let texel = GREYS.map(|g| srgb_to_linear(g as f32 / 255.0));
+    let mean = texel.iter().sum::<f32>() / 4.0;
+    assert!(matches!(scene.lights[0], Light::Mesh(_)), "{:?}", scene.lights);
+    assert!((scene.lights[0].emission().x - 4.0 * mean).abs() < 1e-5, "{:?}", scene.lights[0].emission());
+    for (x, y, t) in [(0.25, 0.75, 0), (0.75, 0.75, 1), (0.25, 0.25, 2), (0.75, 0.25, 3)] {
+        let hit = scene.accel.intersect(&down_at(x, y)).unwrap();
+        let le = scene.emitted_radiance(&hit, -Vec3::Z).unwrap();
+        assert!((le - Vec3::splat(4.0 * texel[t])).abs().max_element() < 1e-4, "({x}, {y}): {le}");
+    }
+}

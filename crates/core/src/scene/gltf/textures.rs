@@ -1,0 +1,134 @@
+//! glTF images and samplers as [`crate::texture`] images: each image a
+//! material reads is decoded once per colour space it is read in (sRGB for
+//! base colour and emission, linear for metallic–roughness), from the
+//! `.glb`'s buffer views, data URIs or files beside the `.gltf`.
+
+use super::error;
+use crate::scene::SceneError;
+use crate::texture::{ColorSpace, Image, Sampler, TextureRef, Wrap};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The decoded images, by (glTF image index, colour space).
+#[derive(Default)]
+pub struct Images {
+    pub images: Vec<Image>,
+    index: HashMap<(usize, ColorSpace), u32>,
+}
+
+impl Images {
+    /// The texture `info` reads in `space`; None if it reads a texture
+    /// coordinate set other than 0 (the caller notes it) or has no image.
+    pub fn texture(&self, info: &gltf::texture::Info, space: ColorSpace) -> Option<TextureRef> {
+        if info.tex_coord() != 0 {
+            return None;
+        }
+        let texture = info.texture();
+        let image = *self.index.get(&(texture.source().index(), space))?;
+        let wrap = |w: gltf::texture::WrappingMode| match w {
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        };
+        let sampler = texture.sampler();
+        Some(TextureRef { image, sampler: Sampler { wrap_s: wrap(sampler.wrap_s()), wrap_t: wrap(sampler.wrap_t()) } })
+    }
+}
+
+/// The textures each material reads, with the glTF path that reads them.
+fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::texture::Info<'a>, ColorSpace)> {
+    let mut used = Vec::new();
+    for m in doc.materials() {
+        let at = format!("materials[{}]", m.index().unwrap_or(0));
+        let pbr = m.pbr_metallic_roughness();
+        let mut push = |name: &str, info: Option<gltf::texture::Info<'a>>, space| {
+            if let Some(info) = info.filter(|i| i.tex_coord() == 0) {
+                used.push((format!("{at}.{name}"), info, space));
+            }
+        };
+        push("pbrMetallicRoughness.baseColorTexture", pbr.base_color_texture(), ColorSpace::Srgb);
+        push("pbrMetallicRoughness.metallicRoughnessTexture", pbr.metallic_roughness_texture(), ColorSpace::Linear);
+        push("emissiveTexture", m.emissive_texture(), ColorSpace::Srgb);
+    }
+    used
+}
+
+/// Decodes every image a material reads (PNG or JPEG); a missing or
+/// undecodable one is an error at `images[i]`.
+pub fn load(
+    doc: &gltf::Document,
+    buffers: &[gltf::buffer::Data],
+    base: Option<&Path>,
+    file: &str,
+) -> Result<Images, SceneError> {
+    let mut out = Images::default();
+    for (used_at, info, space) in used_textures(doc) {
+        let image = info.texture().source();
+        let key = (image.index(), space);
+        if out.index.contains_key(&key) {
+            continue;
+        }
+        let at = format!("images[{}] (read by {used_at})", image.index());
+        let decoded = decode(doc, &image, buffers, base).map_err(|m| error(file, &at, m))?;
+        let texels =
+            to_image(&decoded, space).ok_or_else(|| error(file, &at, "has a pixel format hikari cannot read"))?;
+        out.index.insert(key, out.images.len() as u32);
+        out.images.push(texels);
+    }
+    Ok(out)
+}
+
+/// One image's pixels, after checking what the `gltf` crate would panic on.
+fn decode(
+    doc: &gltf::Document,
+    image: &gltf::image::Image,
+    buffers: &[gltf::buffer::Data],
+    base: Option<&Path>,
+) -> Result<gltf::image::Data, String> {
+    let json = &doc.as_json().images[image.index()];
+    let (what, base) = match (&json.buffer_view, &json.uri) {
+        (Some(view), _) => {
+            if json.mime_type.is_none() {
+                return Err("is stored in a buffer view but has no mimeType".into());
+            }
+            let view = doc.views().nth(view.value()).ok_or("refers to a buffer view that does not exist")?;
+            let length = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+            if view.offset().checked_add(view.length()).is_none_or(|end| end > length) {
+                return Err(format!("reads bufferViews[{}], beyond its buffer's {length} bytes", view.index()));
+            }
+            (format!("the image in bufferViews[{}]", view.index()), base)
+        }
+        // The crate reads data URIs only when given a folder, which they do not use.
+        (None, Some(uri)) if uri.starts_with("data:") => ("its data URI".to_string(), Some(Path::new("."))),
+        (None, Some(uri)) => {
+            if base.is_none() {
+                return Err(format!("refers to file \"{uri}\", but the glTF was not read from a folder"));
+            }
+            (format!("\"{uri}\""), base)
+        }
+        (None, None) => return Err("has neither a uri nor a bufferView".into()),
+    };
+    gltf::image::Data::from_source(image.source(), base, buffers).map_err(|e| format!("cannot read {what}: {e}"))
+}
+
+/// The `gltf` crate's pixels as a linear image.
+fn to_image(data: &gltf::image::Data, space: ColorSpace) -> Option<Image> {
+    use gltf::image::Format;
+    let (w, h, p) = (data.width, data.height, &data.pixels);
+    let eight = |channels| Image::from_integers(w, h, channels, p.iter().map(|&b| b as u32), 255, space);
+    let sixteen = |channels| {
+        let values = p.chunks_exact(2).map(|b| u16::from_ne_bytes([b[0], b[1]]) as u32);
+        Image::from_integers(w, h, channels, values, 65535, space)
+    };
+    match data.format {
+        Format::R8 => eight(1),
+        Format::R8G8 => eight(2),
+        Format::R8G8B8 => eight(3),
+        Format::R8G8B8A8 => eight(4),
+        Format::R16 => sixteen(1),
+        Format::R16G16 => sixteen(2),
+        Format::R16G16B16 => sixteen(3),
+        Format::R16G16B16A16 => sixteen(4),
+        Format::R32G32B32FLOAT | Format::R32G32B32A32FLOAT => None,
+    }
+}

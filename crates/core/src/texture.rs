@@ -1,0 +1,399 @@
+//! Textures on triangle meshes: images decoded once to linear RGBA, the
+//! per-triangle texture coordinates of the primitives that have them, and
+//! what each material takes from its textures.
+//!
+//! Lookups happen once per surface interaction ([`Texturing::apply`],
+//! called by `Scene::material_at`, pbrt's `MaterialEvalContext`), and in
+//! the BVH's alpha test of `alphaMode` MASK cut-outs
+//! ([`Texturing::opaque_at`]).
+//!
+//! # Memory
+//!
+//! A texel is four f32 (16 bytes; an 8-bit RGBA file is 4). Texture
+//! coordinates cost 24 bytes per triangle of a textured primitive and
+//! nothing elsewhere: [`TexCoords`] holds runs of consecutive primitive
+//! indices, found by a binary search over the runs.
+//!
+//! # Filtering
+//!
+//! Bilinear between texel centres, without mipmaps: the CPU renderers take
+//! many samples per pixel, which average a minified texture instead of a
+//! mip level.
+
+use crate::material::{Material, Rgb};
+use glam::{Vec2, Vec4, Vec4Swizzles};
+
+/// How texture coordinates outside [0, 1] wrap (glTF's `wrapS`, `wrapT`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    ClampToEdge,
+    MirroredRepeat,
+}
+
+impl Wrap {
+    /// A texture coordinate brought into a bounded range that wraps the
+    /// same (a period of 2 serves repeat and mirrored repeat; clamping
+    /// needs only [−1, 2]), so that huge coordinates cannot overflow the
+    /// texel arithmetic.
+    fn bounded(self, u: f32) -> f32 {
+        match self {
+            Wrap::ClampToEdge => u.clamp(-1.0, 2.0),
+            Wrap::Repeat | Wrap::MirroredRepeat => u.rem_euclid(2.0),
+        }
+    }
+
+    /// Texel index `i` of a row or column of `n` texels, wrapped.
+    fn texel(self, i: i64, n: i64) -> usize {
+        (match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::ClampToEdge => i.clamp(0, n - 1),
+            Wrap::MirroredRepeat => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+        }) as usize
+    }
+}
+
+/// Wrapping in u (s) and v (t).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Sampler {
+    pub wrap_s: Wrap,
+    pub wrap_t: Wrap,
+}
+
+/// How an 8- or 16-bit file's values are turned into linear values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorSpace {
+    /// sRGB-encoded colour (base colour, emissive); alpha stays linear.
+    Srgb,
+    /// Data (metallic–roughness, normals, occlusion).
+    Linear,
+}
+
+/// The sRGB transfer function's inverse: an encoded value in [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// An image in linear RGBA, row 0 at the top (glTF's texture coordinate
+/// (0, 0) is the top-left corner of the image, (1, 1) the bottom-right).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    width: u32,
+    height: u32,
+    texels: Vec<Vec4>,
+}
+
+impl Image {
+    /// `texels` row by row from the top; None if the count does not match
+    /// or the image is empty.
+    pub fn new(width: u32, height: u32, texels: Vec<Vec4>) -> Option<Image> {
+        (width > 0 && height > 0 && texels.len() == width as usize * height as usize).then_some(Image {
+            width,
+            height,
+            texels,
+        })
+    }
+
+    /// Decodes `channels` (1: grey, 2: grey + alpha, 3: RGB, 4: RGBA)
+    /// values per texel, each `max`-scaled (255 or 65535), from `space`.
+    pub fn from_integers(
+        width: u32,
+        height: u32,
+        channels: usize,
+        values: impl Iterator<Item = u32>,
+        max: u32,
+        space: ColorSpace,
+    ) -> Option<Image> {
+        let scale = 1.0 / max as f32;
+        let colour = |v: u32| match space {
+            ColorSpace::Srgb => srgb_to_linear(v as f32 * scale),
+            ColorSpace::Linear => v as f32 * scale,
+        };
+        let values: Vec<u32> = values.collect();
+        let texels = values
+            .chunks_exact(channels)
+            .map(|t| match *t {
+                [g] => Vec4::new(colour(g), colour(g), colour(g), 1.0),
+                [g, a] => Vec4::new(colour(g), colour(g), colour(g), a as f32 * scale),
+                [r, g, b] => Vec4::new(colour(r), colour(g), colour(b), 1.0),
+                [r, g, b, a, ..] => Vec4::new(colour(r), colour(g), colour(b), a as f32 * scale),
+                [] => Vec4::ZERO,
+            })
+            .collect();
+        Image::new(width, height, texels)
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn texel(&self, x: usize, y: usize) -> Vec4 {
+        self.texels[y * self.width as usize + x]
+    }
+
+    /// The value at texture coordinate `uv`: bilinear between the four
+    /// nearest texel centres (texel (i, j) has its centre at
+    /// ((i + ½)/width, (j + ½)/height)), wrapped by `sampler`.
+    pub fn sample(&self, uv: Vec2, sampler: Sampler) -> Vec4 {
+        let (w, h) = (self.width as i64, self.height as i64);
+        let uv = if uv.is_finite() { uv } else { Vec2::ZERO };
+        let uv = Vec2::new(sampler.wrap_s.bounded(uv.x), sampler.wrap_t.bounded(uv.y));
+        let x = uv.x * w as f32 - 0.5;
+        let y = uv.y * h as f32 - 0.5;
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let xs = [sampler.wrap_s.texel(x0, w), sampler.wrap_s.texel(x0 + 1, w)];
+        let ys = [sampler.wrap_t.texel(y0, h), sampler.wrap_t.texel(y0 + 1, h)];
+        let row = |y: usize| self.texel(xs[0], y).lerp(self.texel(xs[1], y), fx);
+        row(ys[0]).lerp(row(ys[1]), fy)
+    }
+
+    /// The mean over all texels.
+    pub fn mean(&self) -> Vec4 {
+        let sum: glam::DVec4 = self.texels.iter().map(|t| t.as_dvec4()).sum();
+        (sum / self.texels.len() as f64).as_vec4()
+    }
+}
+
+/// A texture: an image of [`Texturing::images`] read through a sampler.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    pub image: u32,
+    pub sampler: Sampler,
+}
+
+/// What a material takes from textures (glTF's metallic–roughness model);
+/// each texture multiplies its factor, which the material already holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MaterialTextures {
+    /// sRGB RGB × base colour, alpha × `alpha_factor`.
+    pub base_color: Option<TextureRef>,
+    /// Linear: B × metallic, G × roughness.
+    pub metallic_roughness: Option<TextureRef>,
+    /// sRGB RGB × the emitted radiance.
+    pub emissive: Option<TextureRef>,
+    /// The mean of the emissive texture's RGB, by which the emitter's
+    /// radiance (`EmissiveMesh`: uniform over the mesh) was already scaled.
+    pub emissive_mean: Rgb,
+    /// `baseColorFactor`'s alpha.
+    pub alpha_factor: f32,
+    /// `alphaMode` MASK's `alphaCutoff`: below it the surface is not there.
+    /// None: opaque.
+    pub alpha_cutoff: Option<f32>,
+}
+
+impl MaterialTextures {
+    pub fn is_textured(&self) -> bool {
+        self.base_color.is_some() || self.metallic_roughness.is_some() || self.emissive.is_some()
+    }
+}
+
+/// A run of consecutive primitive indices with texture coordinates.
+#[derive(Clone, Copy, Debug)]
+struct Run {
+    first_prim: u32,
+    end_prim: u32,
+    first_uv: u32,
+}
+
+/// Per-triangle texture coordinates (of vertices 0, 1, 2), indexed by the
+/// BVH's primitive index, for the triangles that have them.
+#[derive(Clone, Debug, Default)]
+pub struct TexCoords {
+    runs: Vec<Run>,
+    uvs: Vec<[Vec2; 3]>,
+}
+
+impl TexCoords {
+    /// Adds the coordinates of primitives `first_prim..first_prim + uvs.len()`;
+    /// runs must be added in increasing primitive order.
+    pub fn push_run(&mut self, first_prim: u32, uvs: &[[Vec2; 3]]) {
+        if uvs.is_empty() {
+            return;
+        }
+        assert!(self.runs.last().is_none_or(|r| r.end_prim <= first_prim), "runs in increasing order");
+        let end_prim = first_prim + uvs.len() as u32;
+        let first_uv = self.uvs.len() as u32;
+        match self.runs.last_mut() {
+            Some(r) if r.end_prim == first_prim => r.end_prim = end_prim,
+            _ => self.runs.push(Run { first_prim, end_prim, first_uv }),
+        }
+        self.uvs.extend_from_slice(uvs);
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.uvs.is_empty()
+    }
+
+    pub fn triangle(&self, prim: u32) -> Option<&[Vec2; 3]> {
+        let i = self.runs.partition_point(|r| r.end_prim <= prim);
+        let run = self.runs.get(i).filter(|r| r.first_prim <= prim)?;
+        self.uvs.get((run.first_uv + prim - run.first_prim) as usize)
+    }
+
+    /// The coordinates at barycentrics `b` (weights of vertices 1 and 2).
+    pub fn at(&self, prim: u32, b: Vec2) -> Option<Vec2> {
+        let [a, c1, c2] = *self.triangle(prim)?;
+        Some(a * (1.0 - b.x - b.y) + c1 * b.x + c2 * b.y)
+    }
+}
+
+/// Everything a scene's textures need: the images, the texture
+/// coordinates, and per material what it takes from them.
+#[derive(Clone, Debug, Default)]
+pub struct Texturing {
+    pub images: Vec<Image>,
+    /// Parallel to `Scene::materials`: None for untextured opaque ones.
+    pub materials: Vec<Option<MaterialTextures>>,
+    pub uvs: TexCoords,
+    /// Each surface's material (the BVH's alpha test knows surfaces only).
+    pub surface_materials: Vec<u32>,
+}
+
+impl Texturing {
+    fn textures(&self, material: u32) -> Option<&MaterialTextures> {
+        self.materials.get(material as usize)?.as_ref()
+    }
+
+    fn lookup(&self, texture: Option<TextureRef>, uv: Option<Vec2>) -> Option<Vec4> {
+        let (texture, uv) = (texture?, uv?);
+        Some(self.images[texture.image as usize].sample(uv, texture.sampler))
+    }
+
+    /// Is any material a MASK cut-out (so the BVH must test alpha)?
+    pub fn has_masks(&self) -> bool {
+        self.materials.iter().flatten().any(|m| m.alpha_cutoff.is_some())
+    }
+
+    /// Is `surface` a MASK cut-out?
+    pub fn is_masked(&self, surface: u32) -> bool {
+        let m = self.surface_materials.get(surface as usize);
+        m.and_then(|&m| self.textures(m)).is_some_and(|t| t.alpha_cutoff.is_some())
+    }
+
+    /// Is the surface there at primitive `prim`, barycentrics `b`: alpha
+    /// (factor × base-colour texture) at least the cutoff, or not a MASK.
+    pub fn opaque_at(&self, surface: u32, prim: u32, b: Vec2) -> bool {
+        let Some(t) = self.surface_materials.get(surface as usize).and_then(|&m| self.textures(m)) else {
+            return true;
+        };
+        let Some(cutoff) = t.alpha_cutoff else { return true };
+        let texel = self.lookup(t.base_color, self.uvs.at(prim, b)).map_or(1.0, |c| c.w);
+        t.alpha_factor * texel >= cutoff
+    }
+
+    /// `material` (of index `index`) at primitive `prim`, barycentrics `b`,
+    /// with its textures applied. Textures without coordinates (a primitive
+    /// without `TEXCOORD_0`) leave the factors alone.
+    pub fn apply(&self, material: Material, index: u32, prim: u32, b: Vec2) -> Material {
+        let Some(t) = self.textures(index) else { return material };
+        let uv = self.uvs.at(prim, b);
+        let base = self.lookup(t.base_color, uv).map_or(Rgb::ONE, |c| c.xyz());
+        let mr = self.lookup(t.metallic_roughness, uv);
+        match material {
+            Material::Pbr(mut bsdf) => {
+                bsdf.base_color *= base;
+                if let Some(mr) = mr {
+                    bsdf.metallic = (bsdf.metallic * mr.z).clamp(0.0, 1.0);
+                    bsdf.roughness = (bsdf.roughness * mr.y).clamp(0.0, 1.0);
+                }
+                Material::Pbr(bsdf)
+            }
+            // An exactly Lambertian glTF material (metallic 0, no specular
+            // lobe: `Material::from_bsdf`); a metallic texture cannot change
+            // a zero metallic factor.
+            Material::Diffuse { albedo, specular } => Material::Diffuse { albedo: albedo * base, specular },
+            other => other,
+        }
+    }
+
+    /// Per channel, the emissive texture at the point over its mean (1
+    /// without an emissive texture): what scales the emitter's uniform
+    /// radiance to the radiance emitted at this point.
+    pub fn emission_scale(&self, material: u32, prim: u32, b: Vec2) -> Rgb {
+        let Some(t) = self.textures(material) else { return Rgb::ONE };
+        let Some(texel) = self.lookup(t.emissive, self.uvs.at(prim, b)) else { return Rgb::ONE };
+        let mean = t.emissive_mean;
+        Rgb::select(mean.cmpgt(Rgb::ZERO), texel.xyz() / mean.max(Rgb::splat(f32::MIN_POSITIVE)), Rgb::ZERO)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2×2 image: texel (x, y) = (x, y, 0, 1).
+    fn ramp() -> Image {
+        let t = (0..4).map(|i| Vec4::new((i % 2) as f32, (i / 2) as f32, 0.0, 1.0)).collect();
+        Image::new(2, 2, t).unwrap()
+    }
+
+    #[test]
+    fn bilinear_between_texel_centres() {
+        let img = ramp();
+        let s = Sampler::default();
+        // Texel centres show the texels.
+        assert_eq!(img.sample(Vec2::new(0.25, 0.25), s), Vec4::new(0.0, 0.0, 0.0, 1.0));
+        assert_eq!(img.sample(Vec2::new(0.75, 0.25), s), Vec4::new(1.0, 0.0, 0.0, 1.0));
+        assert_eq!(img.sample(Vec2::new(0.25, 0.75), s), Vec4::new(0.0, 1.0, 0.0, 1.0));
+        // Halfway between centres: the mean.
+        let mid = img.sample(Vec2::new(0.5, 0.375), s);
+        assert!((mid - Vec4::new(0.5, 0.25, 0.0, 1.0)).abs().max_element() < 1e-6, "{mid}");
+    }
+
+    #[test]
+    fn wrap_modes() {
+        let img = ramp();
+        let at = |u: f32, wrap: Wrap| img.sample(Vec2::new(u, 0.25), Sampler { wrap_s: wrap, wrap_t: wrap }).x;
+        // u = 0: halfway between texel 0 and the one to its left.
+        assert_eq!(at(0.0, Wrap::Repeat), 0.5); // texel 1 wraps around
+        assert_eq!(at(0.0, Wrap::ClampToEdge), 0.0);
+        assert_eq!(at(0.0, Wrap::MirroredRepeat), 0.0); // texel −1 mirrors to texel 0
+        // u = 1.25: texel centre 0 of the next repeat, texel 1 clamped, texel 1 mirrored.
+        assert_eq!(at(1.25, Wrap::Repeat), 0.0);
+        assert_eq!(at(1.25, Wrap::ClampToEdge), 1.0);
+        assert_eq!(at(1.25, Wrap::MirroredRepeat), 1.0);
+        assert_eq!(at(-0.75, Wrap::MirroredRepeat), 1.0);
+        assert_eq!(Wrap::MirroredRepeat.texel(-1, 3), 0);
+        assert_eq!(Wrap::MirroredRepeat.texel(3, 3), 2);
+        assert_eq!(Wrap::MirroredRepeat.texel(6, 3), 0);
+    }
+
+    #[test]
+    fn srgb_decoding() {
+        let img = Image::from_integers(1, 1, 4, [255, 188, 0, 128].into_iter(), 255, ColorSpace::Srgb).unwrap();
+        let t = img.texel(0, 0);
+        assert_eq!(t.x, 1.0);
+        assert!((t.y - 0.5029).abs() < 1e-3, "{t}"); // sRGB 188 is linear 0.503
+        assert_eq!(t.z, 0.0);
+        assert!((t.w - 128.0 / 255.0).abs() < 1e-6, "alpha stays linear");
+        let lin = Image::from_integers(1, 1, 1, [51].into_iter(), 255, ColorSpace::Linear).unwrap();
+        assert!((lin.texel(0, 0) - Vec4::new(0.2, 0.2, 0.2, 1.0)).abs().max_element() < 1e-6, "data stays linear");
+    }
+
+    #[test]
+    fn tex_coords_are_found_by_run() {
+        let mut uvs = TexCoords::default();
+        let tri = |x: f32| [Vec2::splat(x); 3];
+        uvs.push_run(3, &[tri(3.0), tri(4.0)]);
+        uvs.push_run(5, &[tri(5.0)]); // merges with the run before
+        uvs.push_run(10, &[tri(10.0)]);
+        assert_eq!(uvs.runs.len(), 2);
+        for p in 0..12 {
+            let expected = [3, 4, 5, 10].contains(&p).then(|| tri(p as f32));
+            assert_eq!(uvs.triangle(p).copied(), expected, "prim {p}");
+        }
+        let mut one = TexCoords::default();
+        one.push_run(0, &[[Vec2::ZERO, Vec2::X, Vec2::Y]]);
+        assert_eq!(one.at(0, Vec2::new(0.25, 0.5)), Some(Vec2::new(0.25, 0.5)));
+    }
+}

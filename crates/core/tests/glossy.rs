@@ -1,0 +1,186 @@
+//! Glossy photon mapping (the glTF metallic–roughness BRDF, `pbr`): the
+//! mean of progressive photon-cpu passes converges to the path tracer on a
+//! Cornell box of metals and dielectrics from roughness 0.1 to 1 — lobes
+//! followed by the eye (0.1, 0.2) and lobes gathered from the photon maps
+//! (0.5, 0.7, 1) — under each light type.
+
+use hikari_core::progress::Silent;
+use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, photon_cpu_pass};
+use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
+use hikari_core::render::{Image, path};
+use hikari_core::scene::Scene;
+
+/// The Cornell box with glossy walls and blocks, open at the front, lit by `light`.
+fn glossy_box(light: &str, size: u32) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 3.9]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 39.3
+resolution = [{size}, {size}]
+
+[[material]]
+name = "brushed gold"
+type = "pbr"
+base_color = [0.9, 0.75, 0.45]
+metallic = 1.0
+roughness = 0.2
+
+[[material]]
+name = "satin white"
+type = "pbr"
+base_color = [0.75, 0.74, 0.72]
+roughness = 0.5
+
+[[material]]
+name = "lacquered red"
+type = "pbr"
+base_color = [0.63, 0.07, 0.05]
+roughness = 0.1
+
+[[material]]
+name = "green"
+type = "pbr"
+base_color = [0.14, 0.45, 0.09]
+roughness = 1.0
+
+[[material]]
+name = "rough steel"
+type = "pbr"
+base_color = [0.6, 0.6, 0.62]
+metallic = 1.0
+roughness = 0.7
+
+[[object]]
+shape = "quad"
+corner = [-1.0, -1.0, -1.0]
+edge_u = [0.0, 0.0, 2.0]
+edge_v = [2.0, 0.0, 0.0]
+material = "brushed gold"
+
+[[object]]
+shape = "quad"
+corner = [-1.0, 1.0, -1.0]
+edge_u = [2.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, 2.0]
+material = "satin white"
+
+[[object]]
+shape = "quad"
+corner = [-1.0, -1.0, -1.0]
+edge_u = [2.0, 0.0, 0.0]
+edge_v = [0.0, 2.0, 0.0]
+material = "satin white"
+
+[[object]]
+shape = "quad"
+corner = [-1.0, -1.0, -1.0]
+edge_u = [0.0, 2.0, 0.0]
+edge_v = [0.0, 0.0, 2.0]
+material = "lacquered red"
+
+[[object]]
+shape = "quad"
+corner = [1.0, -1.0, -1.0]
+edge_u = [0.0, 0.0, 2.0]
+edge_v = [0.0, 2.0, 0.0]
+material = "green"
+
+[[object]]
+shape = "box"
+center = [0.33, -0.7, 0.3]
+size = [0.6, 0.6, 0.6]
+rotate_y = -17.0
+material = "rough steel"
+
+[[object]]
+shape = "box"
+center = [-0.33, -0.4, -0.3]
+size = [0.6, 1.2, 0.6]
+rotate_y = 17.0
+material = "satin white"
+
+{light}
+"#
+    );
+    Scene::from_toml(&text, &format!("glossy-box ({})", light.lines().nth(1).unwrap_or(light)), None)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+const POINT: &str = "[[light]]\ntype = \"point\"\nposition = [0.0, 0.9, 0.0]\nintensity = [2.5, 2.5, 2.5]";
+const SPOT: &str = "[[light]]\ntype = \"spot\"\nposition = [0.0, 0.95, 0.3]\ndirection = [0.2, -1.0, -0.3]\n\
+                    intensity = [6.0, 6.0, 6.0]\ncutoff_angle = 40.0\nfalloff_start_angle = 30.0";
+const QUAD: &str = "[[light]]\ntype = \"quad\"\ncorner = [-0.25, 0.999, -0.25]\nedge_u = [0.5, 0.0, 0.0]\n\
+                    edge_v = [0.0, 0.0, 0.5]\nradiance = [12.0, 12.0, 12.0]";
+const SUN: &str = "[[light]]\ntype = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\nirradiance = [3.0, 3.0, 3.0]";
+const SKY: &str = "[environment]\nradiance = [1.0, 1.0, 1.0]";
+
+/// The mean of passes 1..=n of `photons` paths each, at the default first radii.
+fn progressive(scene: &Scene, photons: u64, passes: u32) -> Image {
+    let settings = PhotonCpuSettings::default();
+    let (global, caustic) = settings.estimate_params(scene);
+    let schedules = Schedules::new([global.radius, caustic.radius, default_radius(scene)], DEFAULT_ALPHA);
+    let mut mean = ImageMean::new(scene.camera.width, scene.camera.height);
+    for pass in 1..=passes {
+        let (image, nonfinite) = photon_cpu_pass(scene, &settings, photons, &schedules, pass);
+        assert_eq!(nonfinite, 0);
+        mean.add(&image);
+    }
+    mean.mean()
+}
+
+fn converges(name: &str, light: &str) {
+    let scene = glossy_box(light, 32);
+    let reference_with = |seed| {
+        let (image, nonfinite) =
+            path::render(&scene, &path::PathSettings { spp: 2048, seed, ..Default::default() }, &Silent);
+        assert_eq!(nonfinite, 0);
+        image
+    };
+    let reference = reference_with(99);
+    let noise = compare(&reference_with(98), &reference).unwrap().relative_rmse;
+    eprintln!("{name}: two path references differ by {noise:.4}");
+    // Each reference carries noise of relative RMSE noise/√2: taken out of
+    // each error in quadrature, what is left is photon-cpu's own error.
+    let reference_variance = noise * noise / 2.0;
+    let errors: Vec<(f64, f64)> = [1u32, 4, 16]
+        .iter()
+        .map(|&n| {
+            let e = compare(&progressive(&scene, 20_000, n), &reference).unwrap();
+            ((e.relative_rmse.powi(2) - reference_variance).max(0.0).sqrt(), e.mean_ratio)
+        })
+        .collect();
+    eprintln!("{name}: (own relative RMSE, mean ratio) after 1, 4, 16 passes: {errors:?}");
+    let ((first, _), (last, ratio)) = (errors[0], errors[2]);
+    // Unbiased in the mean, and converging: the error after 16 passes is
+    // well under the first pass's (noise alone would fall to 1/4).
+    assert!((ratio - 1.0).abs() < 0.03, "{name}: mean ratio {ratio} after 16 passes");
+    assert!(last < 0.6 * first, "{name}: {errors:?}");
+    assert!(last < 0.15, "{name}: relative RMSE {last} after 16 passes");
+}
+
+#[test]
+fn glossy_box_under_a_point_light() {
+    converges("point", POINT);
+}
+
+#[test]
+fn glossy_box_under_a_spot_light() {
+    converges("spot", SPOT);
+}
+
+#[test]
+fn glossy_box_under_a_quad_light() {
+    converges("quad", QUAD);
+}
+
+#[test]
+fn glossy_box_under_a_sun() {
+    converges("sun", SUN);
+}
+
+#[test]
+fn glossy_box_under_a_sky() {
+    converges("sky", SKY);
+}
