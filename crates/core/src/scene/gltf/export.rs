@@ -69,15 +69,8 @@ impl GltfBuilder {
         Self::default()
     }
 
-    /// Appends `data` to the binary buffer as a view and returns an accessor over it.
-    fn accessor(
-        &mut self,
-        data: &[u8],
-        count: usize,
-        ty: json::accessor::Type,
-        component: json::accessor::ComponentType,
-        bounds: Option<(Vec3, Vec3)>,
-    ) -> Index<json::Accessor> {
+    /// Appends `data` to the binary buffer (4-byte aligned) as a buffer view.
+    fn view(&mut self, data: &[u8]) -> Index<json::buffer::View> {
         while self.bin.len() % 4 != 0 {
             self.bin.push(0);
         }
@@ -92,6 +85,19 @@ impl GltfBuilder {
             extras: Default::default(),
         });
         self.bin.extend_from_slice(data);
+        view
+    }
+
+    /// Appends `data` to the binary buffer as a view and returns an accessor over it.
+    fn accessor(
+        &mut self,
+        data: &[u8],
+        count: usize,
+        ty: json::accessor::Type,
+        component: json::accessor::ComponentType,
+        bounds: Option<(Vec3, Vec3)>,
+    ) -> Index<json::Accessor> {
+        let view = self.view(data);
         let (min, max) = match bounds {
             Some((lo, hi)) => (
                 Some(json::serialize::to_value(lo.to_array()).unwrap()),
@@ -118,20 +124,7 @@ impl GltfBuilder {
     /// Appends `bytes` (a PNG or JPEG file of MIME type `mime`) to the
     /// binary buffer as an image.
     pub fn image(&mut self, bytes: &[u8], mime: &str) -> Index<json::Image> {
-        while self.bin.len() % 4 != 0 {
-            self.bin.push(0);
-        }
-        let view = self.root.push(json::buffer::View {
-            buffer: Index::new(0),
-            byte_length: USize64::from(bytes.len()),
-            byte_offset: Some(USize64::from(self.bin.len())),
-            byte_stride: None,
-            name: None,
-            target: None,
-            extensions: None,
-            extras: Default::default(),
-        });
-        self.bin.extend_from_slice(bytes);
+        let view = self.view(bytes);
         self.root.push(json::Image {
             buffer_view: Some(view),
             mime_type: Some(json::image::MimeType(mime.into())),
