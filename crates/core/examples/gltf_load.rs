@@ -1,9 +1,10 @@
 //! Loading a large glTF file: `cargo run --release -p hikari-core --example
-//! gltf_load -- [triangles] [photons]`. Writes a wavy grid of about that many
+//! gltf_load -- [triangles] [photons] [KEEP.glb]`. Writes a wavy grid of about that many
 //! triangles (default 1,000,000) under a point light as a `.glb`, then
 //! times `Scene::load` (parse, accessors, transforms, BVH build), reports
 //! the resident memory it added per triangle, and the photon-tracing rate
-//! on it beside cornell-box's.
+//! on it beside cornell-box's. With KEEP.glb the grid is written there and
+//! kept (to try it in `hikari render` and `hikari view`).
 
 use glam::Vec3;
 use gltf::json;
@@ -52,13 +53,16 @@ fn main() {
         }
     }
     let mut builder = GltfBuilder::new();
-    let material = builder.material(&PbrMaterial { base_color: Vec3::splat(0.7), ..Default::default() });
+    // Lambertian (no specular lobe), so the GPU renderer draws it exactly.
+    let material = builder.material(&PbrMaterial { base_color: Vec3::splat(0.7), specular: 0.0, ..Default::default() });
     let mesh = builder.mesh(&positions, None, Some(&indices), Some(material));
     let grid = builder.node(json::Node { mesh: Some(mesh), ..Default::default() });
     let light = builder.light(Type::Point, Vec3::ONE, 2000.0, None);
     let light = builder.node(GltfBuilder::light_node(light, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY));
     let glb = builder.to_glb(vec![grid, light]);
-    let path = std::env::temp_dir().join(format!("hikari-grid-{}.glb", std::process::id()));
+    let keep = args.get(3).map(std::path::PathBuf::from);
+    let path =
+        keep.clone().unwrap_or_else(|| std::env::temp_dir().join(format!("hikari-grid-{}.glb", std::process::id())));
     std::fs::write(&path, &glb).expect("write the grid");
     drop(glb);
 
@@ -73,7 +77,9 @@ fn main() {
         std::fs::metadata(&path).map_or(0.0, |m| m.len() as f64 / 1e6),
         added as f64 / count as f64
     );
-    let _ = std::fs::remove_file(&path);
+    if keep.is_none() {
+        let _ = std::fs::remove_file(&path);
+    }
     let cornell = Scene::load("cornell-box").unwrap();
     let (big, small) = (rate(&scene, photons), rate(&cornell, photons));
     println!(

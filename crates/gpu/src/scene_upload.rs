@@ -140,8 +140,12 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
 /// opaque. `hikari render` then renders with photon-cpu; the viewer draws
 /// the approximation and says so.
 pub fn approximated_materials(scene: &Scene) -> Option<String> {
-    let glossy = scene.materials.iter().filter(|m| matches!(m, Material::Pbr(b) if b.has_specular())).count();
-    let textures = scene.texturing.as_ref().map(|t| t.materials.iter().flatten());
+    // Only the materials some surface uses (a glTF file's default material
+    // is always there, used or not).
+    let used: std::collections::BTreeSet<usize> = scene.surfaces.iter().map(|s| s.material as usize).collect();
+    let glossy = used.iter().filter(|&&m| matches!(scene.materials[m], Material::Pbr(b) if b.has_specular())).count();
+    let textures =
+        scene.texturing.as_ref().map(|t| used.iter().filter_map(move |&m| t.materials.get(m).and_then(Option::as_ref)));
     let textured = textures.clone().map_or(0, |t| t.filter(|m| m.is_textured()).count());
     let masked = textures.map_or(0, |t| t.filter(|m| m.alpha_cutoff.is_some()).count());
     let mut why = Vec::new();

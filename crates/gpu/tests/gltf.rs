@@ -56,3 +56,20 @@ fn the_showcase_renders_on_the_gpu() {
     eprintln!("showcase: mean radiance {mean:.4}");
     assert!(mean > 0.01, "a dark showcase: {mean}");
 }
+
+/// Only materials that surfaces use count: a glTF file always carries the
+/// specification's default material (glossy white metal), used or not.
+#[test]
+fn lambertian_gltf_files_are_drawn_exactly_and_glossy_ones_say_why_not() {
+    use hikari_gpu::scene_upload::approximated_materials;
+    let toml = Scene::load("cornell-box").unwrap();
+    let dir = std::env::temp_dir().join(format!("hikari-gpu-gltf-exact-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("cornell-box.glb");
+    std::fs::write(&path, scene_to_glb(&toml).unwrap()).unwrap();
+    let lambertian = Scene::load(path.to_str().unwrap()).unwrap();
+    assert_eq!(approximated_materials(&lambertian), None);
+    let showcase = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb")).unwrap();
+    let why = approximated_materials(&showcase).expect("the showcase has glossy materials");
+    assert!(why.contains("glossy"), "{why}");
+}
