@@ -8,7 +8,7 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     // No base folder: a buffer given as a file path is an error, not a read.
-    match gltf::scene_from_bytes(data, "fuzz.glb", None, &LoadOptions::default()) {
+    match gltf::scene_from_bytes(data, "fuzz.glb", None, &LoadOptions::default(), &hikari_core::progress::Silent) {
         Ok(scene) => assert!(scene.diagonal().is_finite()),
         Err(e) => assert!(!e.message.is_empty()),
     }

@@ -246,9 +246,11 @@ pub fn parse_resolution(s: &str) -> Result<Resolution, String> {
 
 /// Loads `spec` (built-in name, `.toml`, `.gltf` or `.glb`) through
 /// `camera`, printing the loader's notes; a bad file is a usage error.
-pub fn load_scene(spec: &str, camera: Option<&str>) -> Result<Scene, UsageError> {
+pub fn load_scene(spec: &str, camera: Option<&str>, quiet: bool) -> Result<Scene, UsageError> {
     let options = hikari_core::scene::LoadOptions { camera: camera.map(str::to_string) };
-    let scene = Scene::load_with(spec, &options).map_err(|e| UsageError(e.to_string()))?;
+    // A bar only for files that take over a second (a large glTF file).
+    let progress = TerminalProgress::after(quiet, std::time::Duration::from_secs(1));
+    let scene = Scene::load_with_progress(spec, &options, &progress).map_err(|e| UsageError(e.to_string()))?;
     for note in &scene.notes {
         eprintln!("note: {note}");
     }
@@ -566,7 +568,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .context("setting the thread count")?;
     }
 
-    let mut scene = load_scene(&args.scene, args.camera.as_deref())?;
+    let mut scene = load_scene(&args.scene, args.camera.as_deref(), args.quiet)?;
     if scene.is_animated() {
         scene = scene.at_time(args.at);
     }

@@ -132,7 +132,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             return Err(UsageError(format!("{}: unsupported image type (use .png or .exr)", path.display())).into());
         }
     }
-    let scene = load_scene(&args.scene, args.camera.as_deref())?;
+    let scene = load_scene(&args.scene, args.camera.as_deref(), false)?;
     if let Some(why) = hikari_gpu::scene_upload::approximated_materials(&scene) {
         eprintln!("note: {why}");
     }

@@ -301,7 +301,8 @@ fn load_gltf_object(
         translate,
     );
     let path = base_dir.map_or_else(|| Path::new(file).to_path_buf(), |d| d.join(file));
-    let asset = super::gltf::load_asset(&path, world_from_file, None).map_err(|e| p.error(e.to_string()))?;
+    let asset = super::gltf::load_asset(&path, world_from_file, None, &crate::progress::Silent)
+        .map_err(|e| p.error(e.to_string()))?;
     let first_material = parts.materials.len() as u32;
     parts.materials.extend(asset.materials);
     // The file's images after those of earlier objects.

@@ -62,16 +62,26 @@ impl Scene {
 
     /// [`Scene::load`] with options (the camera of a glTF file).
     pub fn load_with(spec: &str, options: &LoadOptions) -> Result<Scene, SceneError> {
+        Self::load_with_progress(spec, options, &crate::progress::Silent)
+    }
+
+    /// [`Scene::load_with`], reporting the stages of loading a large file
+    /// (reading a glTF file's meshes, building the BVH) to `progress`.
+    pub fn load_with_progress(
+        spec: &str,
+        options: &LoadOptions,
+        progress: &dyn crate::progress::Progress,
+    ) -> Result<Scene, SceneError> {
         match builtin::source(spec) {
             Some(text) => load::parse(text, &format!("builtin:{spec}"), None),
-            None if gltf::is_gltf(Path::new(spec)) => gltf::load_scene(Path::new(spec), options),
+            None if gltf::is_gltf(Path::new(spec)) => gltf::load_scene(Path::new(spec), options, progress),
             None => Self::from_file(Path::new(spec)),
         }
     }
 
     pub fn from_file(path: &Path) -> Result<Scene, SceneError> {
         if gltf::is_gltf(path) {
-            return gltf::load_scene(path, &LoadOptions::default());
+            return gltf::load_scene(path, &LoadOptions::default(), &crate::progress::Silent);
         }
         let name = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {

@@ -17,6 +17,7 @@ use super::limits::MAX_COORD;
 use crate::geometry::{Triangle, TriangleNormals};
 use crate::light::Light;
 use crate::material::{Material, Rgb};
+use crate::progress::Progress;
 use crate::texture::{Image, MaterialTextures};
 use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3};
 use gltf::accessor::DataType;
@@ -32,8 +33,13 @@ pub const LUMENS_PER_WATT: f32 = 683.0;
 
 /// Extensions whose meaning hikari reads; a file that requires any other is
 /// refused, one that merely uses another is loaded with a note.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["KHR_lights_punctual", "KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_transmission"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_specular",
+];
 
 /// A glTF file in world space.
 pub struct Asset {
@@ -104,14 +110,21 @@ fn error(file: &str, context: impl Into<String>, message: impl Into<String>) -> 
 
 /// Reads `path` and places its default scene by `world_from_file`.
 /// `camera` picks a camera by name (else the first perspective one).
-pub fn load_asset(path: &Path, world_from_file: Affine3A, camera: Option<&str>) -> Result<Asset, SceneError> {
+/// Reading the meshes is reported to `progress` (a stage of one step per
+/// placed primitive).
+pub fn load_asset(
+    path: &Path,
+    world_from_file: Affine3A,
+    camera: Option<&str>,
+    progress: &dyn Progress,
+) -> Result<Asset, SceneError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| error(&file, "", format!("cannot read glTF file: {e}")))?;
     let binary_name = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
     if binary_name && !bytes.starts_with(b"glTF") {
         return Err(error(&file, "", "not a binary glTF file: it does not start with the `glTF` magic bytes"));
     }
-    asset_from_bytes(&bytes, &file, path.parent(), world_from_file, camera)
+    asset_from_bytes(&bytes, &file, path.parent(), world_from_file, camera, progress)
 }
 
 /// [`load_asset`] of a file's bytes, named `file` in errors; buffers given
@@ -122,6 +135,7 @@ pub fn asset_from_bytes(
     base: Option<&Path>,
     world_from_file: Affine3A,
     camera: Option<&str>,
+    progress: &dyn Progress,
 ) -> Result<Asset, SceneError> {
     let file = file.to_string();
     let gltf = parse(bytes, &file)?;
@@ -151,6 +165,7 @@ pub fn asset_from_bytes(
         visited: vec![false; gltf.document.nodes().len()],
         ignored_range: false,
         without_uvs: 0,
+        progress,
     };
     let scene = gltf
         .document
@@ -158,9 +173,10 @@ pub fn asset_from_bytes(
         .or_else(|| gltf.document.scenes().next())
         .ok_or_else(|| error(&file, "scenes", "the file has no scene to render"))?;
     let world = Mat4::from(world_from_file);
-    for node in scene.nodes() {
-        walk.node(&node, world)?;
-    }
+    progress.begin("reading meshes", placed_primitives(&scene));
+    let walked = scene.nodes().try_for_each(|node| walk.node(&node, world));
+    progress.end();
+    walked?;
     if let Some(name) = camera
         && walk.asset.camera.is_none()
     {
@@ -313,6 +329,23 @@ struct Walk<'a> {
     ignored_range: bool,
     /// Primitives of textured materials without `TEXCOORD_0`.
     without_uvs: usize,
+    progress: &'a dyn Progress,
+}
+
+/// How many primitives the scene places (one per primitive of each node's
+/// mesh, children included): the loader's progress total. Nodes reached
+/// twice are counted once (the walk refuses them anyway).
+fn placed_primitives(scene: &gltf::Scene) -> u64 {
+    let mut seen = std::collections::HashSet::new();
+    let mut stack: Vec<gltf::Node> = scene.nodes().collect();
+    let mut count = 0;
+    while let Some(node) = stack.pop() {
+        if seen.insert(node.index()) {
+            count += node.mesh().map_or(0, |m| m.primitives().len() as u64);
+            stack.extend(node.children());
+        }
+    }
+    count
 }
 
 impl Walk<'_> {
@@ -344,6 +377,7 @@ impl Walk<'_> {
                 let material = local.material;
                 let emission = self.emissions[material as usize];
                 self.asset.primitives.push(Primitive { name: name.clone(), triangles, uvs, material, emission });
+                self.progress.advance(1);
             }
         }
         if let Some(camera) = node.camera() {
@@ -567,9 +601,9 @@ const DEFAULT_HEIGHT: u32 = 512;
 /// A glTF file as a whole scene: its camera (or one framing its bounds),
 /// its lights and emissive surfaces (or a white environment if it has
 /// none), with a note for each.
-pub fn load_scene(path: &Path, options: &LoadOptions) -> Result<super::Scene, SceneError> {
-    let asset = load_asset(path, Affine3A::IDENTITY, options.camera.as_deref())?;
-    scene_from_asset(asset, path.display().to_string())
+pub fn load_scene(path: &Path, options: &LoadOptions, progress: &dyn Progress) -> Result<super::Scene, SceneError> {
+    let asset = load_asset(path, Affine3A::IDENTITY, options.camera.as_deref(), progress)?;
+    scene_from_asset(asset, path.display().to_string(), progress)
 }
 
 /// [`load_scene`] of a file's bytes (see [`asset_from_bytes`]).
@@ -578,12 +612,13 @@ pub fn scene_from_bytes(
     file: &str,
     base: Option<&Path>,
     options: &LoadOptions,
+    progress: &dyn Progress,
 ) -> Result<super::Scene, SceneError> {
-    let asset = asset_from_bytes(bytes, file, base, Affine3A::IDENTITY, options.camera.as_deref())?;
-    scene_from_asset(asset, file.to_string())
+    let asset = asset_from_bytes(bytes, file, base, Affine3A::IDENTITY, options.camera.as_deref(), progress)?;
+    scene_from_asset(asset, file.to_string(), progress)
 }
 
-fn scene_from_asset(mut asset: Asset, file: String) -> Result<super::Scene, SceneError> {
+fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> Result<super::Scene, SceneError> {
     use super::{Names, Scene, Surface};
     let mut surfaces = Vec::new();
     let mut triangles = Vec::new();
@@ -620,7 +655,10 @@ fn scene_from_asset(mut asset: Asset, file: String) -> Result<super::Scene, Scen
         return Err(error(&file, "", "the scene has no triangle to render"));
     }
     let (triangles, tri_surfaces): (Vec<_>, Vec<_>) = triangles.into_iter().unzip();
+    progress.begin("building the BVH", 1);
     let mut accel = crate::geometry::Accel::build(triangles, tri_surfaces, Vec::new(), Vec::new());
+    progress.advance(1);
+    progress.end();
     let texturing = asset.material_textures.iter().any(Option::is_some).then(|| {
         std::sync::Arc::new(crate::texture::Texturing {
             images: std::mem::take(&mut asset.images),

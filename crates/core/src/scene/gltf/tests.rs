@@ -56,7 +56,7 @@ fn node_hierarchy_places_and_instances_triangles() {
     });
     let dir = folder("hierarchy");
     let path = write(&dir, "h.glb", &b.to_glb(vec![parent]));
-    let asset = load_asset(&path, Affine3A::IDENTITY, None).unwrap();
+    let asset = load_asset(&path, Affine3A::IDENTITY, None, &crate::progress::Silent).unwrap();
     assert_eq!(asset.primitives.len(), 2, "one mesh under two nodes: two instances");
     // Parent: p ↦ T + R(S p) with S = diag(2,1,1), R = 90° about z: (x, y) ↦ (−y, x).
     let parent_of = |p: Vec3| Vec3::new(10.0 - p.y, 2.0 * p.x, p.z);
@@ -90,7 +90,7 @@ fn smooth_normals_follow_the_inverse_transpose() {
     let node = b.node(json::Node { mesh: Some(mesh), scale: Some([2.0, 1.0, 1.0]), ..Default::default() });
     let dir = folder("normals");
     let path = write(&dir, "n.glb", &b.to_glb(vec![node]));
-    let asset = load_asset(&path, Affine3A::IDENTITY, None).unwrap();
+    let asset = load_asset(&path, Affine3A::IDENTITY, None, &crate::progress::Silent).unwrap();
     let TriangleNormals(normals) = asset.primitives[0].triangles[0].normals.unwrap();
     assert!((normals[0] - Vec3::new(-1.0, 2.0, 0.0).normalize()).length() < 1e-5, "{}", normals[0]);
     // Without a material the specification's default (white) applies.
@@ -331,4 +331,47 @@ intensity = [1.0, 1.0, 1.0]
     let missing = toml.replace("tri.glb", "nothing.glb");
     let e = crate::scene::Scene::from_toml(&missing, "t.toml", Some(&dir)).err().unwrap().to_string();
     assert_says(&e, &["t.toml:", "nothing.glb", "cannot read glTF file"]);
+}
+
+/// Loading reports its stages: one step per placed primitive (instances
+/// counted each time), then the BVH.
+#[test]
+fn loading_reports_progress_per_placed_primitive() {
+    use std::sync::Mutex;
+    #[derive(Default)]
+    struct Recorder(Mutex<Vec<(String, u64, u64)>>);
+    impl crate::progress::Progress for Recorder {
+        fn begin(&self, stage: &str, total: u64) {
+            self.0.lock().unwrap().push((stage.to_string(), total, 0));
+        }
+        fn advance(&self, amount: u64) {
+            self.0.lock().unwrap().last_mut().unwrap().2 += amount;
+        }
+    }
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    let child = b.node(json::Node { mesh: Some(mesh), translation: Some([0.0, 0.0, 1.0]), ..Default::default() });
+    let parent = b.node(json::Node { mesh: Some(mesh), children: Some(vec![child]), ..Default::default() });
+    let dir = folder("progress");
+    let path = write(&dir, "p.glb", &b.to_glb(vec![parent]));
+    let recorder = Recorder::default();
+    let options = LoadOptions::default();
+    crate::scene::Scene::load_with_progress(path.to_str().unwrap(), &options, &recorder).unwrap();
+    let stages = recorder.0.into_inner().unwrap();
+    assert_eq!(stages, vec![("reading meshes".to_string(), 2, 2), ("building the BVH".to_string(), 1, 1)]);
+}
+
+/// `KHR_materials_specular` is read, not listed as ignored: its factor 0
+/// makes an exact Lambertian (as hikari's own diffuse material).
+#[test]
+fn the_specular_extension_is_read() {
+    let mut b = GltfBuilder::new();
+    let m = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() });
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let dir = folder("specular");
+    let path = write(&dir, "s.glb", &b.to_glb(vec![node]));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(!scene.notes.iter().any(|n| n.contains("KHR_materials_specular")), "{:?}", scene.notes);
+    assert_eq!(scene.materials[0], Material::Diffuse { albedo: Vec3::splat(0.5), specular: Vec3::ZERO });
 }
