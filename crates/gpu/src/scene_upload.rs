@@ -164,6 +164,31 @@ pub fn approximated_materials(scene: &Scene) -> Option<String> {
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// How the GPU draws a glTF BRDF until it evaluates it (see
+/// [`approximated_materials`]): (Lambert albedo, mirror reflectance). A
+/// lobe the CPU's eye would follow (smoother than `GATHER_ROUGHNESS`) is a
+/// mirror of its normal-incidence reflectance; a rougher one adds its
+/// estimated albedo to the diffuse part, so a rough metal is not black.
+pub fn pbr_as_diffuse_and_mirror(bsdf: &hikari_core::bsdf::Bsdf) -> (Vec3, Vec3) {
+    let lambert = bsdf.lambert_albedo();
+    if !bsdf.has_specular() {
+        (lambert, Vec3::ZERO)
+    } else if bsdf.gathers_specular() {
+        (bsdf.albedo_estimate().min(Vec3::ONE), Vec3::ZERO)
+    } else {
+        let mirror = bsdf.normal_reflectance();
+        (lambert.min(Vec3::ONE - mirror), mirror)
+    }
+}
+
+/// The mirror part the GPU gives a material (its `GpuSurface::specular`).
+pub fn gpu_mirror_reflectance(material: &Material) -> Vec3 {
+    match material {
+        Material::Pbr(bsdf) => pbr_as_diffuse_and_mirror(bsdf).1,
+        other => other.mirror_reflectance(),
+    }
+}
+
 pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
     scene
         .surfaces
@@ -177,7 +202,7 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 Material::Emitter => (kind::EMITTER, Vec3::ZERO, 1.0),
                 // Until the GPU evaluates the BRDF: its Lambert part, and a
                 // smooth lobe as a mirror (`renderer::approximated_materials`).
-                Material::Pbr(_) => (kind::DIFFUSE, material.diffuse_albedo(), 1.0),
+                Material::Pbr(bsdf) => (kind::DIFFUSE, pbr_as_diffuse_and_mirror(bsdf).0, 1.0),
             };
             // What the eye sees besides what the surface reflects.
             let (emission, two_sided) = s.emitter.map_or((Vec3::ZERO, false), |l| match &scene.lights[l as usize] {
@@ -191,7 +216,7 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 kind,
                 emission: emission.to_array(),
                 ior,
-                specular: if kind == kind::DIFFUSE { material.mirror_reflectance().to_array() } else { [0.0; 3] },
+                specular: if kind == kind::DIFFUSE { gpu_mirror_reflectance(material).to_array() } else { [0.0; 3] },
                 two_sided: two_sided as u32,
             }
         })

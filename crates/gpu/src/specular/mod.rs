@@ -26,7 +26,8 @@ const WORKGROUP: u32 = 8;
 pub fn has_specular_surfaces(scene: &Scene) -> bool {
     scene.surfaces.iter().any(|s| {
         let m = &scene.materials[s.material as usize];
-        matches!(m, Material::Mirror { .. } | Material::Glass { .. }) || m.mirror_reflectance().max_element() > 0.0
+        matches!(m, Material::Mirror { .. } | Material::Glass { .. })
+            || crate::scene_upload::gpu_mirror_reflectance(m).max_element() > 0.0
     })
 }
 
