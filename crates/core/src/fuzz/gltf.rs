@@ -44,6 +44,11 @@ pub fn seed_files() -> Vec<Vec<u8>> {
     let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(Vec3::new(0.3, -1.0, 0.2), Vec3::Y)));
     let camera = b.camera(0.8, Some(1.0));
     let camera = b.node(json::Node { camera: Some(camera), translation: Some([0.0, 1.0, 4.0]), ..Default::default() });
+    // The panel swings and the spot steps (animations' samplers and tracks).
+    use gltf::json::animation::{Interpolation, Property};
+    let swing: Vec<f32> = [Quat::IDENTITY, Quat::from_rotation_z(0.5)].iter().flat_map(|q| q.to_array()).collect();
+    b.animate(child, Property::Rotation, Interpolation::Linear, &[0.0, 1.5], &swing);
+    b.animate(spot, Property::Translation, Interpolation::Step, &[0.0, 1.0], &[0.0, 1.8, 0.5, 0.3, 1.8, 0.5]);
     let lit = b.to_glb(vec![root, point, spot, sun, camera]);
     vec![scene_to_glb(&cornell).expect("cornell-box is triangles"), lit, textured()]
 }

@@ -23,8 +23,9 @@ pub enum Target {
     Light(u32),
 }
 
-/// A periodic rigid motion.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A periodic motion: rigid for `Rotate` and `Move`; a glTF animation's
+/// keyframes may also scale.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Motion {
     /// A full turn about the line through `center` along the unit `axis`
     /// every `period` seconds (counter-clockwise looking down the axis): a
@@ -33,6 +34,8 @@ pub enum Motion {
     /// From the rest place to `offset` away and back every `period` seconds,
     /// easing in and out: displacement `offset · (1 − cos 2πt/T) / 2`.
     Move { offset: Vec3, period: f32 },
+    /// A glTF file's node animation, looping.
+    Keyframed(std::sync::Arc<super::keyframes::Keyframes>),
 }
 
 impl Motion {
@@ -50,11 +53,12 @@ impl Motion {
                 let phase = TAU * (time / period).rem_euclid(1.0);
                 Affine3A::from_translation(offset * (0.5 - 0.5 * phase.cos()))
             }
+            Motion::Keyframed(ref keys) => keys.at(time),
         }
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Animation {
     pub target: Target,
     pub motion: Motion,

@@ -8,6 +8,7 @@ pub mod builtin;
 mod desc;
 mod error;
 pub mod gltf;
+pub mod keyframes;
 pub mod limits;
 mod load;
 

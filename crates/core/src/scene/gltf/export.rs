@@ -275,6 +275,54 @@ impl GltfBuilder {
         })
     }
 
+    /// A one-channel animation of `node`'s `property`: `values` holds 3
+    /// (translation, scale) or 4 (rotation, x y z w) floats per key time
+    /// (three times as many keys for CUBICSPLINE). The sampler's key times
+    /// carry their min and max, as the specification asks.
+    pub fn animate(
+        &mut self,
+        node: Index<json::Node>,
+        property: json::animation::Property,
+        interpolation: json::animation::Interpolation,
+        times: &[f32],
+        values: &[f32],
+    ) {
+        use json::accessor::{ComponentType, Type};
+        let input = self.accessor(bytemuck::cast_slice(times), times.len(), Type::Scalar, ComponentType::F32, None);
+        let lo = times.iter().copied().fold(f32::INFINITY, f32::min);
+        let hi = times.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        let accessor = &mut self.root.accessors[input.value()];
+        accessor.min = Some(json::serialize::to_value([lo]).unwrap());
+        accessor.max = Some(json::serialize::to_value([hi]).unwrap());
+        let (ty, n) = if property == json::animation::Property::Rotation { (Type::Vec4, 4) } else { (Type::Vec3, 3) };
+        let output = self.accessor(bytemuck::cast_slice(values), values.len() / n, ty, ComponentType::F32, None);
+        let sampler = json::animation::Sampler {
+            extensions: None,
+            extras: Default::default(),
+            input,
+            interpolation: Valid(interpolation),
+            output,
+        };
+        let channel = json::animation::Channel {
+            sampler: Index::new(0),
+            target: json::animation::Target {
+                extensions: None,
+                extras: Default::default(),
+                node,
+                path: Valid(property),
+            },
+            extensions: None,
+            extras: Default::default(),
+        };
+        self.root.push(json::Animation {
+            extensions: None,
+            extras: Default::default(),
+            channels: vec![channel],
+            name: None,
+            samplers: vec![sampler],
+        });
+    }
+
     /// A `KHR_lights_punctual` light in the file's units (cd or lux).
     pub fn light(
         &mut self,

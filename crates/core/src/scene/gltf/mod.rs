@@ -8,6 +8,7 @@
 //! the culprit (`meshes[3].primitives[0].attributes.POSITION`).
 
 mod accessors;
+mod animations;
 pub mod export;
 mod materials;
 mod textures;
@@ -57,6 +58,20 @@ pub struct Asset {
     pub camera: Option<CameraPose>,
     /// One-line notes on what was ignored or approximated.
     pub notes: Vec<String>,
+    /// Parallel to `lights`: the node path (root first) of each.
+    pub light_paths: Vec<Vec<usize>>,
+    /// The file's first animation, by node.
+    pub channels: animations::NodeChannels,
+    /// Where the file was placed (identity for a file loaded on its own).
+    pub world_from_file: Affine3A,
+}
+
+impl Asset {
+    /// The keyframed motion of what sits at the end of `path`, if it moves.
+    pub fn motion(&self, path: &[usize]) -> Option<crate::scene::Motion> {
+        let keys = self.channels.keyframes(self.world_from_file, path)?;
+        Some(crate::scene::Motion::Keyframed(std::sync::Arc::new(keys)))
+    }
 }
 
 /// The triangles of one primitive under one node (a mesh under several
@@ -72,6 +87,8 @@ pub struct Primitive {
     pub material: u32,
     /// Light the surface emits, from its material.
     pub emission: Option<Emission>,
+    /// The node indices from the scene's root down to the primitive's node.
+    pub node_path: Vec<usize>,
 }
 
 impl Primitive {
@@ -161,6 +178,9 @@ pub fn asset_from_bytes(
             lights: Vec::new(),
             camera: None,
             notes,
+            light_paths: Vec::new(),
+            channels: animations::NodeChannels::default(),
+            world_from_file,
         },
         visited: vec![false; gltf.document.nodes().len()],
         ignored_range: false,
@@ -174,7 +194,7 @@ pub fn asset_from_bytes(
         .ok_or_else(|| error(&file, "scenes", "the file has no scene to render"))?;
     let world = Mat4::from(world_from_file);
     progress.begin("reading meshes", placed_primitives(&scene));
-    let walked = scene.nodes().try_for_each(|node| walk.node(&node, world));
+    let walked = scene.nodes().try_for_each(|node| walk.node(&node, world, &mut Vec::new()));
     progress.end();
     walked?;
     if let Some(name) = camera
@@ -193,6 +213,7 @@ pub fn asset_from_bytes(
             format!("no perspective camera named \"{name}\" is placed in the scene (cameras: {})", names.join(", ")),
         ));
     }
+    walk.asset.channels = animations::read(&gltf.document, &buffers, &file, &mut walk.asset.notes)?;
     if walk.ignored_range {
         walk.asset.notes.push("light `range` is ignored: lights fall off physically, as 1/d²".into());
     }
@@ -218,7 +239,7 @@ fn parse(bytes: &[u8], file: &str) -> Result<gltf::Gltf, SceneError> {
         other => error(file, "", other.to_string()),
     })?;
     let root = document.into_json();
-    check_position_indices(&root, file)?;
+    check_indices(&root, file)?;
     let document = gltf::Document::from_json(root).map_err(|e| match e {
         gltf::Error::Validation(problems) => {
             let (path, problem) = &problems[0];
@@ -233,8 +254,9 @@ fn parse(bytes: &[u8], file: &str) -> Result<gltf::Gltf, SceneError> {
 
 /// The `gltf-json` crate's validation reads each primitive's `POSITION`
 /// accessor before checking that it exists (and panics when it does not),
-/// so that index is checked first.
-fn check_position_indices(root: &gltf::json::Root, file: &str) -> Result<(), SceneError> {
+/// and its animation accessors unwrap their indices: those are checked
+/// first.
+fn check_indices(root: &gltf::json::Root, file: &str) -> Result<(), SceneError> {
     let positions = gltf::json::validation::Checked::Valid(gltf::json::mesh::Semantic::Positions);
     for (m, mesh) in root.meshes.iter().enumerate() {
         for (p, primitive) in mesh.primitives.iter().enumerate() {
@@ -246,6 +268,35 @@ fn check_position_indices(root: &gltf::json::Root, file: &str) -> Result<(), Sce
                     format!("meshes[{m}].primitives[{p}].attributes.POSITION"),
                     format!("accessor {} does not exist ({} accessors)", index.value(), root.accessors.len()),
                 ));
+            }
+        }
+    }
+    // The crate's animation accessors unwrap these indices too.
+    for (a, animation) in root.animations.iter().enumerate() {
+        for (c, channel) in animation.channels.iter().enumerate() {
+            let checks = [
+                ("sampler", channel.sampler.value(), animation.samplers.len(), "samplers"),
+                ("target.node", channel.target.node.value(), root.nodes.len(), "nodes"),
+            ];
+            for (field, index, len, what) in checks {
+                if index >= len {
+                    return Err(error(
+                        file,
+                        format!("animations[{a}].channels[{c}].{field}"),
+                        format!("{what} {index} does not exist ({len} {what})"),
+                    ));
+                }
+            }
+        }
+        for (i, sampler) in animation.samplers.iter().enumerate() {
+            for (field, index) in [("input", sampler.input.value()), ("output", sampler.output.value())] {
+                if index >= root.accessors.len() {
+                    return Err(error(
+                        file,
+                        format!("animations[{a}].samplers[{i}].{field}"),
+                        format!("accessor {index} does not exist ({} accessors)", root.accessors.len()),
+                    ));
+                }
             }
         }
     }
@@ -349,7 +400,8 @@ fn placed_primitives(scene: &gltf::Scene) -> u64 {
 }
 
 impl Walk<'_> {
-    fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<(), SceneError> {
+    /// Places `node` under `parent`; `path` holds the node indices above it.
+    fn node(&mut self, node: &gltf::Node, parent: Mat4, path: &mut Vec<usize>) -> Result<(), SceneError> {
         let at = format!("nodes[{}]", node.index());
         if std::mem::replace(&mut self.visited[node.index()], true) {
             return Err(error(
@@ -363,6 +415,7 @@ impl Walk<'_> {
             return Err(error(self.file, &at, "the node's transform is not finite"));
         }
         let name = node.name().map(str::to_string);
+        path.push(node.index());
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
                 let local = self.local_primitive(&mesh, &primitive)?;
@@ -376,7 +429,15 @@ impl Walk<'_> {
                 }
                 let material = local.material;
                 let emission = self.emissions[material as usize];
-                self.asset.primitives.push(Primitive { name: name.clone(), triangles, uvs, material, emission });
+                let node_path = path.clone();
+                self.asset.primitives.push(Primitive {
+                    name: name.clone(),
+                    triangles,
+                    uvs,
+                    material,
+                    emission,
+                    node_path,
+                });
                 self.progress.advance(1);
             }
         }
@@ -386,10 +447,12 @@ impl Walk<'_> {
         if let Some(light) = node.light() {
             let light = self.light(&light, &world, &at)?;
             self.asset.lights.push((name, light));
+            self.asset.light_paths.push(path.clone());
         }
         for child in node.children() {
-            self.node(&child, world)?;
+            self.node(&child, world, path)?;
         }
+        path.pop();
         Ok(())
     }
 
@@ -619,18 +682,25 @@ pub fn scene_from_bytes(
 }
 
 fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> Result<super::Scene, SceneError> {
-    use super::{Names, Scene, Surface};
+    use super::{Animation, Names, Scene, Surface, Target};
     let mut surfaces = Vec::new();
     let mut triangles = Vec::new();
     let mut names = Names::default();
     let mut lights: Vec<Light> = Vec::new();
     let mut light_names = Vec::new();
-    for (name, light) in asset.lights.drain(..) {
+    // The file's animation, as motions of the lights and surfaces it moves.
+    let mut animations = Vec::new();
+    let light_motions: Vec<_> = asset.light_paths.iter().map(|path| asset.motion(path)).collect();
+    let primitive_motions: Vec<_> = asset.primitives.iter().map(|p| asset.motion(&p.node_path)).collect();
+    for ((name, light), motion) in asset.lights.drain(..).zip(light_motions) {
+        if let Some(motion) = motion {
+            animations.push(Animation { target: Target::Light(lights.len() as u32), motion });
+        }
         light_names.push(name);
         lights.push(light);
     }
     let mut uvs = crate::texture::TexCoords::default();
-    for primitive in asset.primitives.drain(..) {
+    for (primitive, motion) in asset.primitives.drain(..).zip(primitive_motions) {
         if primitive.triangles.is_empty() {
             continue;
         }
@@ -644,6 +714,11 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
             lights.len() as u32 - 1
         });
         surfaces.push(Surface { material: primitive.material, emitter });
+        if let Some(motion) = motion {
+            // An emissive surface moves with its light (`Scene::posed`).
+            let target = emitter.map_or(Target::Object(surface), Target::Light);
+            animations.push(Animation { target, motion });
+        }
         if let Some(name) = primitive.name
             && !names.objects.iter().any(|(n, _)| *n == name)
         {
@@ -691,7 +766,7 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
         accel,
         media: crate::medium::Media::new(Vec::new()).expect("no media is valid"),
         names,
-        animations: Vec::new(),
+        animations,
         notes: asset.notes,
         texturing,
     })

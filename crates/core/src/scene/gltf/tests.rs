@@ -375,3 +375,47 @@ fn the_specular_extension_is_read() {
     assert!(!scene.notes.iter().any(|n| n.contains("KHR_materials_specular")), "{:?}", scene.notes);
     assert_eq!(scene.materials[0], Material::Diffuse { albedo: Vec3::splat(0.5), specular: Vec3::ZERO });
 }
+
+/// A glTF animation moves what it animates: a parent's rotation carries a
+/// child mesh and a light, `--at` poses them (`Scene::at_time`), and the
+/// loop restarts after the last key.
+#[test]
+fn node_animations_move_meshes_and_lights() {
+    use json::animation::{Interpolation, Property};
+    use json::extensions::scene::khr_lights_punctual::Type;
+    let mut b = GltfBuilder::new();
+    let mesh = one_triangle(&mut b);
+    let child = b.node(json::Node { mesh: Some(mesh), translation: Some([2.0, 0.0, 0.0]), ..Default::default() });
+    let light = b.light(Type::Point, Vec3::ONE, 683.0, None);
+    let lamp = b.node(GltfBuilder::light_node(light, Vec3::new(0.0, 0.0, 3.0), glam::Quat::IDENTITY));
+    let pivot = b.node(json::Node { children: Some(vec![child, lamp]), ..Default::default() });
+    let quarter = glam::Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+    let rotations: Vec<f32> = [glam::Quat::IDENTITY, quarter].iter().flat_map(|q| q.to_array()).collect();
+    b.animate(pivot, Property::Rotation, Interpolation::Linear, &[0.0, 2.0], &rotations);
+    // A second node moves by steps: 0, then 5 up from 1 s, then 10 from 2 s (a 2 s loop).
+    let stepper = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let ups = [0.0, 0.0, 0.0, 0.0, 5.0, 0.0, 0.0, 10.0, 0.0];
+    b.animate(stepper, Property::Translation, Interpolation::Step, &[0.0, 1.0, 2.0], &ups);
+    let dir = folder("animated");
+    let path = write(&dir, "a.glb", &b.to_glb(vec![pivot, stepper]));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(scene.is_animated());
+    assert_eq!(scene.animations.len(), 3, "the child mesh, the lamp and the stepper");
+    let at = |t: f32| scene.at_time(t);
+    // The child's vertex (2, 0, 0) + (0, 0, 0) turns with the pivot: at 1.99 s almost a quarter turn.
+    let first_vertex = |s: &crate::scene::Scene, surface: u32| {
+        s.accel.triangles().find(|(_, id)| *id == surface).map(|(t, _)| t.v[0]).unwrap()
+    };
+    assert!((first_vertex(&at(0.0), 0) - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5);
+    let turned = first_vertex(&at(1.0), 0);
+    let s = 2.0 * std::f32::consts::FRAC_1_SQRT_2;
+    assert!((turned - Vec3::new(s, 0.0, -s)).length() < 1e-4, "{turned}");
+    // The lamp at (0, 0, 3) turns to (3 sin 45°, 0, 3 cos 45°).
+    let lamp_at = at(1.0).lights[0].delta_position().unwrap();
+    assert!((lamp_at - Vec3::new(3.0, 0.0, 3.0) * std::f32::consts::FRAC_1_SQRT_2).length() < 1e-4, "{lamp_at}");
+    // Step interpolation holds each key (linear would give 2.5 and 7.5).
+    assert_eq!(first_vertex(&at(0.5), 1), Vec3::ZERO);
+    assert_eq!(first_vertex(&at(1.5), 1), Vec3::new(0.0, 5.0, 0.0));
+    // The loop is 2 s long (its last key): 2.5 s is 0.5 s again.
+    assert_eq!(first_vertex(&at(2.5), 1), Vec3::ZERO);
+}
