@@ -1,10 +1,11 @@
 //! # hikari-core
 //!
 //! The part of the hikari photon mapper that needs no GPU: the scene model
-//! and its TOML loader, ray casting (BVH), sampling, photon tracing (also
-//! through a homogeneous participating medium, into a volume map), photon
-//! maps, the radiance estimates, level of detail, and the CPU renderers
-//! `photon-cpu` (the seed's fixed-radius pipeline) and `path` (ground truth).
+//! and its TOML and glTF 2.0 loaders, the glTF metallic–roughness BRDF
+//! (`bsdf`) and textures, ray casting (BVH), sampling, photon tracing (also
+//! through participating media, into a volume map), photon maps, the
+//! radiance estimates, level of detail, and the CPU renderers `photon-cpu`
+//! (the seed's fixed-radius pipeline) and `path` (ground truth).
 //!
 //! ```
 //! use hikari_core::{photon, progress::Silent, render::photon_cpu, scene::Scene};

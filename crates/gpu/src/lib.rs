@@ -12,6 +12,11 @@
 //!
 //! Each pass is a small struct with its pipeline, its shader beside it;
 //! WGSL shared between passes is in `wgsl`, composed once per shader.
+//!
+//! Not on the GPU yet: the glTF metallic–roughness BRDF and textures. Such
+//! materials are drawn by a stand-in (`scene_upload::pbr_as_diffuse_and_mirror`)
+//! and reported by `scene_upload::approximated_materials`, so the CLI renders
+//! those scenes with `photon-cpu` and the viewer says it approximates.
 
 pub mod accumulate;
 pub mod binding;
