@@ -135,3 +135,115 @@ pub fn quad_lights_as_meshes(scene: &Scene) -> Scene {
     }
     scene
 }
+
+/// The Cornell box with glossy walls and blocks, open at the front, lit by `light`.
+pub fn glossy_box(light: &str, size: u32) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 3.9]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 39.3
+resolution = [{size}, {size}]
+
+[[material]]
+name = "brushed gold"
+type = "pbr"
+base_color = [0.9, 0.75, 0.45]
+metallic = 1.0
+roughness = 0.2
+
+[[material]]
+name = "satin white"
+type = "pbr"
+base_color = [0.75, 0.74, 0.72]
+roughness = 0.5
+
+[[material]]
+name = "lacquered red"
+type = "pbr"
+base_color = [0.63, 0.07, 0.05]
+roughness = 0.1
+
+[[material]]
+name = "green"
+type = "pbr"
+base_color = [0.14, 0.45, 0.09]
+roughness = 1.0
+
+[[material]]
+name = "rough steel"
+type = "pbr"
+base_color = [0.6, 0.6, 0.62]
+metallic = 1.0
+roughness = 0.7
+
+[[object]]
+shape = "quad"
+corner = [-1.0, -1.0, -1.0]
+edge_u = [0.0, 0.0, 2.0]
+edge_v = [2.0, 0.0, 0.0]
+material = "brushed gold"
+
+[[object]]
+shape = "quad"
+corner = [-1.0, 1.0, -1.0]
+edge_u = [2.0, 0.0, 0.0]
+edge_v = [0.0, 0.0, 2.0]
+material = "satin white"
+
+[[object]]
+shape = "quad"
+corner = [-1.0, -1.0, -1.0]
+edge_u = [2.0, 0.0, 0.0]
+edge_v = [0.0, 2.0, 0.0]
+material = "satin white"
+
+[[object]]
+shape = "quad"
+corner = [-1.0, -1.0, -1.0]
+edge_u = [0.0, 2.0, 0.0]
+edge_v = [0.0, 0.0, 2.0]
+material = "lacquered red"
+
+[[object]]
+shape = "quad"
+corner = [1.0, -1.0, -1.0]
+edge_u = [0.0, 0.0, 2.0]
+edge_v = [0.0, 2.0, 0.0]
+material = "green"
+
+[[object]]
+shape = "box"
+center = [0.33, -0.7, 0.3]
+size = [0.6, 0.6, 0.6]
+rotate_y = -17.0
+material = "rough steel"
+
+[[object]]
+shape = "box"
+center = [-0.33, -0.4, -0.3]
+size = [0.6, 1.2, 0.6]
+rotate_y = 17.0
+material = "satin white"
+
+{light}
+"#
+    );
+    Scene::from_toml(&text, &format!("glossy-box ({})", light.lines().nth(1).unwrap_or(light)), None)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The lights `glossy_box` is tested under, one of each kind, as TOML.
+pub mod glossy_lights {
+    pub const POINT: &str = "[[light]]\ntype = \"point\"\nposition = [0.0, 0.9, 0.0]\nintensity = [2.5, 2.5, 2.5]";
+    pub const SPOT: &str = "[[light]]\ntype = \"spot\"\nposition = [0.0, 0.95, 0.3]\ndirection = [0.2, -1.0, -0.3]\n\
+                        intensity = [6.0, 6.0, 6.0]\ncutoff_angle = 40.0\nfalloff_start_angle = 30.0";
+    pub const QUAD: &str = "[[light]]\ntype = \"quad\"\ncorner = [-0.25, 0.999, -0.25]\nedge_u = [0.5, 0.0, 0.0]\n\
+                        edge_v = [0.0, 0.0, 0.5]\nradiance = [12.0, 12.0, 12.0]";
+    pub const SUN: &str =
+        "[[light]]\ntype = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\nirradiance = [3.0, 3.0, 3.0]";
+    pub const SKY: &str = "[environment]\nradiance = [1.0, 1.0, 1.0]";
+    /// Each with its name.
+    pub const ALL: [(&str, &str); 5] = [("point", POINT), ("spot", SPOT), ("quad", QUAD), ("sun", SUN), ("sky", SKY)];
+}

@@ -354,8 +354,8 @@ impl GpuRenderer {
             specular_pass,
             gbuffer_binding: gbuffer_pass.bind(device, &scene_buffers, &targets.gbuffer),
             gbuffer_pass,
-            global_splat: splat_pass.bind(device, &targets.gbuffer),
-            caustic_splat: splat_pass.bind(device, &targets.gbuffer),
+            global_splat: splat_pass.bind(device, &targets.gbuffer, &scene_buffers.surfaces),
+            caustic_splat: splat_pass.bind(device, &targets.gbuffer, &scene_buffers.surfaces),
             splat_pass,
             direct_binding: direct_pass.bind(
                 device,
@@ -462,6 +462,8 @@ impl GpuRenderer {
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         self.scene = SceneBuffers::upload(device, scene);
         self.gbuffer_binding = self.gbuffer_pass.bind(device, &self.scene, &self.targets.gbuffer);
+        self.global_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
+        self.caustic_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
         self.bounds = scene.accel.bounds();
         let lights = GpuLights::new(scene, self.settings.area_light_samples);
         if !self.targets.shadow_maps.update(queue, &lights, self.bounds) {
@@ -502,6 +504,8 @@ impl GpuRenderer {
             power_unit: self.power_unit,
             normal_test: estimate.normal_test as u32,
             _pad: 0,
+            camera_position: self.camera_position.to_array(),
+            _pad1: 0,
         }
     }
 
@@ -547,7 +551,7 @@ impl GpuRenderer {
             // A first guess: four tiles a photon, settled by `render`.
             let entries = output.capacity().saturating_mul(4).clamp(1024, self.max_tile_entries());
             let (device, gbuffer) = (&self.ctx.device, &self.targets.gbuffer);
-            pass.bind(device, gbuffer, &self.media, kind, output, target, entries, 1, budget)
+            pass.bind(device, gbuffer, &self.media, kind, output, &self.scene.surfaces, target, entries, 1, budget)
         });
         pass.record(&self.ctx.queue, encoder, tiled, params, output, budget);
     }
@@ -580,8 +584,11 @@ impl GpuRenderer {
                 let device = &self.ctx.device;
                 let gbuffer = &self.targets.gbuffer;
                 let media = &self.media;
-                *binding =
-                    Some(self.tiled_pass().bind(device, gbuffer, media, kind, output, target, entries, slices, budget));
+                let surfaces = &self.scene.surfaces;
+                *binding = Some(
+                    self.tiled_pass()
+                        .bind(device, gbuffer, media, kind, output, surfaces, target, entries, slices, budget),
+                );
                 rerun = true;
             }
             if !rerun {

@@ -43,6 +43,15 @@ pub struct GpuSurface {
     pub specular: [f32; 3],
     /// 1 where `emission` leaves both faces (two-sided emissive meshes).
     pub two_sided: u32,
+    /// The glTF BRDF's parameters (`hikari_core::bsdf::Bsdf`) where
+    /// `glossy` is 1; `albedo` is then its base colour.
+    pub metallic: f32,
+    pub roughness: f32,
+    pub specular_factor: f32,
+    /// 1: a kind-0 surface reflecting by the glTF BRDF (a `Pbr` material
+    /// with a specular lobe); 0: Lambertian `albedo`, plus the mirror part
+    /// `specular`.
+    pub glossy: u32,
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -164,31 +173,6 @@ pub fn approximated_materials(scene: &Scene) -> Option<String> {
     (!why.is_empty()).then(|| why.join("; "))
 }
 
-/// How the GPU draws a glTF BRDF until it evaluates it (see
-/// [`approximated_materials`]): (Lambert albedo, mirror reflectance). A
-/// lobe the CPU's eye would follow (smoother than `GATHER_ROUGHNESS`) is a
-/// mirror of its normal-incidence reflectance; a rougher one adds its
-/// estimated albedo to the diffuse part, so a rough metal is not black.
-pub fn pbr_as_diffuse_and_mirror(bsdf: &hikari_core::bsdf::Bsdf) -> (Vec3, Vec3) {
-    let lambert = bsdf.lambert_albedo();
-    if !bsdf.has_specular() {
-        (lambert, Vec3::ZERO)
-    } else if bsdf.gathers_specular() {
-        (bsdf.albedo_estimate().min(Vec3::ONE), Vec3::ZERO)
-    } else {
-        let mirror = bsdf.normal_reflectance();
-        (lambert.min(Vec3::ONE - mirror), mirror)
-    }
-}
-
-/// The mirror part the GPU gives a material (its `GpuSurface::specular`).
-pub fn gpu_mirror_reflectance(material: &Material) -> Vec3 {
-    match material {
-        Material::Pbr(bsdf) => pbr_as_diffuse_and_mirror(bsdf).1,
-        other => other.mirror_reflectance(),
-    }
-}
-
 pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
     scene
         .surfaces
@@ -200,9 +184,7 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 Material::Mirror { reflectance } => (kind::MIRROR, *reflectance, 1.0),
                 Material::Glass { ior } => (kind::GLASS, Vec3::ONE, *ior),
                 Material::Emitter => (kind::EMITTER, Vec3::ZERO, 1.0),
-                // Until the GPU evaluates the BRDF: its Lambert part, and a
-                // smooth lobe as a mirror (`renderer::approximated_materials`).
-                Material::Pbr(bsdf) => (kind::DIFFUSE, pbr_as_diffuse_and_mirror(bsdf).0, 1.0),
+                Material::Pbr(bsdf) => (kind::DIFFUSE, bsdf.base_color, 1.0),
             };
             // What the eye sees besides what the surface reflects.
             let (emission, two_sided) = s.emitter.map_or((Vec3::ZERO, false), |l| match &scene.lights[l as usize] {
@@ -211,13 +193,26 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 hikari_core::light::Light::Mesh(mesh) => (mesh.radiance, mesh.two_sided),
                 _ => (Vec3::ZERO, false),
             });
+            // The glTF BRDF where it has a specular lobe; exactly
+            // Lambertian ones (and the old materials) take the cheaper path.
+            let glossy = match material {
+                Material::Pbr(bsdf) if bsdf.has_specular() => Some(bsdf),
+                _ => None,
+            };
             GpuSurface {
                 albedo: albedo.to_array(),
                 kind,
                 emission: emission.to_array(),
                 ior,
-                specular: if kind == kind::DIFFUSE { gpu_mirror_reflectance(material).to_array() } else { [0.0; 3] },
+                specular: match material {
+                    Material::Diffuse { specular, .. } => specular.to_array(),
+                    _ => [0.0; 3],
+                },
                 two_sided: two_sided as u32,
+                metallic: glossy.map_or(0.0, |b| b.metallic),
+                roughness: glossy.map_or(1.0, |b| b.roughness),
+                specular_factor: glossy.map_or(0.0, |b| b.specular),
+                glossy: glossy.is_some() as u32,
             }
         })
         .collect()

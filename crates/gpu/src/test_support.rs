@@ -28,6 +28,50 @@ pub fn media_context(test: &str, scene: &Scene) -> Option<GpuContext> {
     None
 }
 
+/// Runs `main` of `source` (composed after `modules`) over `count`
+/// invocations with one read-write buffer `io` of `words` u32 initialised
+/// from `input`, and returns the buffer.
+pub fn run_kernel(ctx: &GpuContext, modules: &[&crate::wgsl::Module], main: &str, input: &[u32]) -> Vec<u32> {
+    let kernel = format!(
+        "@group(0) @binding(0) var<storage, read_write> io: array<u32>;\n\
+         @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n{main}\n}}\n"
+    );
+    let source = crate::wgsl::compose(modules) + &kernel;
+    let device = &ctx.device;
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("kernel"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: None,
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    use wgpu::util::DeviceExt;
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(input),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.dispatch_workgroups((input.len() as u32).div_ceil(64), 1, 1);
+    }
+    ctx.queue.submit([encoder.finish()]);
+    crate::readback::read_u32s(ctx, &buffer, input.len() as u64).unwrap()
+}
+
 /// A camera at `size`×`size` with the eye close to `cornell-box`'s floor,
 /// looking down into the corner: photon spheres there cross the near plane
 /// and lie behind the eye, the hard case for a splat's or a tile's footprint.

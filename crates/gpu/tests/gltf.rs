@@ -73,21 +73,3 @@ fn lambertian_gltf_files_are_drawn_exactly_and_glossy_ones_say_why_not() {
     let why = approximated_materials(&showcase).expect("the showcase has glossy materials");
     assert!(why.contains("glossy"), "{why}");
 }
-
-/// The GPU's stand-in for the glTF BRDF: Lambert stays Lambert, a lobe the
-/// CPU's eye follows is a mirror of its normal-incidence reflectance, a
-/// rough lobe adds its albedo to the diffuse part (a rough metal is not black).
-#[test]
-fn glossy_materials_have_a_reasonable_gpu_stand_in() {
-    use glam::Vec3;
-    use hikari_core::bsdf::Bsdf;
-    use hikari_gpu::scene_upload::pbr_as_diffuse_and_mirror;
-    let gold = Vec3::new(0.9, 0.7, 0.4);
-    assert_eq!(pbr_as_diffuse_and_mirror(&Bsdf::new(gold, 0.0, 0.5, 0.0)), (gold, Vec3::ZERO));
-    let (albedo, mirror) = pbr_as_diffuse_and_mirror(&Bsdf::new(gold, 1.0, 0.1, 1.0));
-    assert_eq!(albedo, Vec3::ZERO);
-    assert!((mirror - gold).abs().max_element() < 1e-6, "{mirror}");
-    let (albedo, mirror) = pbr_as_diffuse_and_mirror(&Bsdf::new(gold, 1.0, 0.8, 1.0));
-    assert_eq!(mirror, Vec3::ZERO);
-    assert!(albedo.min_element() > 0.3 && albedo.max_element() <= 1.0, "{albedo}");
-}

@@ -80,9 +80,19 @@ macro_rules! assert_layout {
 fn shared_structs_match_wgsl_layouts() {
     let gbuffer = hikari_gpu::gbuffer::shader_source();
     assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
-    assert_layout!(gbuffer, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, two_sided]);
+    assert_layout!(
+        gbuffer,
+        "Surface",
+        GpuSurface,
+        [albedo, kind, emission, ior, specular, two_sided, metallic, roughness, specular_factor, glossy]
+    );
     let splat = hikari_gpu::splat::shader_source();
-    assert_layout!(splat, "SplatParams", SplatParams, [clip_from_world, radius, power_unit, normal_test, _pad]);
+    assert_layout!(
+        splat,
+        "SplatParams",
+        SplatParams,
+        [clip_from_world, radius, power_unit, normal_test, _pad, camera_position, _pad1]
+    );
     let shadow = hikari_gpu::shadow::shader_source();
     assert_layout!(shadow, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
     let direct = hikari_gpu::direct::shader_source();
@@ -148,7 +158,6 @@ fn shared_structs_match_wgsl_layouts() {
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
-    assert_layout!(specular, "Surface", GpuSurface, [albedo, kind, emission, ior, specular, two_sided]);
     assert_layout!(specular, "SliceParams", hikari_gpu::specular::SliceParams, [index, count, iteration_budget, _pad]);
     let resolve = hikari_gpu::resolve::shader_source();
     let (size, members) = wgsl_layout(&resolve, "Terms");

@@ -10,56 +10,12 @@ use hikari_core::progressive::compare;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{cornell_quad_light, quad_lights_as_meshes};
+use hikari_core::test_scenes::{cornell_quad_light, glossy_box, glossy_lights, quad_lights_as_meshes};
 use hikari_gpu::GpuContext;
-use hikari_gpu::test_support::{sky_over_a_box, sun_and_sky_in_fog, sun_over_a_box, test_context};
+use hikari_gpu::test_support::{run_kernel, sky_over_a_box, sun_and_sky_in_fog, sun_over_a_box, test_context};
 use hikari_gpu::trace::GpuTracer;
-use hikari_gpu::wgsl::{Module, PHOTON_ENCODING, RANDOM, SAMPLING, compose};
+use hikari_gpu::wgsl::{PHOTON_ENCODING, RANDOM, SAMPLING};
 use std::collections::HashMap;
-
-/// Runs `main` of `source` (composed after `modules`) over `count`
-/// invocations with one read-write buffer `io` of `words` u32 initialised
-/// from `input`, and returns the buffer.
-fn run_kernel(ctx: &GpuContext, modules: &[&Module], main: &str, input: &[u32]) -> Vec<u32> {
-    let kernel = format!(
-        "@group(0) @binding(0) var<storage, read_write> io: array<u32>;\n\
-         @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n{main}\n}}\n"
-    );
-    let source = compose(modules) + &kernel;
-    let device = &ctx.device;
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("kernel"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: None,
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    use wgpu::util::DeviceExt;
-    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(input),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-    });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind_group, &[]);
-        pass.dispatch_workgroups((input.len() as u32).div_ceil(64), 1, 1);
-    }
-    ctx.queue.submit([encoder.finish()]);
-    hikari_gpu::readback::read_u32s(ctx, &buffer, input.len() as u64).unwrap()
-}
 
 /// random.wgsl draws the same numbers as `Rng::for_item`.
 #[test]
@@ -366,6 +322,8 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("sun and sky in fog", sun_and_sky_in_fog(32)),
         ("cornell mesh light", quad_lights_as_meshes(&cornell_quad_light(16))),
         ("cornell two-sided mesh light", two_sided(quad_lights_as_meshes(&cornell_quad_light(16)))),
+        ("glossy box, quad light", glossy_box(glossy_lights::QUAD, 16)),
+        ("glossy box, sky", glossy_box(glossy_lights::SKY, 16)),
     ]
 }
 

@@ -4,7 +4,9 @@
 //! different order).
 
 use glam::Vec3;
-use hikari_core::estimate::{FixedRadius, fixed_radius_radiance};
+use hikari_core::bsdf::ShadingFrame;
+use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf};
+use hikari_core::material::Material;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_seed};
@@ -83,14 +85,21 @@ fn twin_pass(
             if position[i].w == 0.0 || albedo[i].w != 0.0 {
                 continue; // no surface, or not diffuse
             }
-            let want = fixed_radius_radiance(
-                map,
-                None,
-                position[i].truncate(),
-                normal[i].truncate(),
-                albedo[i].truncate(),
-                params,
-            );
+            let (x, n) = (position[i].truncate(), normal[i].truncate());
+            // The glTF BRDF weights each photon by f at its own direction
+            // (the lobes the maps stand for); Lambertian surfaces by ρ/π.
+            let material = scene.materials[scene.surfaces[normal[i].w as usize].material as usize];
+            let want = match material {
+                Material::Pbr(bsdf) if bsdf.has_specular() => {
+                    let frame = ShadingFrame::new(n);
+                    let wo = frame.to_local((scene.camera.position - x).normalize());
+                    fixed_radius_radiance_brdf(map, x, n, params, |wi| {
+                        let wi = frame.to_local(wi);
+                        if bsdf.gathers_specular() { bsdf.f(wo, wi) } else { bsdf.f_diffuse(wo, wi) }
+                    })
+                }
+                _ => fixed_radius_radiance(map, None, x, n, albedo[i].truncate(), params),
+            };
             let got: Vec3 = gpu_image[i].truncate();
             if want.max_element() == 0.0 && got.max_element() == 0.0 {
                 continue;
@@ -197,6 +206,23 @@ fn gpu_splat_equals_cpu_estimate_under_a_sky_and_an_emissive_mesh() {
         for estimator in ESTIMATORS {
             let (indirect, _) = twin_scene(scene.clone(), photons, false, estimator).expect("a twin");
             assert_twin(&format!("{name} indirect ({estimator:?})"), &indirect, min_lit);
+        }
+    }
+}
+
+/// The glTF BRDF: photons weighted by f for their own directions, on a box
+/// of metals and dielectrics from roughness 0.1 to 1 (the smoother ones
+/// gathering their diffuse lobe only), both estimators, with and without
+/// the normal test, under a quad light and a sky.
+#[test]
+fn gpu_glossy_estimates_equal_cpu_estimates() {
+    use hikari_core::test_scenes::{glossy_box, glossy_lights};
+    for (light, text) in [("quad", glossy_lights::QUAD), ("sky", glossy_lights::SKY)] {
+        for (estimator, normal_test) in [(Estimator::Raster, false), (Estimator::Tiled, true)] {
+            let (indirect, caustic) = twin_scene(glossy_box(text, 64), 20_000, normal_test, estimator).expect("a twin");
+            let name = format!("glossy box, {light} ({estimator:?}, normal test {normal_test})");
+            assert_twin(&format!("{name} indirect"), &indirect, 2000);
+            assert_twin(&format!("{name} caustic"), &caustic, 20);
         }
     }
 }

@@ -21,13 +21,15 @@ use wgpu::util::DeviceExt;
 /// Workgroup side (the `WORKGROUP` override of the shader).
 const WORKGROUP: u32 = 8;
 
-/// Whether any surface is a mirror, glass or partly mirroring: the pass
-/// runs only then.
+/// Whether any surface is a mirror, glass, partly mirroring, or glossy
+/// with a lobe the eye follows (smoother than `GATHER_ROUGHNESS`): the
+/// pass runs only then.
 pub fn has_specular_surfaces(scene: &Scene) -> bool {
-    scene.surfaces.iter().any(|s| {
-        let m = &scene.materials[s.material as usize];
-        matches!(m, Material::Mirror { .. } | Material::Glass { .. })
-            || crate::scene_upload::gpu_mirror_reflectance(m).max_element() > 0.0
+    scene.surfaces.iter().any(|s| match &scene.materials[s.material as usize] {
+        Material::Mirror { .. } | Material::Glass { .. } => true,
+        Material::Diffuse { specular, .. } => specular.max_element() > 0.0,
+        Material::Pbr(bsdf) => bsdf.has_specular() && !bsdf.gathers_specular(),
+        Material::Emitter => false,
     })
 }
 

@@ -13,6 +13,9 @@ pub struct SplatParams {
     pub power_unit: f32,
     pub normal_test: u32,
     pub _pad: u32,
+    /// The eye, for glossy surfaces' BRDF.
+    pub camera_position: [f32; 3],
+    pub _pad1: u32,
 }
 
 /// The photon footprint vertex shader shared with the volume splat.
@@ -103,6 +106,7 @@ impl SplatPass {
                 entry(1, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(2, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(3, wgpu::ShaderStages::FRAGMENT, texture(D2)),
+                entry(4, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "splat", &layout);
@@ -117,8 +121,9 @@ impl SplatPass {
         SplatPass { pipeline, layout }
     }
 
-    /// The uniforms and bind group of one map's splat over `gbuffer`, made once.
-    pub fn bind(&self, device: &wgpu::Device, gbuffer: &GBuffer) -> SplatBinding {
+    /// The uniforms and bind group of one map's splat over `gbuffer` of a
+    /// scene with `surfaces` (`SceneBuffers::surfaces`), made once per scene.
+    pub fn bind(&self, device: &wgpu::Device, gbuffer: &GBuffer, surfaces: &wgpu::Buffer) -> SplatBinding {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("splat params"),
             size: std::mem::size_of::<SplatParams>() as u64,
@@ -135,6 +140,7 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&position) },
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&albedo) },
+                wgpu::BindGroupEntry { binding: 4, resource: surfaces.as_entire_binding() },
             ],
         });
         SplatBinding { uniforms, bind_group }

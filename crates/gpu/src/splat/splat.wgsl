@@ -10,12 +10,16 @@ struct SplatParams {
     power_unit: f32,
     normal_test: u32,
     _pad: u32,
+    // The eye, for glossy surfaces' BRDF.
+    camera_position: vec3<f32>,
+    _pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: SplatParams;
 @group(0) @binding(1) var gbuffer_position: texture_2d<f32>;
 @group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
 
 @fragment
 fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
@@ -26,13 +30,16 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     if (position.w == 0.0 || albedo.a != 0.0) {
         discard;
     }
-    let normal = textureLoad(gbuffer_normal, pixel, 0).xyz;
+    let g = textureLoad(gbuffer_normal, pixel, 0);
+    let normal = g.xyz;
     let d = position.xyz - in.photon_position;
     let direction = decode_octahedral_15(in.direction_and_class & 0x3fffffffu);
     if (!photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
         discard;
     }
-    let radiance = radiance_per_power(albedo.rgb, params.radius) * decode_rgb9e5(in.power_rgb9e5) * (params.power_unit * in.scale);
+    let eye = unit(params.camera_position - position.xyz);
+    let weight = photon_weight(surfaces[u32(g.w)], albedo.rgb, eye, normal, direction, params.radius);
+    let radiance = weight * decode_rgb9e5(in.power_rgb9e5) * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);
 }

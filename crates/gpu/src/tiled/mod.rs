@@ -164,6 +164,7 @@ impl TiledPass {
                 compute(13, crate::binding::uniform()),
                 compute(14, storage(true)),
                 compute(15, texture(wgpu::TextureViewDimension::D2Array)),
+                compute(16, storage(true)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "tiled", &layout);
@@ -193,6 +194,7 @@ impl TiledPass {
         media: &GpuMedia,
         map: TiledMap,
         photons: &LodOutput,
+        surfaces: &wgpu::Buffer,
         target: &wgpu::Texture,
         list_capacity: u32,
         slices: u32,
@@ -257,6 +259,7 @@ impl TiledPass {
                 whole(13, &media.params_buffer),
                 whole(14, &media.regions),
                 texture(15, &slices_view),
+                whole(16, surfaces),
             ],
         });
         TiledBinding {

@@ -61,6 +61,7 @@ struct TiledParams {
 @group(0) @binding(13) var<uniform> media: MediaParams;
 @group(0) @binding(14) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(15) var slices_tex: texture_2d_array<f32>;
+@group(0) @binding(16) var<storage, read> surfaces: array<Surface>;
 
 const TILE: u32 = 16u;
 
@@ -235,8 +236,14 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     let index = 8u * (gid.y * params.width + gid.x);
     var sum = load_sum(index);
     let position = textureLoad(gbuffer_position, pixel, 0);
-    let normal = textureLoad(gbuffer_normal, pixel, 0).xyz;
+    let g = textureLoad(gbuffer_normal, pixel, 0);
+    let normal = g.xyz;
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
+    // A glossy surface weights each photon by its BRDF (photon_weight) in
+    // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
+    let surface = surfaces[u32(g.w)];
+    let glossy = surface.glossy != 0u;
+    let eye = unit(media.camera_position - position.xyz);
     // Only visible diffuse surfaces (kind 0) take photon light.
     if (position.w != 0.0 && albedo.a == 0.0) {
         let slots = slice_slots(wid.y * params.tiles_x + wid.x);
@@ -245,11 +252,19 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
             let d = position.xyz - vec3<f32>(p.position_x, p.position_y, p.position_z);
             let direction = decode_octahedral_15(p.direction_and_class & 0x3fffffffu);
             if (photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
-                add_to_sum(&sum, decode_rgb9e5(p.power_rgb9e5) * p.scale);
+                var power = decode_rgb9e5(p.power_rgb9e5) * p.scale;
+                if (glossy) {
+                    power *= photon_brdf(surface, albedo.rgb, eye, normal, direction);
+                }
+                add_to_sum(&sum, power);
             }
         }
     }
-    finish_sum(pixel, index, sum, radiance_per_power(albedo.rgb, params.radius) * params.power_unit);
+    var factor = radiance_per_power(albedo.rgb, params.radius);
+    if (glossy) {
+        factor = vec3<f32>(radiance_per_weighted_power(params.radius));
+    }
+    finish_sum(pixel, index, sum, factor * params.power_unit);
 }
 
 // The volume map: the volume splat's chords (volume.wgsl) along the pixel's view ray.

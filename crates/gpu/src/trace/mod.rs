@@ -42,6 +42,7 @@ pub fn trace_shader_source() -> String {
             &OPTICS,
             &BVH,
             &SURFACE,
+            &crate::wgsl::BSDF,
             &SPOT,
             &PHOTON_ENCODING,
             &RECORD,

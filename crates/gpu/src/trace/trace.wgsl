@@ -139,10 +139,6 @@ fn loop_iteration() -> bool {
     return !over_budget;
 }
 
-fn mean(c: vec3<f32>) -> f32 {
-    return (c.x + c.y + c.z) / 3.0;
-}
-
 // material::reflect, written out (WGSL's reflect may round differently).
 fn mirror(dir: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return dir - 2.0 * dot(dir, n) * n;
@@ -408,6 +404,31 @@ fn trace_one(rng: ptr<function, Rng>) {
                     next_dir = refract_direction(ray.dir, n, eta, cos_i, fresnel.y);
                 }
             }
+        } else if (s.glossy != 0u) {
+            // The glTF BRDF (photon::trace's Pbr arm): stored where the
+            // photon maps stand for some lobe, then a bounce sampling the
+            // whole BRDF with roulette on the sample's weight.
+            let b = surface_bsdf(s, s.albedo);
+            if (bsdf_has_diffuse(b) || bsdf_gathers_specular(b)) {
+                store_surface(x, power, ray.dir, diffuse_bounces, specular_bounces);
+            }
+            let u_lobe = rng_next_f32(rng);
+            let u = rng_next_2d(rng);
+            let sample = bsdf_sample(b, to_shading(-ray.dir, ns), u_lobe, u);
+            if (!sample.valid) {
+                return;
+            }
+            let survive = min(rgb_mean(sample.weight), 1.0);
+            if (!(rng_next_f32(rng) < survive)) {
+                return;
+            }
+            power *= sample.weight / survive;
+            if (sample.specular && !bsdf_gathers_specular(b)) {
+                specular_bounces += 1u;
+            } else {
+                diffuse_bounces += 1u;
+            }
+            next_dir = local_to_world(sample.wi, ns);
         } else {
             let rho_d = select(vec3<f32>(0.0), s.albedo, s.kind == 0u);
             let rho_s = select(s.albedo, s.specular, s.kind == 0u);
@@ -416,8 +437,8 @@ fn trace_one(rng: ptr<function, Rng>) {
             }
             // Material::roulette.
             let xi = rng_next_f32(rng);
-            let p_d = mean(rho_d);
-            let p_s = mean(rho_s);
+            let p_d = rgb_mean(rho_d);
+            let p_s = rgb_mean(rho_s);
             if (xi < p_d) {
                 power *= rho_d / p_d;
                 diffuse_bounces += 1u;
@@ -468,8 +489,8 @@ fn media_scattering(mask: u32) -> vec4<f32> {
     let sigma_t = coefficients.sigma_t;
     let sigma_s = coefficients.sigma_s;
     var lambda = 0.0;
-    if (mean(sigma_t) > 0.0) {
-        lambda = mean(sigma_s) / mean(sigma_t);
+    if (rgb_mean(sigma_t) > 0.0) {
+        lambda = rgb_mean(sigma_s) / rgb_mean(sigma_t);
     }
     if (lambda <= 0.0) {
         return vec4<f32>(0.0);
@@ -480,7 +501,7 @@ fn media_scattering(mask: u32) -> vec4<f32> {
 
 // Media::choose_scatterer: a medium of `mask` with probability ∝ its mean σ_s.
 fn choose_scatterer(mask: u32, xi: f32) -> u32 {
-    let total = mean(mask_coefficients(mask).sigma_s);
+    let total = rgb_mean(mask_coefficients(mask).sigma_s);
     var acc = 0.0;
     var bits = mask;
     var last = firstTrailingBit(mask);
@@ -490,7 +511,7 @@ fn choose_scatterer(mask: u32, xi: f32) -> u32 {
         }
         let i = firstTrailingBit(bits);
         bits &= bits - 1u;
-        acc += mean(media[i].sigma_s) / total;
+        acc += rgb_mean(media[i].sigma_s) / total;
         last = i;
         if (xi < acc) {
             break;
@@ -569,7 +590,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
         }
         let t1 = min(t_next, t_max);
         let sigma_t = mask_coefficients(mask).sigma_t;
-        let sigma_bar = mean(sigma_t);
+        let sigma_bar = rgb_mean(sigma_t);
         if (sigma_bar > 0.0) {
             let length = t1 - t0;
             if (tau_bar + sigma_bar * length > target_depth) {

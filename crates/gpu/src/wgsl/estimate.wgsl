@@ -10,3 +10,26 @@ fn photon_accepted(d2: f32, photon_dir: vec3<f32>, normal: vec3<f32>, radius: f3
 fn radiance_per_power(albedo: vec3<f32>, radius: f32) -> vec3<f32> {
     return albedo * (1.0 / (PI * PI * radius * radius));
 }
+
+// 1 / (π r²): the estimate's factor for photons already weighted by the
+// BRDF at their own directions (estimate::fixed_radius_radiance_brdf).
+fn radiance_per_weighted_power(radius: f32) -> f32 {
+    return 1.0 / (PI * radius * radius);
+}
+
+// The BRDF a photon arriving along `photon_dir` (its travel direction) is
+// weighted by at a glossy pixel of base colour `base` on `surface`, seen
+// from `eye` (world, from the point toward the viewer), shading normal `n`:
+// the lobes the photon maps stand for (photon-cpu's `part`).
+fn photon_brdf(surface: Surface, base: vec3<f32>, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>) -> vec3<f32> {
+    return bsdf_f_gathered(surface_bsdf(surface, base), to_shading(eye, n), to_shading(-photon_dir, n));
+}
+
+// What a photon adds per unit power there: f·(1/π r²) on a glossy
+// surface, ρ/(π² r²) on a Lambertian one.
+fn photon_weight(surface: Surface, base: vec3<f32>, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>, radius: f32) -> vec3<f32> {
+    if (surface.glossy == 0u) {
+        return radiance_per_power(base, radius);
+    }
+    return photon_brdf(surface, base, eye, n, photon_dir) * radiance_per_weighted_power(radius);
+}

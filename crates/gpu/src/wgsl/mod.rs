@@ -57,6 +57,13 @@ pub static OPTICS: Module = Module { name: "optics.wgsl", source: include_str!("
 /// The per-surface material record (scene_upload::GpuSurface).
 pub static SURFACE: Module = Module { name: "surface.wgsl", source: include_str!("surface.wgsl"), requires: &[] };
 
+/// The glTF metallic–roughness BRDF (hikari_core::bsdf), and a surface's.
+pub static BSDF: Module = Module {
+    name: "bsdf.wgsl",
+    source: include_str!("bsdf.wgsl"),
+    requires: &[&CONSTANTS, &SAMPLING, &OPTICS, &SURFACE],
+};
+
 /// Mitsuba's spot falloff (hikari_core::light::spot_falloff).
 pub static SPOT: Module = Module { name: "spot.wgsl", source: include_str!("spot.wgsl"), requires: &[] };
 
@@ -81,8 +88,11 @@ pub static VOLUME_CHORD: Module = Module {
 };
 
 /// The radiance estimate (hikari_core::estimate).
-pub static ESTIMATE: Module =
-    Module { name: "estimate.wgsl", source: include_str!("estimate.wgsl"), requires: &[&CONSTANTS, &PHOTON_ENCODING] };
+pub static ESTIMATE: Module = Module {
+    name: "estimate.wgsl",
+    source: include_str!("estimate.wgsl"),
+    requires: &[&CONSTANTS, &PHOTON_ENCODING, &SURFACE, &BSDF],
+};
 
 /// `loop_iteration()` for the passes whose loops the host bounds exactly
 /// (shared WGSL calls it in every loop; the specular pass and the tracer count).

@@ -2,7 +2,10 @@
 // kind 0 diffuse (albedo ρ_d, specular ρ_s), 1 mirror (albedo is its
 // reflectance), 2 glass (ior), 3 an area light's black body. `emission`
 // leaves the front face (the geometric normal's side), or both faces when
-// `two_sided` is 1; emissive meshes emit from surfaces of any kind.
+// `two_sided` is 1; emissive meshes emit from surfaces of any kind. A
+// kind-0 surface with `glossy` 1 reflects by the glTF BRDF (bsdf.wgsl) of
+// base colour `albedo` (the G-buffer's, with textures), `metallic`,
+// `roughness` and `specular_factor`; otherwise it is Lambertian.
 
 struct Surface {
     albedo: vec3<f32>,
@@ -11,4 +14,8 @@ struct Surface {
     ior: f32,
     specular: vec3<f32>,
     two_sided: u32,
+    metallic: f32,
+    roughness: f32,
+    specular_factor: f32,
+    glossy: u32,
 }

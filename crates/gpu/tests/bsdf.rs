@@ -1,0 +1,153 @@
+//! bsdf.wgsl against hikari_core::bsdf: the same values, densities and
+//! sampled directions on random materials and directions, to float rounding.
+
+use glam::Vec3;
+use hikari_core::bsdf::{Bsdf, BsdfSample, ShadingFrame};
+use hikari_core::sampling::{Rng, uniform_sphere};
+use hikari_gpu::test_support::{run_kernel, test_context};
+use hikari_gpu::wgsl::BSDF;
+
+/// Words per item: 15 inputs, then the outputs the kernel writes.
+const ITEM: usize = 40;
+
+/// A random material, roughness spread over the smooth, followed and
+/// gathered ranges, with the extremes (black, pure metal or dielectric,
+/// no specular) often.
+fn random_bsdf(rng: &mut Rng) -> Bsdf {
+    let pick = |rng: &mut Rng, values: &[f32]| {
+        let i = (rng.next_f32() * (values.len() + 1) as f32) as usize;
+        values.get(i).copied().unwrap_or_else(|| rng.next_f32())
+    };
+    let base =
+        if rng.next_f32() < 0.05 { Vec3::ZERO } else { Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) };
+    let metallic = pick(rng, &[0.0, 1.0]);
+    let roughness = pick(rng, &[0.0, 0.03, 0.2, 0.35, 1.0]);
+    let specular = pick(rng, &[0.0, 1.0]);
+    Bsdf::new(base, metallic, roughness, specular)
+}
+
+/// A direction toward the viewer or light: mostly above the surface,
+/// sometimes grazing or below it.
+fn random_direction(rng: &mut Rng) -> Vec3 {
+    let w = uniform_sphere(rng.next_2d());
+    if rng.next_f32() < 0.85 { Vec3::new(w.x, w.y, w.z.abs()) } else { w }
+}
+
+fn flags(s: &Option<BsdfSample>) -> u32 {
+    s.map_or(0, |s| 1 | (s.is_delta as u32) << 1 | (s.specular as u32) << 2)
+}
+
+fn close(got: f32, want: f32, tolerance: f32) -> bool {
+    (got - want).abs() <= tolerance * want.abs().max(1.0)
+}
+
+#[test]
+fn wgsl_bsdf_matches_the_cpu() {
+    let ctx = test_context("wgsl_bsdf_matches_the_cpu");
+    let mut rng = Rng::for_item(18, 0);
+    let n = 8192;
+    let mut items = Vec::new();
+    let mut input = vec![0u32; n * ITEM];
+    for item in input.chunks_mut(ITEM) {
+        let (b, wo, wi) = (random_bsdf(&mut rng), random_direction(&mut rng), random_direction(&mut rng));
+        let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
+        let words = [
+            b.base_color.x,
+            b.base_color.y,
+            b.base_color.z,
+            b.metallic,
+            b.roughness,
+            b.specular,
+            wo.x,
+            wo.y,
+            wo.z,
+            wi.x,
+            wi.y,
+            wi.z,
+            u_lobe,
+            u.x,
+            u.y,
+        ];
+        for (k, w) in words.iter().enumerate() {
+            item[k] = w.to_bits();
+        }
+        items.push((b, wo, wi, u_lobe, u));
+    }
+    let main = format!(
+        "let o = {ITEM}u * id.x; if (o >= arrayLength(&io)) {{ return; }}\n\
+         let w = array<f32, 15>(bitcast<f32>(io[o]), bitcast<f32>(io[o + 1u]), bitcast<f32>(io[o + 2u]),\n\
+             bitcast<f32>(io[o + 3u]), bitcast<f32>(io[o + 4u]), bitcast<f32>(io[o + 5u]),\n\
+             bitcast<f32>(io[o + 6u]), bitcast<f32>(io[o + 7u]), bitcast<f32>(io[o + 8u]),\n\
+             bitcast<f32>(io[o + 9u]), bitcast<f32>(io[o + 10u]), bitcast<f32>(io[o + 11u]),\n\
+             bitcast<f32>(io[o + 12u]), bitcast<f32>(io[o + 13u]), bitcast<f32>(io[o + 14u]));\n\
+         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5]);\n\
+         let wo = vec3<f32>(w[6], w[7], w[8]);\n\
+         let wi = vec3<f32>(w[9], w[10], w[11]);\n\
+         let u = vec2<f32>(w[13], w[14]);\n\
+         var out: array<f32, 25>;\n\
+         let f = bsdf_f(b, wo, wi);\n\
+         let fg = bsdf_f_gathered(b, wo, wi);\n\
+         let s = bsdf_sample(b, wo, w[12], u);\n\
+         let ss = bsdf_sample_specular(b, wo, u);\n\
+         let local = to_shading(wi, normalize(wo));\n\
+         out[0] = f.x; out[1] = f.y; out[2] = f.z; out[3] = bsdf_pdf(b, wo, wi);\n\
+         out[4] = fg.x; out[5] = fg.y; out[6] = fg.z;\n\
+         out[7] = s.wi.x; out[8] = s.wi.y; out[9] = s.wi.z; out[10] = s.pdf;\n\
+         out[11] = s.weight.x; out[12] = s.weight.y; out[13] = s.weight.z;\n\
+         out[14] = ss.wi.x; out[15] = ss.wi.y; out[16] = ss.wi.z; out[17] = ss.pdf;\n\
+         out[18] = ss.weight.x; out[19] = ss.weight.y; out[20] = ss.weight.z;\n\
+         out[21] = local.x; out[22] = local.y; out[23] = local.z;\n\
+         for (var k = 0u; k < 24u; k++) {{ io[o + 15u + k] = bitcast<u32>(out[k]); }}\n\
+         io[o + 39u] = select(0u, 1u | select(0u, 2u, s.is_delta) | select(0u, 4u, s.specular), s.valid)\n\
+             | (select(0u, 1u | select(0u, 2u, ss.is_delta) | select(0u, 4u, ss.specular), ss.valid) << 8u);"
+    );
+    let gpu = run_kernel(&ctx, &[&BSDF], &main, &input);
+    // Rounding differs (WGSL's sqrt and normalize against Rust's), and a
+    // sampled direction amplifies it where the GGX lobe is narrow: compare
+    // relative to the value (at least 1).
+    const TOLERANCE: f32 = 2e-4;
+    let (mut worst, mut flag_mismatches) = (0.0f32, 0);
+    for (i, (out, (b, wo, wi, u_lobe, u))) in gpu.chunks(ITEM).zip(&items).enumerate() {
+        let g = |k: usize| f32::from_bits(out[15 + k]);
+        let f = b.f(*wo, *wi);
+        let gathered = if b.gathers_specular() { f } else { b.f_diffuse(*wo, *wi) };
+        let local = ShadingFrame::new(wo.normalize()).to_local(*wi);
+        let mut check = |name: &str, got: f32, want: f32| {
+            let err = (got - want).abs() / want.abs().max(1.0);
+            worst = worst.max(err);
+            assert!(close(got, want, TOLERANCE), "item {i} {b:?} wo {wo} wi {wi}: {name} {got} vs {want}");
+        };
+        for k in 0..3 {
+            check("f", g(k), f[k]);
+            check("f gathered", g(4 + k), gathered[k]);
+            check("to_shading", g(21 + k), local[k]);
+        }
+        check("pdf", g(3), b.pdf(*wo, *wi));
+        let samples = [(b.sample(*wo, *u_lobe, *u), 7, 0), (b.sample_specular(*wo, *u), 14, 8)];
+        for (sample, at, shift) in samples {
+            let gpu_flags = (out[39] >> shift) & 0xff;
+            if gpu_flags != flags(&sample) {
+                // A lobe choice or a direction at the horizon decided by rounding.
+                flag_mismatches += 1;
+                continue;
+            }
+            if let Some(s) = sample {
+                for k in 0..3 {
+                    check("sampled wi", g(at + k), s.wi[k]);
+                    check("sample weight", g(at + 4 + k), s.weight[k]);
+                }
+                check("sample pdf", g(at + 3), s.pdf);
+            }
+        }
+    }
+    eprintln!(
+        "bsdf.wgsl: worst relative difference {worst:e}, {flag_mismatches} of {} samples decided otherwise",
+        2 * n
+    );
+    assert!(flag_mismatches <= 4, "{flag_mismatches} samples decided otherwise");
+    // The kernel saw every kind of material the test meant to cover.
+    let smooth = items.iter().filter(|(b, ..)| b.is_delta()).count();
+    let followed = items.iter().filter(|(b, ..)| b.has_specular() && !b.is_delta() && !b.gathers_specular()).count();
+    let gathered = items.iter().filter(|(b, ..)| b.has_specular() && b.gathers_specular()).count();
+    assert!(smooth > 500 && followed > 500 && gathered > 500, "{smooth} {followed} {gathered}");
+}
