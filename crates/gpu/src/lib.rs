@@ -13,10 +13,15 @@
 //! Each pass is a small struct with its pipeline, its shader beside it;
 //! WGSL shared between passes is in `wgsl`, composed once per shader.
 //!
-//! Not on the GPU yet: the glTF metallic–roughness BRDF and textures. Such
-//! materials are drawn by a stand-in (`scene_upload::pbr_as_diffuse_and_mirror`)
-//! and reported by `scene_upload::approximated_materials`, so the CLI renders
-//! those scenes with `photon-cpu` and the viewer says it approximates.
+//! The glTF metallic–roughness BRDF is `wgsl/bsdf.wgsl`, pinned to
+//! `hikari_core::bsdf` by a test: glossy surfaces weight photons by it in
+//! both estimators, take direct light through it, sample it in the photon
+//! tracer and follow their smoother lobes in the specular pass.
+//!
+//! Not on the GPU yet: textures. Textured materials are drawn in their
+//! factors and cut-outs opaque, reported by
+//! `scene_upload::approximated_materials`, so the CLI renders those scenes
+//! with `photon-cpu` and the viewer says it approximates.
 
 pub mod accumulate;
 pub mod binding;

@@ -50,6 +50,10 @@ pub struct GpuSettings {
     pub terms: crate::resolve::Terms,
     /// How the global and caustic maps are estimated (raster splat by default).
     pub estimator: Estimator,
+    /// The progressive pass this frame is (from 1): it seeds the random
+    /// streams with which glossy points sample their lobes and area lights,
+    /// so each pass draws new samples and the passes' mean converges.
+    pub pass: u32,
 }
 
 impl GpuSettings {
@@ -66,6 +70,7 @@ impl GpuSettings {
             volume_slices: 8,
             terms: crate::resolve::Terms::ALL,
             estimator: Estimator::Raster,
+            pass: 1,
         }
     }
 }
@@ -144,7 +149,7 @@ pub struct GpuRenderer {
     caustic_splat: SplatBinding,
     shadow_pass: ShadowPass,
     direct_pass: DirectPass,
-    direct_binding: wgpu::BindGroup,
+    direct_binding: crate::direct::DirectBinding,
     specular_pass: SpecularPass,
     resolve_pass: ResolvePass,
     media: GpuMedia,
@@ -360,6 +365,7 @@ impl GpuRenderer {
             direct_binding: direct_pass.bind(
                 device,
                 &targets.gbuffer,
+                &scene_buffers.surfaces,
                 &lights,
                 &targets.shadow_maps,
                 settings.shadow_bias,
@@ -474,6 +480,7 @@ impl GpuRenderer {
         self.direct_binding = self.direct_pass.bind(
             device,
             &self.targets.gbuffer,
+            &self.scene.surfaces,
             &lights,
             &self.targets.shadow_maps,
             self.settings.shadow_bias,
@@ -755,7 +762,7 @@ impl GpuRenderer {
             Stage::OpticalDepth => self.media.record(encoder),
             Stage::Direct => {
                 let view = self.targets.direct.create_view(&Default::default());
-                self.direct_pass.record(encoder, &self.direct_binding, &view);
+                self.direct_pass.record(&self.ctx.queue, encoder, &self.direct_binding, self.settings.pass, &view);
             }
             Stage::GlobalSplat => {
                 splat(encoder, &self.global_splat, &self.global_lod, &self.settings.global, &self.targets.indirect)
@@ -781,7 +788,7 @@ impl GpuRenderer {
                 let photons = if self.has_media { &self.volume_lod } else { &self.caustic_lod };
                 self.volume_pass.record(encoder, photons, &view, self.has_media);
             }
-            Stage::Specular => self.specular_pass.record(&self.ctx.queue, encoder),
+            Stage::Specular => self.specular_pass.record(&self.ctx.queue, encoder, self.settings.pass),
             Stage::Resolve => self.resolve_pass.record(queue, encoder, &self.settings.terms),
         }
     }

@@ -142,28 +142,18 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
 }
 
 /// Why the GPU's image of `scene` is not exact, or None: the GPU passes do
-/// not evaluate the glTF BRDF yet, so a `Pbr` material with a specular lobe
-/// is drawn as its Lambert part (and a smooth lobe as a mirror of its
-/// normal-incidence reflectance). Nor do they sample textures: textured
-/// materials are drawn in their factors and cut-outs (`alphaMode` MASK)
-/// opaque. `hikari render` then renders with photon-cpu; the viewer draws
-/// the approximation and says so.
+/// not sample textures yet, so textured materials are drawn in their
+/// factors and cut-outs (`alphaMode` MASK) opaque. `hikari render` then
+/// renders with photon-cpu; the viewer draws the approximation and says so.
 pub fn approximated_materials(scene: &Scene) -> Option<String> {
     // Only the materials some surface uses (a glTF file's default material
     // is always there, used or not).
     let used: std::collections::BTreeSet<usize> = scene.surfaces.iter().map(|s| s.material as usize).collect();
-    let glossy = used.iter().filter(|&&m| matches!(scene.materials[m], Material::Pbr(b) if b.has_specular())).count();
     let textures =
         scene.texturing.as_ref().map(|t| used.iter().filter_map(move |&m| t.materials.get(m).and_then(Option::as_ref)));
     let textured = textures.clone().map_or(0, |t| t.filter(|m| m.is_textured()).count());
     let masked = textures.map_or(0, |t| t.filter(|m| m.alpha_cutoff.is_some()).count());
     let mut why = Vec::new();
-    if glossy > 0 {
-        why.push(format!(
-            "{glossy} glossy (metallic-roughness) material(s) are drawn by the GPU renderer as their diffuse part \
-             (a smooth lobe as a mirror) until it evaluates the glTF BRDF"
-        ));
-    }
     if textured > 0 {
         why.push(format!("{textured} textured material(s) are drawn by the GPU renderer in their factors"));
     }

@@ -59,8 +59,9 @@ fn the_showcase_renders_on_the_gpu() {
 
 /// Only materials that surfaces use count: a glTF file always carries the
 /// specification's default material (glossy white metal), used or not.
+/// Glossy materials are drawn exactly (the showcase's); textures are not yet.
 #[test]
-fn lambertian_gltf_files_are_drawn_exactly_and_glossy_ones_say_why_not() {
+fn untextured_gltf_files_are_drawn_exactly_and_textured_ones_say_why_not() {
     use hikari_gpu::scene_upload::approximated_materials;
     let toml = Scene::load("cornell-box").unwrap();
     let dir = std::env::temp_dir().join(format!("hikari-gpu-gltf-exact-{}", std::process::id()));
@@ -70,6 +71,11 @@ fn lambertian_gltf_files_are_drawn_exactly_and_glossy_ones_say_why_not() {
     let lambertian = Scene::load(path.to_str().unwrap()).unwrap();
     assert_eq!(approximated_materials(&lambertian), None);
     let showcase = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb")).unwrap();
-    let why = approximated_materials(&showcase).expect("the showcase has glossy materials");
-    assert!(why.contains("glossy"), "{why}");
+    assert_eq!(approximated_materials(&showcase), None);
+    // The fuzzers' textured seed: a checker base colour and a MASK cut-out.
+    let textured = hikari_core::fuzz::gltf::seed_files().pop().expect("seeds");
+    let path = dir.join("textured.glb");
+    std::fs::write(&path, textured).unwrap();
+    let why = approximated_materials(&Scene::load(path.to_str().unwrap()).unwrap()).expect("textures");
+    assert!(why.contains("textured") && why.contains("cut-out"), "{why}");
 }

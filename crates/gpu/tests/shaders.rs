@@ -96,7 +96,7 @@ fn shared_structs_match_wgsl_layouts() {
     let shadow = hikari_gpu::shadow::shader_source();
     assert_layout!(shadow, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
     let direct = hikari_gpu::direct::shader_source();
-    assert_layout!(direct, "DirectParams", DirectParams, [light_count, shadow_size, bias, _pad]);
+    assert_layout!(direct, "DirectParams", DirectParams, [light_count, shadow_size, bias, pass_index]);
     assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
     assert_layout!(
         direct,
@@ -158,7 +158,12 @@ fn shared_structs_match_wgsl_layouts() {
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
     assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
-    assert_layout!(specular, "SliceParams", hikari_gpu::specular::SliceParams, [index, count, iteration_budget, _pad]);
+    assert_layout!(
+        specular,
+        "SliceParams",
+        hikari_gpu::specular::SliceParams,
+        [index, count, iteration_budget, pass_index]
+    );
     let resolve = hikari_gpu::resolve::shader_source();
     let (size, members) = wgsl_layout(&resolve, "Terms");
     assert_eq!(size as usize, size_of::<hikari_gpu::resolve::Terms>());

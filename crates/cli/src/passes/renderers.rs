@@ -118,6 +118,8 @@ impl PassRenderer for GpuPasses<'_> {
             let traced = self.tracer.trace(self.scene, &pass_trace_settings(self.photons, self.seed, pass), &Silent);
             let s = &mut self.renderer.settings;
             [s.global.radius, s.caustic.radius, s.volume_radius] = self.schedules.radii(pass);
+            // Glossy lobes and area lights draw new samples each pass.
+            s.pass = pass;
             self.renderer.set_photons(self.scene, &traced)?;
             // One sample per pixel a pass: each pass samples another point of the pixel.
             let mut camera = self.renderer.camera().clone();

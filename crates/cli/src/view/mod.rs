@@ -580,6 +580,8 @@ impl Viewer {
             let settings = &mut session.renderer.settings;
             (settings.global.radius, settings.caustic.radius, settings.volume_radius) = (global, caustic, volume);
             (settings.global.normal_test, settings.caustic.normal_test) = (progressive, progressive);
+            // Glossy lobes and area lights draw new samples each pass.
+            settings.pass = pass;
             let mut camera = session.renderer.camera().clone();
             camera.jitter = if progressive { pass_jitter(pass) } else { Vec2::ZERO };
             session.renderer.set_camera(&camera)?;

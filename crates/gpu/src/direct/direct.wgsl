@@ -11,6 +11,7 @@
 @group(0) @binding(7) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(8) var<uniform> media: MediaParams;
 @group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
+@group(0) @binding(10) var<storage, read> surfaces: array<Surface>;
 
 
 
@@ -23,6 +24,10 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         return vec4<f32>(0.0);
     }
     let x = position.xyz;
-    let n = textureLoad(gbuffer_normal, pixel, 0).xyz;
-    return vec4<f32>(direct_radiance(x, n, albedo.rgb), 1.0);
+    let g = textureLoad(gbuffer_normal, pixel, 0);
+    let n = g.xyz;
+    let r = surface_reflector(surfaces[u32(g.w)], albedo.rgb, unit(media.camera_position - x), n);
+    // Glossy points sample their lobe and area lights: a new stream each pass.
+    var rng = pixel_stream(vec2<u32>(pixel), direct_params.pass_index, 1u);
+    return vec4<f32>(direct_radiance(x, n, r, &rng), 1.0);
 }

@@ -1,10 +1,19 @@
 // Light evaluation shared by the direct-light pass and the specular pass:
-// each light's exact unshadowed irradiance times the fraction of its
+// each light's exact unshadowed light times the fraction of its
 // shadow-mapped samples that see the point (point, spot, sphere, quad,
 // sun), or, where no closed form fits, a sum over the samples each
-// evaluated on its own (sky, emissive mesh: `sampled_irradiance`). The
-// counterpart of hikari_core::render::direct_diffuse, which integrates the
-// same by shadow rays. The includer declares `direct_params`, `lights`,
+// evaluated on its own (sky, emissive mesh: `sampled_radiance`). The
+// counterpart of hikari_core::render::direct_diffuse and direct_reflected,
+// which integrate the same by shadow rays.
+//
+// A Lambertian point takes the closed-form irradiance. A glossy point
+// (the glTF BRDF, `Reflector`) takes f at the light's direction for point,
+// spot and sun (exact); for sphere and quad lights the unshadowed integral
+// of f·L·cos over the light is estimated with `AREA_SAMPLES` light samples
+// and as many BRDF samples, weighted by multiple importance sampling, from
+// the caller's random stream (a new one each progressive pass, so passes
+// converge), and the sky's from BRDF samples alone (`sky_glossy`). The
+// shadow-mapped samples give the fraction seen, as for Lambertian points. The includer declares `direct_params`, `lights`,
 // `samples`, `views`, `shadow_maps`, and `light_transmittance(x, end)` (the
 // media's transmittance from x to a point toward the light; 1 where media
 // are not drawn).
@@ -14,7 +23,9 @@ struct DirectParams {
     shadow_size: u32,
     // Depth bias, as a fraction of the distance to the light sample.
     bias: f32,
-    _pad: u32,
+    // The progressive pass (from 1), seeding the direct pass's random
+    // streams (the specular pass seeds its own).
+    pass_index: u32,
 }
 
 // Kinds (light_samples::kind): 0 point, 1 spot, 2 sphere, 3 quad, 4 sun,
@@ -149,16 +160,186 @@ fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
     return shadow_depth(view, xs) <= stored * (1.0 + direct_params.bias);
 }
 
-// Irradiance at x (normal n) from a light whose samples are each evaluated
-// on their own, shadowed:
-// * the sky (radiance L from every direction): πL, what the upper
-//   hemisphere gives, times the cosine-weighted fraction of its K fixed
-//   directions that see x. Exact where all or none see it; in between a
-//   sky seen through K hard shadows, as an area light is N hard shadows.
-// * an emissive mesh: Σ_k L·a·cos_l·cos_x/(d² + a/π) over its N points,
+// How the shaded point reflects toward the viewer: Lambertian `albedo`, or
+// (glossy) the glTF BRDF `bsdf` seen from `wo` (shading frame of the normal).
+struct Reflector {
+    albedo: vec3<f32>,
+    glossy: bool,
+    bsdf: Bsdf,
+    wo: vec3<f32>,
+}
+
+// Surface `s` at a point of base colour `base` and shading normal `n`,
+// seen from `eye` (world, toward the viewer).
+fn surface_reflector(s: Surface, base: vec3<f32>, eye: vec3<f32>, n: vec3<f32>) -> Reflector {
+    return Reflector(base, s.glossy != 0u, surface_bsdf(s, base), to_shading(eye, n));
+}
+
+// f toward the world direction `wi` (every non-delta lobe).
+fn reflector_f(r: Reflector, n: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (!r.glossy) {
+        return r.albedo / PI;
+    }
+    return bsdf_f(r.bsdf, r.wo, to_shading(wi, n));
+}
+
+// Light and BRDF samples per sphere or quad light and glossy point.
+const AREA_SAMPLES: u32 = 4u;
+
+// Veach's power heuristic for a sample of density a against b, written so
+// that neither square overflows.
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    if (a <= 0.0) {
+        return 0.0;
+    }
+    let ratio = b / a;
+    return 1.0 / (1.0 + ratio * ratio);
+}
+
+// A BRDF sample for the area-light and sky estimates: a non-delta direction
+// (the mirror of smooth lobes is the specular pass's), or `valid` false.
+fn glossy_sample(r: Reflector, rng: ptr<function, u32>) -> BsdfSample {
+    let u_lobe = stream_next_f32(rng);
+    let s = bsdf_sample(r.bsdf, r.wo, u_lobe, stream_next_2d(rng));
+    if (s.is_delta) {
+        return no_bsdf_sample();
+    }
+    return s;
+}
+
+// ∫ f L cos dω over sphere or quad light l, unshadowed, at a glossy point:
+// light samples (uniform on the quad, uniform in the sphere's cone) and
+// BRDF samples combined by the power heuristic.
+fn area_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    if (l.kind == 2u) {
+        let to_centre = l.position - x;
+        let dc2 = dot(to_centre, to_centre);
+        let r2 = l.cutoff * l.cutoff;
+        if (dc2 <= r2) {
+            return vec3<f32>(0.0);
+        }
+        let axis = to_centre / sqrt(dc2);
+        let sin2_max = r2 / dc2;
+        let cos_max = sqrt(max(1.0 - sin2_max, 0.0));
+        // 1 − cos θmax without cancellation for small or distant spheres.
+        let pdf_cone = 1.0 / (2.0 * PI * (sin2_max / (1.0 + cos_max)));
+        for (var k = 0u; k < AREA_SAMPLES; k++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            let wi = local_to_world(uniform_cone(stream_next_2d(rng), cos_max), axis);
+            let local = to_shading(wi, n);
+            if (local.z > 0.0) {
+                let f = bsdf_f(r.bsdf, r.wo, local);
+                sum += f * (local.z / pdf_cone * power_heuristic(pdf_cone, bsdf_pdf(r.bsdf, r.wo, local)));
+            }
+            let s = glossy_sample(r, rng);
+            if (s.valid && dot(local_to_world(s.wi, n), axis) >= cos_max) {
+                sum += s.weight * power_heuristic(s.pdf, pdf_cone);
+            }
+        }
+    } else {
+        let normal = cross(l.axis, l.edge_v);
+        let area = length(normal);
+        let nl = normal / area;
+        // Its two edges' Gram matrix, to find where a ray crosses it.
+        let uu = dot(l.axis, l.axis);
+        let uv = dot(l.axis, l.edge_v);
+        let vv = dot(l.edge_v, l.edge_v);
+        let det = uu * vv - uv * uv;
+        for (var k = 0u; k < AREA_SAMPLES; k++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            let u = stream_next_2d(rng);
+            let to_light = l.position + l.axis * u.x + l.edge_v * u.y - x;
+            let d2 = dot(to_light, to_light);
+            let wi = to_light / sqrt(d2);
+            let cos_l = -dot(wi, nl);
+            let local = to_shading(wi, n);
+            if (cos_l > 0.0 && local.z > 0.0) {
+                let pdf_light = d2 / (area * cos_l);
+                let f = bsdf_f(r.bsdf, r.wo, local);
+                sum += f * (local.z / pdf_light * power_heuristic(pdf_light, bsdf_pdf(r.bsdf, r.wo, local)));
+            }
+            let s = glossy_sample(r, rng);
+            if (!s.valid) {
+                continue;
+            }
+            let dir = local_to_world(s.wi, n);
+            let facing = -dot(dir, nl);
+            if (facing <= 0.0) {
+                continue;
+            }
+            let t = dot(x - l.position, nl) / facing;
+            let q = x + dir * t - l.position;
+            let qu = dot(q, l.axis);
+            let qv = dot(q, l.edge_v);
+            let a = (qu * vv - qv * uv) / det;
+            let b = (qv * uu - qu * uv) / det;
+            if (t > 0.0 && a >= 0.0 && a <= 1.0 && b >= 0.0 && b <= 1.0) {
+                let pdf_light = t * t / (area * facing);
+                sum += s.weight * power_heuristic(s.pdf, pdf_light);
+            }
+        }
+    }
+    return l.emission * sum / f32(AREA_SAMPLES);
+}
+
+// The sky's light reflected at a glossy point x: L·∫f cos·V dω by BRDF
+// samples, the visibility V of each sampled direction taken from the
+// nearest of the sky's K shadow-mapped directions (each stands for its
+// cell of the sphere, as an area light's N points stand for theirs), with
+// the media's transmittance toward it. Exact where the whole sky or none of
+// it is seen; a narrow lobe pointing at a wall is shadowed by that wall,
+// which weighting the K directions by f could not see.
+fn sky_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var m = 0u; m < AREA_SAMPLES; m++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let b = glossy_sample(r, rng);
+        if (!b.valid) {
+            continue;
+        }
+        let wi = local_to_world(b.wi, n);
+        var nearest = 0u;
+        var best = -2.0;
+        for (var k = 0u; k < l.sample_count; k++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            let c = dot(wi, samples[l.first_sample + k].direction);
+            if (c > best) {
+                best = c;
+                nearest = k;
+            }
+        }
+        let s = samples[l.first_sample + nearest];
+        if (visible(s, x, n)) {
+            sum += b.weight * light_transmittance(x, distant_start(l, x, s.direction));
+        }
+    }
+    return l.emission * sum / f32(AREA_SAMPLES);
+}
+
+// Radiance reflected at x (normal n) from a light whose samples are each
+// evaluated on their own, shadowed:
+// * the sky (radiance L from every direction): a Lambertian point takes
+//   πL·ρ/π, what the upper hemisphere gives, times the cosine-weighted
+//   fraction of its K fixed directions that see x. Exact where all or none
+//   see it; in between a sky seen through K hard shadows, as an area light
+//   is N hard shadows. A glossy point: `sky_glossy`.
+// * an emissive mesh: Σ_k f·L·a·cos_l·cos_x/(d² + a/π) over its N points,
 //   each standing for its share a = A/N of the area (the small-disc form of
-//   a/d²), one-sided unless two-sided.
-fn sampled_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+//   a/d²), one-sided unless two-sided. On a glossy point a quadrature of
+//   the lobe by N points: exact as N grows (documented).
+fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
+    if (l.kind == KIND_SKY && r.glossy) {
+        return sky_glossy(l, x, n, r, rng);
+    }
     var seen = vec3<f32>(0.0);
     var total_weight = 0.0;
     for (var k = 0u; k < l.sample_count; k++) {
@@ -168,6 +349,7 @@ fn sampled_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         let s = samples[l.first_sample + k];
         var weight = 0.0;
         var end = s.position;
+        var f = vec3<f32>(1.0);
         if (l.kind == KIND_SKY) {
             weight = max(dot(n, s.direction), 0.0);
             total_weight += weight;
@@ -187,23 +369,28 @@ fn sampled_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             // axis that gives L·a/(d² + a/π) exactly, which stays finite
             // (at most πL) where a point's a/d² would not.
             weight = max(dot(n, wi), 0.0) * max(cos_l, 0.0) / (d2 + l.sample_area / PI);
+            if (r.glossy) {
+                f = reflector_f(r, n, wi);
+            }
         }
         if (weight > 0.0 && visible(s, x, n)) {
-            seen += weight * light_transmittance(x, end);
+            seen += weight * f * light_transmittance(x, end);
         }
     }
     if (l.kind == KIND_SKY) {
         if (total_weight <= 0.0) {
             return vec3<f32>(0.0);
         }
-        return l.emission * PI * seen / total_weight;
+        return r.albedo * l.emission * seen / total_weight;
+    }
+    if (!r.glossy) {
+        return r.albedo / PI * l.emission * l.sample_area * seen;
     }
     return l.emission * l.sample_area * seen;
 }
 
-
-// Direct radiance leaving a diffuse point x (normal n toward the viewer).
-fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
+// Direct radiance leaving x (normal n toward the viewer) toward the viewer.
+fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < direct_params.light_count; i++) {
         if (!loop_iteration()) {
@@ -211,7 +398,7 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
         }
         let l = lights[i];
         if (l.kind == KIND_SKY || l.kind == KIND_MESH) {
-            sum += sampled_irradiance(l, x, n);
+            sum += sampled_radiance(l, x, n, r, rng);
             continue;
         }
         let e = unshadowed_irradiance(l, x, n);
@@ -232,7 +419,19 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>) -> vec3<f32> {
                 seen += light_transmittance(x, end);
             }
         }
-        sum += e * (seen / f32(l.sample_count));
+        let fraction = seen / f32(l.sample_count);
+        if (!r.glossy) {
+            sum += r.albedo / PI * e * fraction;
+        } else if (l.kind == 2u || l.kind == 3u) {
+            sum += area_glossy(l, x, n, r, rng) * fraction;
+        } else {
+            // Point, spot, sun: one direction, f exact.
+            var wi = l.axis;
+            if (l.kind != KIND_SUN) {
+                wi = unit(l.position - x);
+            }
+            sum += reflector_f(r, n, wi) * e * fraction;
+        }
     }
-    return albedo / PI * sum;
+    return sum;
 }

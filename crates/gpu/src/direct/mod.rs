@@ -11,22 +11,45 @@ use wgpu::util::DeviceExt;
 pub static LIGHT_EVAL: crate::wgsl::Module = crate::wgsl::Module {
     name: "light_eval.wgsl",
     source: include_str!("light_eval.wgsl"),
-    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::SPOT, &crate::shadow::SHADOW_VIEW],
+    requires: &[
+        &crate::wgsl::CONSTANTS,
+        &crate::wgsl::SPOT,
+        &crate::shadow::SHADOW_VIEW,
+        &crate::wgsl::RANDOM,
+        &crate::wgsl::SAMPLING,
+        &crate::wgsl::BSDF,
+    ],
 };
 
 pub fn shader_source() -> String {
     use crate::wgsl::{FULLSCREEN, Module, UNCOUNTED_LOOPS, compose};
     static DIRECT: Module = Module { name: "direct.wgsl", source: include_str!("direct.wgsl"), requires: &[] };
-    compose(&[&UNCOUNTED_LOOPS, &FULLSCREEN, &crate::media::MEDIA, &LIGHT_EVAL, &DIRECT])
+    compose(&[&UNCOUNTED_LOOPS, &FULLSCREEN, &crate::media::MEDIA, &crate::wgsl::SURFACE, &LIGHT_EVAL, &DIRECT])
 }
 
-/// Loop iterations one pixel of the direct pass runs at most: per light,
-/// the quad's 4 corners, then per sample (every light's, the sky's
-/// directions and a mesh's points included) the region triangles crossed
-/// on the way to the light (light_eval.wgsl's `direct_radiance` and
-/// `sampled_irradiance`).
+/// Light and BRDF samples per area light at a glossy point (`AREA_SAMPLES`
+/// in light_eval.wgsl; a test reads it back).
+pub const AREA_SAMPLES: u32 = 4;
+
+/// Loop iterations one pixel of the direct pass runs at most (a bound):
+/// per light, the quad's 4 corners and a glossy point's `AREA_SAMPLES`, then per
+/// sample (every light's, the sky's directions and a mesh's points
+/// included) the region triangles crossed on the way to the light
+/// (light_eval.wgsl's `direct_radiance` and `sampled_radiance`).
+/// A glossy point's sky (`sky_glossy`) adds, per BRDF sample, a search of
+/// the sky's directions and the region triangles toward the nearest.
 pub fn loop_iterations(lights: &GpuLights, region_triangles: usize) -> u64 {
-    lights.lights.iter().map(|l| 1 + 4 + l.sample_count as u64 * (1 + region_triangles as u64)).sum()
+    let per_light = 1 + 4 + AREA_SAMPLES as u64;
+    let regions = region_triangles as u64;
+    lights
+        .lights
+        .iter()
+        .map(|l| {
+            let samples = l.sample_count as u64;
+            let sky_search = AREA_SAMPLES as u64 * (samples + regions);
+            per_light + samples * (1 + regions) + sky_search
+        })
+        .sum()
 }
 
 /// Mirrors `DirectParams` in direct.wgsl.
@@ -36,7 +59,8 @@ pub struct DirectParams {
     pub light_count: u32,
     pub shadow_size: u32,
     pub bias: f32,
-    pub _pad: u32,
+    /// The progressive pass (from 1): the direct pass's random streams.
+    pub pass_index: u32,
 }
 
 pub struct DirectPass {
@@ -66,6 +90,7 @@ impl DirectPass {
                 entry(7, texture(D2)),
                 entry(8, uniform()),
                 entry(9, storage(true)),
+                entry(10, storage(true)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "direct", &layout);
@@ -73,22 +98,26 @@ impl DirectPass {
         DirectPass { pipeline, layout }
     }
 
-    /// The bind group of frames over `gbuffer` with these lights, shadow
-    /// maps and media, made once (all of it is static between frames).
+    /// The bind group of frames over `gbuffer` of a scene with `surfaces`
+    /// and these lights, shadow maps and media, made once per scene (only
+    /// the pass number changes between frames: `record`).
+    #[allow(clippy::too_many_arguments)]
     pub fn bind(
         &self,
         device: &wgpu::Device,
         gbuffer: &GBuffer,
+        surfaces: &wgpu::Buffer,
         lights: &GpuLights,
         maps: &ShadowMaps,
         bias: f32,
         media: &crate::media::GpuMedia,
-    ) -> wgpu::BindGroup {
-        let params = DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, _pad: 0 };
+    ) -> DirectBinding {
+        let params =
+            DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, pass_index: 1 };
         let uniforms = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("direct params"),
             contents: bytemuck::bytes_of(&params),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         let storage = |label, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -106,7 +135,7 @@ impl DirectPass {
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("direct"),
             layout: &self.layout,
             entries: &[
@@ -120,15 +149,43 @@ impl DirectPass {
                 wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&albedo) },
                 wgpu::BindGroupEntry { binding: 8, resource: media.params_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 10, resource: surfaces.as_entire_binding() },
             ],
-        })
+        });
+        DirectBinding { bind_group, uniforms, params }
     }
 
-    /// Shades every pixel of `target` with the bind group of `bind`.
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, bind_group: &wgpu::BindGroup, target: &wgpu::TextureView) {
+    /// Shades every pixel of `target` for progressive pass `pass`.
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        binding: &DirectBinding,
+        pass_index: u32,
+        target: &wgpu::TextureView,
+    ) {
+        let params = DirectParams { pass_index, ..binding.params };
+        queue.write_buffer(&binding.uniforms, 0, bytemuck::bytes_of(&params));
         let mut pass = crate::binding::color_pass(encoder, "direct light", target, true);
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_bind_group(0, &binding.bind_group, &[]);
         pass.draw(0..3, 0..1);
+    }
+}
+
+/// A `DirectPass`'s state for one scene, kept between frames.
+pub struct DirectBinding {
+    bind_group: wgpu::BindGroup,
+    uniforms: wgpu::Buffer,
+    params: DirectParams,
+}
+
+#[cfg(test)]
+mod tests {
+    /// `AREA_SAMPLES` is the WGSL's.
+    #[test]
+    fn area_samples_match_the_wgsl() {
+        let line = format!("const AREA_SAMPLES: u32 = {}u;", super::AREA_SAMPLES);
+        assert!(include_str!("light_eval.wgsl").contains(&line), "light_eval.wgsl lacks `{line}`");
     }
 }

@@ -376,7 +376,10 @@ mod tests {
         let mean = sky.samples.iter().map(|s| Vec3::from(s.direction)).sum::<Vec3>() / sky.samples.len() as f32;
         assert!(mean.length() < 0.05, "mean direction {mean}");
         // The direct pass's loop bound counts every direction (and its region crossings).
-        assert_eq!(crate::direct::loop_iterations(&sky, 3), 1 + 4 + 16 * (1 + 3));
+        // Per light 1 + 4 + AREA_SAMPLES, per direction 1 + 3, and a glossy
+        // point's search of the directions per BRDF sample.
+        let area = crate::direct::AREA_SAMPLES as u64;
+        assert_eq!(crate::direct::loop_iterations(&sky, 3), 1 + 4 + area + 16 * (1 + 3) + area * (16 + 3));
         // Stratified in z: exactly half above the z = 0 plane, and about half above the floor.
         let above = |axis: usize| sky.samples.iter().filter(|s| s.direction[axis] > 0.0).count();
         assert_eq!(above(2), sky.samples.len() / 2);

@@ -99,7 +99,8 @@ pub struct SliceParams {
     pub index: u32,
     pub count: u32,
     pub iteration_budget: u32,
-    pub _pad: u32,
+    /// The progressive pass (from 1): seeds the pixels' random streams.
+    pub pass_index: u32,
 }
 
 /// Most dispatches the gathers are split into before the pass gives up.
@@ -169,7 +170,7 @@ impl SceneData {
         let bvh = FlatBvh::new(&scene.accel);
         let storage = wgpu::BufferUsages::STORAGE;
         let direct_params =
-            DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, _pad: 0 };
+            DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, pass_index: 0 };
         SceneData {
             nodes: padded_buffer(device, "bvh nodes", bytemuck::cast_slice(&bvh.nodes), storage),
             prims: padded_buffer(device, "bvh prims", bytemuck::cast_slice(&bvh.prims), storage),
@@ -547,15 +548,16 @@ impl SpecularPass {
         Ok(SpecularStatus { over_budget: words[0], most_iterations: words[1] })
     }
 
-    /// Records the pass: one dispatch per slice, after clearing the status.
-    pub fn record(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder) {
+    /// Records the pass for progressive pass `pass`: one dispatch per slice,
+    /// after clearing the status.
+    pub fn record(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, pass: u32) {
         if !self.enabled {
             return;
         }
         let count = self.slices();
         let params: Vec<u8> = (0..count)
             .flat_map(|index| {
-                let p = SliceParams { index, count, iteration_budget: self.iteration_budget, _pad: 0 };
+                let p = SliceParams { index, count, iteration_budget: self.iteration_budget, pass_index: pass };
                 let mut bytes = bytemuck::bytes_of(&p).to_vec();
                 bytes.resize(SLICE_STRIDE as usize, 0);
                 bytes

@@ -80,7 +80,8 @@ struct SliceParams {
     index: u32,
     count: u32,
     iteration_budget: u32,
-    _pad: u32,
+    // The progressive pass (from 1): seeds the pixels' random streams.
+    pass_index: u32,
 }
 
 // The spatial hash of photon_grid.rs.
@@ -92,9 +93,11 @@ fn bucket_of(cell: vec3<i32>, buckets: u32) -> u32 {
 // Fixed-radius estimate at x from one photon grid (PhotonGrid::for_each_within),
 // over this dispatch's slice of each cell's photons. A bucket shared by two
 // of the 27 cells is read twice: a photon counts only from its own cell
-// (which costs no loop, unlike remembering the buckets read).
-fn gather(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
+// (which costs no loop, unlike remembering the buckets read). A glossy
+// surface `s` weights each photon by its BRDF seen from `eye`.
+fn gather(x: vec3<f32>, n: vec3<f32>, s: Surface, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
     let centre = vec3<i32>(floor(x / radius));
+    let glossy = s.glossy != 0u;
     var power = vec3<f32>(0.0);
     for (var k = 0u; k < 27u; k++) {
         if (!loop_iteration()) {
@@ -116,11 +119,18 @@ fn gather(x: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>, radius: f32, buckets: u
             let d = p - x;
             let dir = decode_octahedral_15(grid[base + 4u] & 0x3fffffffu);
             if (photon_accepted(dot(d, d), dir, n, radius, params.normal_test != 0u)) {
-                power += decode_rgb9e5(grid[base + 3u]);
+                var p_power = decode_rgb9e5(grid[base + 3u]);
+                if (glossy) {
+                    p_power *= photon_brdf(s, s.albedo, eye, n, dir);
+                }
+                power += p_power;
             }
         }
     }
-    return radiance_per_power(albedo, radius) * power * params.power_unit;
+    if (glossy) {
+        return power * (radiance_per_weighted_power(radius) * params.power_unit);
+    }
+    return radiance_per_power(s.albedo, radius) * power * params.power_unit;
 }
 
 fn has_media() -> bool {
@@ -235,7 +245,17 @@ struct Branch {
     origin: vec3<f32>,
     depth: u32,
     dir: vec3<f32>,
+    // 0 along a glossy (non-delta) lobe's sample: what it sees emitted (and
+    // the sky) is left out, since the direct light at its start counted it
+    // (photon-cpu's `radiance_seen` without emission).
+    sees_emission: u32,
     weight: vec3<f32>,
+}
+
+// A glossy surface whose specular lobe the eye follows (smoother than
+// GATHER_ROUGHNESS; the photon maps stand for rougher ones).
+fn follows_lobe(s: Surface) -> bool {
+    return s.kind == 0u && s.glossy != 0u && s.roughness < GATHER_ROUGHNESS;
 }
 
 const STACK: u32 = 16u;
@@ -253,7 +273,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // w = 0 everywhere, so check coverage through the normal's length).
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let first = surfaces[u32(g.w)];
-    let mirror_part = first.kind == 0u && any(first.specular > vec3<f32>(0.0));
+    let mirror_part = first.kind == 0u && (any(first.specular > vec3<f32>(0.0)) || follows_lobe(first));
     if (dot(g.xyz, g.xyz) == 0.0 || (first.kind != 1u && first.kind != 2u && !mirror_part)) {
         if (slice.index + 1u == slice.count) {
             textureStore(output, pixel, vec4<f32>(0.0));
@@ -267,8 +287,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let primary = normalize(params.camera_forward + params.camera_right * sx + params.camera_up * sy);
 
     var stack: array<Branch, STACK>;
-    stack[0] = Branch(params.camera_position, 0u, primary, vec3<f32>(1.0));
+    stack[0] = Branch(params.camera_position, 0u, primary, 1u, vec3<f32>(1.0));
     var top = 1u;
+    // Glossy lobes are sampled from the pixel's stream of this pass: the
+    // same draws in every slice, so every slice retraces the same rays.
+    var path_rng = pixel_stream(id.xy, slice.pass_index, 2u);
     var radiance = vec3<f32>(0.0);
     while (top > 0u) {
         if (!loop_iteration()) {
@@ -288,7 +311,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         if (hit.t >= NO_HIT) {
             // Out of the scene: the sky (a primary ray's is the resolve's).
-            if (b.depth > 0u && slice.index == 0u) {
+            if (b.depth > 0u && slice.index == 0u && b.sees_emission != 0u) {
                 radiance += weight * params.sky_radiance;
             }
             continue;
@@ -305,29 +328,41 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let can_bounce = b.depth < params.max_depth;
         // Emitted light (Light::emitted_radiance), besides what the surface
         // reflects; a primary hit's is the G-buffer's.
-        if ((b.depth > 0u || s.kind == 3u) && slice.index == 0u && (front || s.two_sided != 0u)) {
+        if ((b.depth > 0u || s.kind == 3u) && slice.index == 0u && (front || s.two_sided != 0u) && b.sees_emission != 0u) {
             radiance += weight * s.emission;
         }
         switch s.kind {
             case 0u: {
                 // A diffuse primary hit is shaded by the raster passes; here
-                // only its mirror part is followed.
+                // only its mirror part or followed lobe is.
+                let eye = -b.dir;
                 if (b.depth > 0u) {
                     if (slice.index == 0u) {
-                        radiance += weight * direct_radiance(x, n, s.albedo);
+                        // Its own stream, so slice 0's draws leave the path's alone.
+                        var light_rng = hash_u32(path_rng ^ 0x68bc21ebu);
+                        let r = surface_reflector(s, s.albedo, eye, n);
+                        radiance += weight * direct_radiance(x, n, r, &light_rng);
                     }
-                    let g = gather(x, n, s.albedo, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
-                    let c = gather(x, n, s.albedo, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    let g = gather(x, n, s, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
+                    let c = gather(x, n, s, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
                     radiance += weight * (g + c);
                 }
-                if (any(s.specular > vec3<f32>(0.0)) && can_bounce && top < STACK) {
-                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * s.specular);
+                if (follows_lobe(s)) {
+                    // One direction of the specular lobe per pass.
+                    let sample = bsdf_sample_specular(surface_bsdf(s, s.albedo), to_shading(eye, n), stream_next_2d(&path_rng));
+                    if (sample.valid && can_bounce && top < STACK) {
+                        let dir = local_to_world(sample.wi, n);
+                        stack[top] = Branch(x, b.depth + 1u, dir, select(0u, 1u, sample.is_delta), weight * sample.weight);
+                        top += 1u;
+                    }
+                } else if (any(s.specular > vec3<f32>(0.0)) && can_bounce && top < STACK) {
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), 1u, weight * s.specular);
                     top += 1u;
                 }
             }
             case 1u: {
                 if (can_bounce && top < STACK) {
-                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * s.albedo);
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), 1u, weight * s.albedo);
                     top += 1u;
                 }
             }
@@ -340,11 +375,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     let reflectance = fresnel.x;
                     if (reflectance < 1.0 && top < STACK) {
                         let refracted = refract_direction(b.dir, n, eta, cos_i, fresnel.y);
-                        stack[top] = Branch(x, b.depth + 1u, refracted, weight * (1.0 - reflectance));
+                        stack[top] = Branch(x, b.depth + 1u, refracted, 1u, weight * (1.0 - reflectance));
                         top += 1u;
                     }
                     if (reflectance > 0.0 && top < STACK) {
-                        stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), weight * reflectance);
+                        stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), 1u, weight * reflectance);
                         top += 1u;
                     }
                 }

@@ -76,3 +76,30 @@ fn rng_next_2d(rng: ptr<function, Rng>) -> vec2<f32> {
     let y = rng_next_f32(rng);
     return vec2<f32>(x, y);
 }
+
+// Per-pixel random numbers for the passes that no CPU twin draws (the
+// direct pass's and specular pass's samples of glossy lobes and area
+// lights): PCG's output permutation as a hash (Jarzynski & Olano 2020,
+// "Hash Functions for GPU Rendering"), fed back into itself.
+fn hash_u32(x: u32) -> u32 {
+    let state = x * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// The stream of `pixel` in progressive pass `pass_index` for purpose `salt`.
+fn pixel_stream(pixel: vec2<u32>, pass_index: u32, salt: u32) -> u32 {
+    return hash_u32(hash_u32(hash_u32(pass_index ^ (salt * 0x9e3779b9u)) + pixel.x) + pixel.y);
+}
+
+// Uniform in [0, 1) from the top 24 bits of the next hash.
+fn stream_next_f32(state: ptr<function, u32>) -> f32 {
+    *state = hash_u32(*state);
+    return f32(*state >> 8u) * (1.0 / 16777216.0);
+}
+
+fn stream_next_2d(state: ptr<function, u32>) -> vec2<f32> {
+    let x = stream_next_f32(state);
+    let y = stream_next_f32(state);
+    return vec2<f32>(x, y);
+}
