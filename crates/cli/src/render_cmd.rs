@@ -314,10 +314,6 @@ fn open_gpu(scene: &Scene, settings: &GpuSettings, expected: [u64; 3]) -> Option
             return None;
         }
     };
-    if let Some(why) = hikari_gpu::scene_upload::approximated_materials(scene) {
-        eprintln!("gpu {}: {why}: rendering with photon-cpu instead", ctx.describe());
-        return None;
-    }
     if let Err(e) = GpuRenderer::check_fits(&ctx, scene, settings, expected) {
         eprintln!("gpu {}: {e}: rendering with photon-cpu instead", ctx.describe());
         return None;

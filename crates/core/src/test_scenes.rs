@@ -247,3 +247,92 @@ pub mod glossy_lights {
     /// Each with its name.
     pub const ALL: [(&str, &str); 5] = [("point", POINT), ("spot", SPOT), ("quad", QUAD), ("sun", SUN), ("sky", SKY)];
 }
+
+/// glTF files with textures, written by code: what the texture tests of
+/// every renderer load.
+pub mod gltf_textures {
+    use crate::scene::Scene;
+    use crate::scene::gltf::export::{GltfBuilder, PbrMaterial, looking, png};
+    use glam::{Vec2, Vec3};
+    use gltf::json;
+    use gltf::json::texture::WrappingMode;
+
+    /// A folder of the test's own (`tag`: tests run in parallel).
+    pub fn folder(tag: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("hikari-gltf-tex-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Writes `bytes` to `t.glb` in `folder(tag)` and loads it.
+    pub fn load(tag: &str, bytes: &[u8]) -> Scene {
+        let path = folder(tag).join("t.glb");
+        std::fs::write(&path, bytes).unwrap();
+        Scene::load(path.to_str().unwrap()).unwrap()
+    }
+
+    /// A quad with corners `origin`, + `eu`, + `eu` + `ev`, + `ev`: the point
+    /// `origin + s·eu + t·ev` has texture coordinates `scale · (s, t)`.
+    pub fn quad(
+        b: &mut GltfBuilder,
+        origin: Vec3,
+        eu: Vec3,
+        ev: Vec3,
+        scale: f32,
+        m: json::Index<json::Material>,
+    ) -> json::Index<json::Node> {
+        let positions = [origin, origin + eu, origin + eu + ev, origin + ev];
+        let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].map(|uv| uv * scale);
+        let mesh = b.textured_mesh(&positions, None, Some(&uvs), Some(&[0, 1, 2, 0, 2, 3]), Some(m));
+        b.node(json::Node { mesh: Some(mesh), ..Default::default() })
+    }
+
+    /// 2×2 greys, sRGB-encoded, rows from the top: 255, 0 / 128, 64.
+    pub const GREYS: [u8; 4] = [255, 0, 128, 64];
+
+    pub fn grey_checker(alpha: [u8; 4]) -> Vec<u8> {
+        let rgba: Vec<u8> = GREYS.iter().zip(alpha).flat_map(|(&g, a)| [g, g, g, a]).collect();
+        png(2, 2, &rgba)
+    }
+
+    /// Two Lambertian quads (no specular lobe) under the white sky of a file
+    /// without lights, both with the grey checker in base colour: x ∈ [0, 1]
+    /// with texture coordinates [0, 1]² and REPEAT, x ∈ [2, 3] with [0, 2]²
+    /// and CLAMP_TO_EDGE. They lie in z = 0, with v = 0 at the top (y = 1),
+    /// as glTF's texture coordinates have the image's top-left at (0, 0).
+    pub fn checker_glb() -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let image = b.image(&grey_checker([255; 4]), "image/png");
+        let repeat = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let clamp = b.texture(image, WrappingMode::ClampToEdge, WrappingMode::ClampToEdge);
+        let mut roots = Vec::new();
+        for (x, t, scale) in [(0.0, repeat, 1.0), (2.0, clamp, 2.0)] {
+            let m = b.material(&PbrMaterial { specular: 0.0, base_color_texture: Some(t), ..Default::default() });
+            roots.push(quad(&mut b, Vec3::new(x, 1.0, 0.0), Vec3::X, -Vec3::Y, scale, m));
+        }
+        b.to_glb(roots)
+    }
+
+    /// A black cut-out quad at y = 1 over a white floor, lit by a sun straight
+    /// down (E = 2 W/m²), alpha a 2×2 checker (REPEAT, cutoff 0.5): the floor
+    /// is lit and seen from above exactly where alpha < 0.5, half of the quad.
+    pub fn cutout_glb() -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let floor = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() });
+        let floor = quad(&mut b, Vec3::new(-2.0, 0.0, -2.0), 4.0 * Vec3::X, 4.0 * Vec3::Z, 1.0, floor);
+        let image = b.image(&grey_checker([255, 0, 0, 255]), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let cutout = b.material(&PbrMaterial {
+            base_color: Vec3::ZERO,
+            specular: 0.0,
+            alpha_cutoff: Some(0.5),
+            base_color_texture: Some(t),
+            ..Default::default()
+        });
+        let cutout = quad(&mut b, Vec3::new(-0.5, 1.0, -0.5), Vec3::X, Vec3::Z, 1.0, cutout);
+        use json::extensions::scene::khr_lights_punctual::Type;
+        let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+        let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(-Vec3::Y, Vec3::Z)));
+        b.to_glb(vec![floor, cutout, sun])
+    }
+}

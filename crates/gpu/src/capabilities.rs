@@ -36,11 +36,12 @@ pub fn required_limits() -> wgpu::Limits {
         max_color_attachment_bytes_per_sample: 64,
         // The photon tracer: BVH nodes, primitives and shading normals,
         // surfaces, lights, media, photon records, counts, status words,
-        // region triangles and emissive triangles (the specular pass binds
-        // 10).
-        max_storage_buffers_per_shader_stage: 11,
+        // region triangles, emissive triangles and textures (the specular
+        // pass binds 11).
+        max_storage_buffers_per_shader_stage: 12,
         max_storage_textures_per_shader_stage: 1,
-        max_bindings_per_bind_group: 16,
+        // The specular pass's bindings 0–17.
+        max_bindings_per_bind_group: 18,
         max_compute_invocations_per_workgroup: 256,
         max_compute_workgroup_size_x: 256,
         max_compute_workgroup_storage_size: 1024,
@@ -256,7 +257,7 @@ mod tests {
     fn shortfalls_name_the_limit() {
         let offered = wgpu::Limits { max_storage_buffers_per_shader_stage: 4, ..wgpu::Limits::default() };
         let short = limit_shortfalls(&offered, &required_limits());
-        assert!(short.iter().any(|s| s.contains("max_storage_buffers_per_shader_stage 4 < 11")), "{short:?}");
+        assert!(short.iter().any(|s| s.contains("max_storage_buffers_per_shader_stage 4 < 12")), "{short:?}");
         assert!(limit_shortfalls(&required_limits(), &required_limits()).is_empty());
     }
 

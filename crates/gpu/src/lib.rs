@@ -18,10 +18,10 @@
 //! both estimators, take direct light through it, sample it in the photon
 //! tracer and follow their smoother lobes in the specular pass.
 //!
-//! Not on the GPU yet: textures. Textured materials are drawn in their
-//! factors and cut-outs opaque, reported by
-//! `scene_upload::approximated_materials`, so the CLI renders those scenes
-//! with `photon-cpu` and the viewer says it approximates.
+//! Textures (`textures`) are one storage buffer of 8-bit texels with their
+//! mip chains, sampled by `textures.wgsl` with the CPU's filter: in the
+//! G-buffer (mip-mapped by the pixel's footprint), the shadow maps and
+//! the ray-traced passes (level 0), cut-outs (alphaMode MASK) included.
 
 pub mod accumulate;
 pub mod binding;
@@ -41,6 +41,7 @@ pub mod scene_upload;
 pub mod shadow;
 pub mod specular;
 pub mod splat;
+pub mod textures;
 pub mod trace;
 pub mod volume;
 pub mod wgsl;

@@ -24,6 +24,8 @@ pub struct FrameSize {
     pub volume_slices: u32,
     /// Photons in the global, caustic and volume maps.
     pub photons: [u64; 3],
+    /// The packed textures' buffer (`textures::packed_bytes`).
+    pub texture_bytes: u64,
 }
 
 impl FrameSize {
@@ -39,7 +41,7 @@ impl FrameSize {
         // Each map: its photons, its LOD survivors, and (for the specular
         // pass) its hashed grid: the photons again plus two bucket starts each.
         let photons: u64 = self.photons.iter().map(|n| n * (2 * PHOTON_BYTES + SURVIVOR_BYTES + 8)).sum();
-        targets + shadows + slices + photons
+        targets + shadows + slices + photons + self.texture_bytes
     }
 
     /// Bytes of the shadow maps (one Depth32Float layer per view).
@@ -89,6 +91,14 @@ impl FrameSize {
                 binding >> 20
             ));
         }
+        if self.texture_bytes > binding {
+            over.push(format!(
+                "the scene's textures ({} MiB with their mip levels and coordinates, 4 bytes a texel) exceed the \
+                 adapter's {} MiB per buffer",
+                self.texture_bytes >> 20,
+                binding >> 20
+            ));
+        }
         let total = self.bytes();
         if ctx.adapter_info.device_type == wgpu::DeviceType::Cpu && total > SOFTWARE_MEMORY_CAP {
             over.push(format!(
@@ -117,6 +127,7 @@ mod tests {
             shadow_layers: 6,
             volume_slices: 0,
             photons: [200_000, 20_000, 0],
+            texture_bytes: 16,
         }
     }
 
@@ -127,6 +138,7 @@ mod tests {
         assert!(FrameSize { shadow_layers: 12, ..frame() }.bytes() > base);
         assert!(FrameSize { volume_slices: 8, ..frame() }.bytes() > base);
         assert!(FrameSize { photons: [400_000, 20_000, 0], ..frame() }.bytes() > base);
+        assert!(FrameSize { texture_bytes: 1 << 20, ..frame() }.bytes() > base);
         // 8192² shadow maps × 24 layers: 6 GiB of depth alone.
         assert!(FrameSize { shadow_map_size: 8192, shadow_layers: 24, ..frame() }.bytes() >= 6 << 30);
     }

@@ -148,6 +148,8 @@ pub struct GpuRenderer {
     global_splat: SplatBinding,
     caustic_splat: SplatBinding,
     shadow_pass: ShadowPass,
+    /// The shadow pass's bind group of the scene (cut-outs).
+    shadow_scene: wgpu::BindGroup,
     direct_pass: DirectPass,
     direct_binding: crate::direct::DirectBinding,
     specular_pass: SpecularPass,
@@ -235,6 +237,10 @@ impl GpuRenderer {
             shadow_layers: lights.views.len() as u32,
             volume_slices: if GpuMedia::has_regions(scene) { settings.volume_slices } else { 0 },
             photons,
+            texture_bytes: crate::textures::packed_bytes(
+                scene,
+                scene.accel.triangles().count() + scene.accel.spheres().count(),
+            ),
         }
     }
 
@@ -327,7 +333,7 @@ impl GpuRenderer {
         let specular_pass = SpecularPass::new(
             device,
             scene,
-            &scene_buffers.surfaces,
+            &scene_buffers,
             &lights,
             &targets.shadow_maps,
             &targets.gbuffer,
@@ -372,6 +378,7 @@ impl GpuRenderer {
                 &media,
             ),
             direct_pass,
+            shadow_scene: shadow_pass.bind_scene(device, &scene_buffers),
             shadow_pass,
             scene: scene_buffers,
             global_lod: lod_pass
@@ -468,6 +475,7 @@ impl GpuRenderer {
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         self.scene = SceneBuffers::upload(device, scene);
         self.gbuffer_binding = self.gbuffer_pass.bind(device, &self.scene, &self.targets.gbuffer);
+        self.shadow_scene = self.shadow_pass.bind_scene(device, &self.scene);
         self.global_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
         self.caustic_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
         self.bounds = scene.accel.bounds();
@@ -486,7 +494,7 @@ impl GpuRenderer {
             self.settings.shadow_bias,
             &self.media,
         );
-        self.specular_pass.set_scene(device, queue, scene, &self.scene.surfaces, &lights, &self.targets.shadow_maps);
+        self.specular_pass.set_scene(device, queue, scene, &self.scene, &lights, &self.targets.shadow_maps);
         self.media.set_scene(queue, scene);
         self.clip_from_world = clip_from_world(&self.camera, self.bounds);
         self.media.set_camera(queue, &self.camera, self.clip_from_world);
@@ -758,7 +766,9 @@ impl GpuRenderer {
                 let t = &self.targets;
                 self.gbuffer_pass.record(queue, encoder, &self.scene, &self.gbuffer_binding, &params, &t.gbuffer);
             }
-            Stage::Shadows => self.shadow_pass.record(encoder, &self.scene, &self.targets.shadow_maps),
+            Stage::Shadows => {
+                self.shadow_pass.record(encoder, &self.scene, &self.shadow_scene, &self.targets.shadow_maps)
+            }
             Stage::OpticalDepth => self.media.record(encoder),
             Stage::Direct => {
                 let view = self.targets.direct.create_view(&Default::default());

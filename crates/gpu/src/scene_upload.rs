@@ -3,6 +3,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use hikari_core::geometry::FlatBvh;
 use hikari_core::material::Material;
 use hikari_core::scene::Scene;
 use wgpu::util::DeviceExt;
@@ -16,8 +17,14 @@ pub struct GpuVertex {
     pub normal: [f32; 3],
     /// The triangle's geometric normal (winding side; outward for spheres).
     pub geometric_normal: [f32; 3],
+    /// The surface id, with `HAS_UV` set where `uv` holds the vertex's
+    /// texture coordinates.
     pub surface: u32,
+    pub uv: [f32; 2],
 }
+
+/// `GpuVertex::surface`'s flag: the triangle has texture coordinates.
+pub const HAS_UV: u32 = 1 << 31;
 
 /// Material kinds as the G-buffer stores them.
 pub mod kind {
@@ -52,6 +59,18 @@ pub struct GpuSurface {
     /// with a specular lobe); 0: Lambertian `albedo`, plus the mirror part
     /// `specular`.
     pub glossy: u32,
+    /// What textures make of the surface (`hikari_core::texture::Texturing`):
+    /// `emission` per unit of the emissive texture (the emitter's uniform
+    /// radiance over the texture's mean), and `alphaMode` MASK's cut-off
+    /// (negative: opaque).
+    pub emission_per_texel: [f32; 3],
+    pub alpha_cutoff: f32,
+    /// `textures::texture_ref`s (`textures::NO_TEXTURE` for none).
+    pub base_color_texture: u32,
+    pub metallic_roughness_texture: u32,
+    pub emissive_texture: u32,
+    /// `baseColorFactor`'s alpha, against the cut-off.
+    pub alpha_factor: f32,
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -66,11 +85,16 @@ pub struct SceneBuffers {
     /// are not shadowed by the light itself.
     pub occluder_count: u32,
     pub surfaces: wgpu::Buffer,
+    /// The scene's flat BVH, which the specular pass traverses.
+    pub bvh: FlatBvh,
+    /// The packed textures (`textures::pack_scene`), texture coordinates
+    /// in `bvh`'s primitive order.
+    pub textures: wgpu::Buffer,
 }
 
 /// All vertices, area-light bodies last; returns them and the occluder count.
 pub fn scene_vertices(scene: &Scene) -> (Vec<GpuVertex>, u32) {
-    let is_emitter = |surface: u32| scene.surfaces[surface as usize].emitter.is_some();
+    let is_emitter = |surface: u32| scene.surfaces[(surface & !HAS_UV) as usize].emitter.is_some();
     let mut occluders = Vec::new();
     let mut emitters = Vec::new();
     for_each_vertex(scene, |v| if is_emitter(v.surface) { emitters.push(v) } else { occluders.push(v) });
@@ -81,18 +105,22 @@ pub fn scene_vertices(scene: &Scene) -> (Vec<GpuVertex>, u32) {
 
 fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
     let mut out = Vec::new();
-    for (tri, surface) in scene.accel.triangles() {
+    let uvs = scene.texturing.as_ref().map(|t| &t.uvs);
+    for (prim, (tri, surface)) in scene.accel.triangles().enumerate() {
         let ng = tri.geometric_normal().normalize();
         let normals = match tri.normals {
             Some(n) => n.0,
             None => [ng; 3],
         };
+        let uv = uvs.and_then(|t| t.triangle(prim as u32));
+        let surface = if uv.is_some() { surface | HAS_UV } else { surface };
         for k in 0..3 {
             out.push(GpuVertex {
                 position: tri.v[k].to_array(),
                 normal: normals[k].to_array(),
                 geometric_normal: ng.to_array(),
                 surface,
+                uv: uv.map_or([0.0; 2], |uv| uv[k].to_array()),
             });
         }
     }
@@ -128,6 +156,7 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
                 normal: n.to_array(),
                 geometric_normal: ng.to_array(),
                 surface,
+                uv: [0.0; 2],
             });
         }
     };
@@ -139,28 +168,6 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
             push(a, c, d);
         }
     }
-}
-
-/// Why the GPU's image of `scene` is not exact, or None: the GPU passes do
-/// not sample textures yet, so textured materials are drawn in their
-/// factors and cut-outs (`alphaMode` MASK) opaque. `hikari render` then
-/// renders with photon-cpu; the viewer draws the approximation and says so.
-pub fn approximated_materials(scene: &Scene) -> Option<String> {
-    // Only the materials some surface uses (a glTF file's default material
-    // is always there, used or not).
-    let used: std::collections::BTreeSet<usize> = scene.surfaces.iter().map(|s| s.material as usize).collect();
-    let textures =
-        scene.texturing.as_ref().map(|t| used.iter().filter_map(move |&m| t.materials.get(m).and_then(Option::as_ref)));
-    let textured = textures.clone().map_or(0, |t| t.filter(|m| m.is_textured()).count());
-    let masked = textures.map_or(0, |t| t.filter(|m| m.alpha_cutoff.is_some()).count());
-    let mut why = Vec::new();
-    if textured > 0 {
-        why.push(format!("{textured} textured material(s) are drawn by the GPU renderer in their factors"));
-    }
-    if masked > 0 {
-        why.push(format!("{masked} cut-out (alphaMode MASK) material(s) are drawn opaque by the GPU renderer"));
-    }
-    (!why.is_empty()).then(|| why.join("; "))
 }
 
 pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
@@ -183,6 +190,14 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 hikari_core::light::Light::Mesh(mesh) => (mesh.radiance, mesh.two_sided),
                 _ => (Vec3::ZERO, false),
             });
+            let textures = scene
+                .texturing
+                .as_ref()
+                .and_then(|t| t.materials.get(s.material as usize).copied().flatten())
+                .unwrap_or_default();
+            let mean = textures.emissive_mean;
+            let per_texel =
+                Vec3::select(mean.cmpgt(Vec3::ZERO), emission / mean.max(Vec3::splat(f32::MIN_POSITIVE)), Vec3::ZERO);
             // The glTF BRDF where it has a specular lobe; exactly
             // Lambertian ones (and the old materials) take the cheaper path.
             let glossy = match material {
@@ -203,6 +218,12 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 roughness: glossy.map_or(1.0, |b| b.roughness),
                 specular_factor: glossy.map_or(0.0, |b| b.specular),
                 glossy: glossy.is_some() as u32,
+                emission_per_texel: per_texel.to_array(),
+                alpha_cutoff: textures.alpha_cutoff.unwrap_or(-1.0),
+                base_color_texture: crate::textures::texture_ref(textures.base_color),
+                metallic_roughness_texture: crate::textures::texture_ref(textures.metallic_roughness),
+                emissive_texture: crate::textures::texture_ref(textures.emissive),
+                alpha_factor: if textures.alpha_cutoff.is_some() { textures.alpha_factor } else { 1.0 },
             }
         })
         .collect()
@@ -212,7 +233,15 @@ impl SceneBuffers {
     pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
         let (vertices, occluder_count) = scene_vertices(scene);
         let surfaces = scene_surfaces(scene);
+        let bvh = FlatBvh::new(&scene.accel);
+        let textures = crate::textures::pack_scene(scene, Some(&bvh));
         SceneBuffers {
+            bvh,
+            textures: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("scene textures"),
+                contents: bytemuck::cast_slice(&textures),
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
             vertex_count: vertices.len() as u32,
             occluder_count,
             vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

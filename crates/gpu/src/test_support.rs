@@ -32,8 +32,19 @@ pub fn media_context(test: &str, scene: &Scene) -> Option<GpuContext> {
 /// invocations with one read-write buffer `io` of `words` u32 initialised
 /// from `input`, and returns the buffer.
 pub fn run_kernel(ctx: &GpuContext, modules: &[&crate::wgsl::Module], main: &str, input: &[u32]) -> Vec<u32> {
+    run_kernel_on(ctx, modules, main, "io", input)
+}
+
+/// `run_kernel` with the buffer named `buffer` (what `modules` read).
+pub fn run_kernel_on(
+    ctx: &GpuContext,
+    modules: &[&crate::wgsl::Module],
+    main: &str,
+    buffer: &str,
+    input: &[u32],
+) -> Vec<u32> {
     let kernel = format!(
-        "@group(0) @binding(0) var<storage, read_write> io: array<u32>;\n\
+        "@group(0) @binding(0) var<storage, read_write> {buffer}: array<u32>;\n\
          @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n{main}\n}}\n"
     );
     let source = crate::wgsl::compose(modules) + &kernel;

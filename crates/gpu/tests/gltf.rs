@@ -56,26 +56,3 @@ fn the_showcase_renders_on_the_gpu() {
     eprintln!("showcase: mean radiance {mean:.4}");
     assert!(mean > 0.01, "a dark showcase: {mean}");
 }
-
-/// Only materials that surfaces use count: a glTF file always carries the
-/// specification's default material (glossy white metal), used or not.
-/// Glossy materials are drawn exactly (the showcase's); textures are not yet.
-#[test]
-fn untextured_gltf_files_are_drawn_exactly_and_textured_ones_say_why_not() {
-    use hikari_gpu::scene_upload::approximated_materials;
-    let toml = Scene::load("cornell-box").unwrap();
-    let dir = std::env::temp_dir().join(format!("hikari-gpu-gltf-exact-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("cornell-box.glb");
-    std::fs::write(&path, scene_to_glb(&toml).unwrap()).unwrap();
-    let lambertian = Scene::load(path.to_str().unwrap()).unwrap();
-    assert_eq!(approximated_materials(&lambertian), None);
-    let showcase = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb")).unwrap();
-    assert_eq!(approximated_materials(&showcase), None);
-    // The fuzzers' textured seed: a checker base colour and a MASK cut-out.
-    let textured = hikari_core::fuzz::gltf::seed_files().pop().expect("seeds");
-    let path = dir.join("textured.glb");
-    std::fs::write(&path, textured).unwrap();
-    let why = approximated_materials(&Scene::load(path.to_str().unwrap()).unwrap()).expect("textures");
-    assert!(why.contains("textured") && why.contains("cut-out"), "{why}");
-}

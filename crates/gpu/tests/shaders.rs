@@ -84,7 +84,24 @@ fn shared_structs_match_wgsl_layouts() {
         gbuffer,
         "Surface",
         GpuSurface,
-        [albedo, kind, emission, ior, specular, two_sided, metallic, roughness, specular_factor, glossy]
+        [
+            albedo,
+            kind,
+            emission,
+            ior,
+            specular,
+            two_sided,
+            metallic,
+            roughness,
+            specular_factor,
+            glossy,
+            emission_per_texel,
+            alpha_cutoff,
+            base_color_texture,
+            metallic_roughness_texture,
+            emissive_texture,
+            alpha_factor
+        ]
     );
     let splat = hikari_gpu::splat::shader_source();
     assert_layout!(
@@ -351,7 +368,8 @@ fn vertex_attribute_offsets_match_rust_structs() {
             offset_of!(GpuVertex, position),
             offset_of!(GpuVertex, normal),
             offset_of!(GpuVertex, geometric_normal),
-            offset_of!(GpuVertex, surface)
+            offset_of!(GpuVertex, surface),
+            offset_of!(GpuVertex, uv)
         ]
     );
 }

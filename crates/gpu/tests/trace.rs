@@ -10,7 +10,7 @@ use hikari_core::progressive::compare;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{cornell_quad_light, glossy_box, glossy_lights, quad_lights_as_meshes};
+use hikari_core::test_scenes::{cornell_quad_light, glossy_box, glossy_lights, gltf_textures, quad_lights_as_meshes};
 use hikari_gpu::GpuContext;
 use hikari_gpu::test_support::{run_kernel, sky_over_a_box, sun_and_sky_in_fog, sun_over_a_box, test_context};
 use hikari_gpu::trace::GpuTracer;
@@ -323,7 +323,8 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("cornell mesh light", quad_lights_as_meshes(&cornell_quad_light(16))),
         ("cornell two-sided mesh light", two_sided(quad_lights_as_meshes(&cornell_quad_light(16)))),
         ("glossy box, quad light", glossy_box(glossy_lights::QUAD, 16)),
-        ("glossy box, sky", glossy_box(glossy_lights::SKY, 16)),
+        ("glossy box, point light", glossy_box(glossy_lights::POINT, 16)),
+        ("textured cut-out", gltf_textures::load("trace-cutout", &gltf_textures::cutout_glb())),
     ]
 }
 

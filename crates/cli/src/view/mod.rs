@@ -133,9 +133,6 @@ pub fn run(args: ViewArgs) -> Result<()> {
         }
     }
     let scene = load_scene(&args.scene, args.camera.as_deref(), false)?;
-    if let Some(why) = hikari_gpu::scene_upload::approximated_materials(&scene) {
-        eprintln!("note: {why}");
-    }
     if let Some(size) = args.size {
         size.resolve(scene.camera.aspect()).map_err(UsageError)?;
     }

@@ -51,6 +51,10 @@ pub struct FlatBvh {
     pub prims: Vec<FlatPrim>,
     /// Per primitive, in `prims` order.
     pub shading: Vec<FlatShading>,
+    /// Per primitive, in `prims` order, its index in `Accel`'s joint
+    /// primitive space (triangles, then spheres): what `Hit::prim` and the
+    /// scene's texture coordinates are indexed by.
+    pub source: Vec<u32>,
     pub epsilon: f32,
 }
 
@@ -95,7 +99,7 @@ impl FlatBvh {
             _pad: 0,
         }));
         if prims.is_empty() {
-            return FlatBvh { nodes: Vec::new(), prims, shading, epsilon: accel.epsilon };
+            return FlatBvh { nodes: Vec::new(), prims, shading, source: Vec::new(), epsilon: accel.epsilon };
         }
         let bounds: Vec<Bounds> = prims
             .iter()
@@ -122,7 +126,8 @@ impl FlatBvh {
             .collect();
         let ordered = bvh.primitive_indices.iter().map(|&i| prims[i as usize]).collect();
         let ordered_shading = bvh.primitive_indices.iter().map(|&i| shading[i as usize]).collect();
-        FlatBvh { nodes, prims: ordered, shading: ordered_shading, epsilon: accel.epsilon }
+        let source = bvh.primitive_indices.clone();
+        FlatBvh { nodes, prims: ordered, shading: ordered_shading, source, epsilon: accel.epsilon }
     }
 
     /// Closest hit: (t, primitive index in `prims`). The WGSL traversal

@@ -12,6 +12,7 @@
 @group(0) @binding(8) var<uniform> media: MediaParams;
 @group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(10) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(11) var gbuffer_emission: texture_2d<f32>;
 
 
 
@@ -26,7 +27,9 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let x = position.xyz;
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let n = g.xyz;
-    let r = surface_reflector(surfaces[u32(g.w)], albedo.rgb, unit(media.camera_position - x), n);
+    let s = surfaces[u32(g.w)];
+    let b = pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
+    let r = surface_reflector(s, b, unit(media.camera_position - x), n);
     // Glossy points sample their lobe and area lights: a new stream each pass.
     var rng = pixel_stream(vec2<u32>(pixel), direct_params.pass_index, 1u);
     return vec4<f32>(direct_radiance(x, n, r, &rng), 1.0);

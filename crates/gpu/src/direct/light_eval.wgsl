@@ -169,10 +169,10 @@ struct Reflector {
     wo: vec3<f32>,
 }
 
-// Surface `s` at a point of base colour `base` and shading normal `n`,
-// seen from `eye` (world, toward the viewer).
-fn surface_reflector(s: Surface, base: vec3<f32>, eye: vec3<f32>, n: vec3<f32>) -> Reflector {
-    return Reflector(base, s.glossy != 0u, surface_bsdf(s, base), to_shading(eye, n));
+// Surface `s` at a point where its BRDF is `b` (textures applied), of
+// shading normal `n`, seen from `eye` (world, toward the viewer).
+fn surface_reflector(s: Surface, b: Bsdf, eye: vec3<f32>, n: vec3<f32>) -> Reflector {
+    return Reflector(b.base_color, s.glossy != 0u, b, to_shading(eye, n));
 }
 
 // f toward the world direction `wi` (every non-delta lobe).

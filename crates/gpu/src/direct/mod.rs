@@ -31,23 +31,28 @@ pub fn shader_source() -> String {
 /// in light_eval.wgsl; a test reads it back).
 pub const AREA_SAMPLES: u32 = 4;
 
-/// Loop iterations one pixel of the direct pass runs at most (a bound):
-/// per light, the quad's 4 corners and a glossy point's `AREA_SAMPLES`, then per
-/// sample (every light's, the sky's directions and a mesh's points
-/// included) the region triangles crossed on the way to the light
-/// (light_eval.wgsl's `direct_radiance` and `sampled_radiance`).
-/// A glossy point's sky (`sky_glossy`) adds, per BRDF sample, a search of
-/// the sky's directions and the region triangles toward the nearest.
+/// Loop iterations one pixel of the direct pass runs at most: per light,
+/// the quad's 4 corners, then per sample (every light's, the sky's
+/// directions and a mesh's points included) the region triangles crossed
+/// on the way to the light (light_eval.wgsl's `direct_radiance` and
+/// `sampled_radiance`). A glossy point adds `AREA_SAMPLES` for a sphere or
+/// quad light (`area_glossy`), and for the sky (`sky_glossy`) a search of
+/// its directions and the region triangles toward the nearest, per sample.
 pub fn loop_iterations(lights: &GpuLights, region_triangles: usize) -> u64 {
-    let per_light = 1 + 4 + AREA_SAMPLES as u64;
+    use crate::shadow::light_samples::kind;
     let regions = region_triangles as u64;
+    let area = AREA_SAMPLES as u64;
     lights
         .lights
         .iter()
         .map(|l| {
             let samples = l.sample_count as u64;
-            let sky_search = AREA_SAMPLES as u64 * (samples + regions);
-            per_light + samples * (1 + regions) + sky_search
+            let glossy = match l.kind {
+                kind::SPHERE | kind::QUAD => area,
+                kind::ENVIRONMENT => area * (1 + samples + regions),
+                _ => 0,
+            };
+            1 + 4 + samples * (1 + regions) + glossy
         })
         .sum()
 }
@@ -91,6 +96,7 @@ impl DirectPass {
                 entry(8, uniform()),
                 entry(9, storage(true)),
                 entry(10, storage(true)),
+                entry(11, texture(D2)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "direct", &layout);
@@ -135,6 +141,7 @@ impl DirectPass {
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
+        let emission = view(&gbuffer.emission);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("direct"),
             layout: &self.layout,
@@ -150,6 +157,7 @@ impl DirectPass {
                 wgpu::BindGroupEntry { binding: 8, resource: media.params_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 10, resource: surfaces.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&emission) },
             ],
         });
         DirectBinding { bind_group, uniforms, params }

@@ -1,5 +1,7 @@
 // G-buffer: world position, normal facing the eye, albedo and material kind,
-// emitted radiance. One fragment per pixel centre, like a primary ray.
+// emitted radiance. One fragment per pixel centre, like a primary ray. The
+// surface's textures are applied here (surface_point.wgsl, mip-mapped by
+// the pixel's footprint); MASK cut-outs discard their fragments.
 
 struct GBufferParams {
     clip_from_world: mat4x4<f32>,
@@ -10,12 +12,17 @@ struct GBufferParams {
 
 @group(0) @binding(0) var<uniform> params: GBufferParams;
 @group(0) @binding(1) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(2) var<storage, read> texture_data: array<u32>;
+
+// scene_upload::HAS_UV: the vertex's surface id carries whether `uv` is set.
+const HAS_UV: u32 = 0x80000000u;
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) geometric_normal: vec3<f32>,
     @location(3) surface: u32,
+    @location(4) uv: vec2<f32>,
 }
 
 struct VertexOut {
@@ -25,6 +32,7 @@ struct VertexOut {
     @location(1) normal: vec3<f32>,
     @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
     @location(3) @interpolate(flat) surface: u32,
+    @location(4) uv: vec2<f32>,
 }
 
 @vertex
@@ -35,6 +43,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.normal = v.normal;
     out.geometric_normal = v.geometric_normal;
     out.surface = v.surface;
+    out.uv = v.uv;
     return out;
 }
 
@@ -45,7 +54,8 @@ struct GBufferOut {
     @location(1) normal: vec4<f32>,
     // rgb: diffuse albedo (mirror reflectance for mirrors); a: material kind.
     @location(2) albedo: vec4<f32>,
-    // rgb: radiance emitted toward the eye (area lights, emissive meshes).
+    // rgb: radiance emitted toward the eye (area lights, emissive meshes);
+    // w: metallic and roughness with textures applied (`pack_metal_rough`).
     @location(3) emission: vec4<f32>,
 }
 
@@ -54,16 +64,40 @@ fn fs_main(in: VertexOut) -> GBufferOut {
     return shade(in);
 }
 
-// What a pixel stores (fs_main's outputs; gbuffer_storage.wgsl stores the same).
+// The surface at the fragment, textures applied; its footprint's change of
+// texture coordinates is taken here, in uniform control flow.
+fn fragment_point(in: VertexOut) -> SurfacePoint {
+    let dx = dpdx(in.uv);
+    let dy = dpdy(in.uv);
+    let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
+    return surface_point(surfaces[in.surface & ~HAS_UV], uv, dx, dy);
+}
+
+// What a pixel stores (fs_main's outputs; gbuffer_storage.wgsl stores the
+// same); a cut-out's fragment is discarded.
 fn shade(in: VertexOut) -> GBufferOut {
-    let surface = surfaces[in.surface];
+    let point = fragment_point(in);
+    if (!point.opaque) {
+        discard;
+    }
+    let id = in.surface & ~HAS_UV;
+    let surface = surfaces[id];
     let view = in.world - params.camera_position;
     let front = dot(in.geometric_normal, view) < 0.0;
     let side = select(-1.0, 1.0, front);
     var out: GBufferOut;
     out.position = vec4<f32>(in.world, 1.0);
-    out.normal = vec4<f32>(normalize(in.normal) * side, f32(in.surface));
-    out.albedo = vec4<f32>(surface.albedo, f32(surface.kind));
-    out.emission = vec4<f32>(select(vec3<f32>(0.0), surface.emission, front || surface.two_sided != 0u), 0.0);
+    out.normal = vec4<f32>(normalize(in.normal) * side, f32(id));
+    out.albedo = vec4<f32>(point.base, f32(surface.kind));
+    let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);
+    out.emission = vec4<f32>(emitted, pack_metal_rough(point.metallic, point.roughness));
     return out;
+}
+
+// The depth-only draw of the storage path: cut-outs leave no depth.
+@fragment
+fn fs_depth(in: VertexOut) {
+    if (!fragment_point(in).opaque) {
+        discard;
+    }
 }

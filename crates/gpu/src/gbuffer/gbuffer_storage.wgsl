@@ -4,10 +4,10 @@
 // shader (early_depth_test), so only each pixel's nearest fragment runs
 // and stores the same four values as fs_main. Appended to gbuffer.wgsl.
 
-@group(0) @binding(2) var out_position: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(3) var out_normal: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(4) var out_albedo: texture_storage_2d<rgba32float, write>;
-@group(0) @binding(5) var out_emission: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(3) var out_position: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(4) var out_normal: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(5) var out_albedo: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(6) var out_emission: texture_storage_2d<rgba32float, write>;
 
 @fragment
 @early_depth_test(force)

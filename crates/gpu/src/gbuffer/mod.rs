@@ -17,8 +17,11 @@ pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub fn shader_source() -> String {
     use crate::wgsl::{Module, SURFACE, compose};
-    static GBUFFER: Module =
-        Module { name: "gbuffer.wgsl", source: include_str!("gbuffer.wgsl"), requires: &[&SURFACE] };
+    static GBUFFER: Module = Module {
+        name: "gbuffer.wgsl",
+        source: include_str!("gbuffer.wgsl"),
+        requires: &[&SURFACE, &crate::textures::SURFACE_POINT],
+    };
     compose(&[&GBUFFER])
 }
 
@@ -29,11 +32,12 @@ pub fn storage_shader_source() -> String {
 
 /// `GpuVertex` as vertex attributes, offsets written by hand (a test checks
 /// them against the struct).
-pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 4] = [
+pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = [
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 12, shader_location: 1 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 24, shader_location: 2 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 36, shader_location: 3 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 40, shader_location: 4 },
 ];
 
 /// The G-buffer's textures, all `width × height`.
@@ -119,9 +123,10 @@ impl GBufferPass {
         let mut entries = vec![
             crate::binding::entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, crate::binding::uniform()),
             crate::binding::entry(1, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
+            crate::binding::entry(2, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
         ];
         if storage {
-            entries.extend((2..6).map(|b| {
+            entries.extend((3..7).map(|b| {
                 crate::binding::entry(b, wgpu::ShaderStages::FRAGMENT, crate::binding::storage_texture_rgba32f())
             }));
         }
@@ -163,7 +168,7 @@ impl GBufferPass {
                 ..nearest.clone()
             };
             Mode::Storage {
-                depth: pipeline("gbuffer depth", None, nearest),
+                depth: pipeline("gbuffer depth", Some(("fs_depth", &[])), nearest),
                 store: pipeline("gbuffer store", Some(("fs_storage", &[])), equal),
             }
         } else {
@@ -190,10 +195,11 @@ impl GBufferPass {
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: scene.surfaces.as_entire_binding() },
+            wgpu::BindGroupEntry { binding: 2, resource: scene.textures.as_entire_binding() },
         ];
         if matches!(self.mode, Mode::Storage { .. }) {
             entries.extend(views.iter().enumerate().map(|(i, view)| wgpu::BindGroupEntry {
-                binding: 2 + i as u32,
+                binding: 3 + i as u32,
                 resource: wgpu::BindingResource::TextureView(view),
             }));
         }

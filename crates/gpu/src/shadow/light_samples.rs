@@ -123,6 +123,10 @@ pub struct MeshOccluders {
     pub ranges: Vec<(u32, Range<u32>)>,
 }
 
+/// The surface id of an emissive mesh's own triangles drawn as occluders
+/// (opaque: no cut-out test).
+pub const NO_SURFACE: u32 = 0x7fff_ffff;
+
 impl MeshOccluders {
     /// The vertex ranges a view of light `light` draws: all but its own.
     pub fn drawn_by(&self, light: u32) -> impl Iterator<Item = Range<u32>> + '_ {
@@ -320,7 +324,7 @@ impl MeshOccluders {
         let start = self.vertices.len() as u32;
         for triangle in mesh.triangles() {
             for v in triangle {
-                self.vertices.push(GpuVertex { position: v.to_array(), ..GpuVertex::zeroed() });
+                self.vertices.push(GpuVertex { position: v.to_array(), surface: NO_SURFACE, ..GpuVertex::zeroed() });
             }
         }
         self.ranges.push((light, start..self.vertices.len() as u32));
@@ -376,10 +380,10 @@ mod tests {
         let mean = sky.samples.iter().map(|s| Vec3::from(s.direction)).sum::<Vec3>() / sky.samples.len() as f32;
         assert!(mean.length() < 0.05, "mean direction {mean}");
         // The direct pass's loop bound counts every direction (and its region crossings).
-        // Per light 1 + 4 + AREA_SAMPLES, per direction 1 + 3, and a glossy
-        // point's search of the directions per BRDF sample.
+        // Per light 1 + 4, per direction 1 + 3, and per BRDF sample of a
+        // glossy point a search of the directions and the regions.
         let area = crate::direct::AREA_SAMPLES as u64;
-        assert_eq!(crate::direct::loop_iterations(&sky, 3), 1 + 4 + area + 16 * (1 + 3) + area * (16 + 3));
+        assert_eq!(crate::direct::loop_iterations(&sky, 3), 1 + 4 + 16 * (1 + 3) + area * (1 + 16 + 3));
         // Stratified in z: exactly half above the z = 0 plane, and about half above the floor.
         let above = |axis: usize| sky.samples.iter().filter(|s| s.direction[axis] > 0.0).count();
         assert_eq!(above(2), sky.samples.len() / 2);

@@ -26,8 +26,11 @@ pub static SHADOW_VIEW: crate::wgsl::Module =
 
 pub fn shader_source() -> String {
     use crate::wgsl::{Module, compose};
-    static SHADOW: Module =
-        Module { name: "shadow.wgsl", source: include_str!("shadow.wgsl"), requires: &[&SHADOW_VIEW] };
+    static SHADOW: Module = Module {
+        name: "shadow.wgsl",
+        source: include_str!("shadow.wgsl"),
+        requires: &[&SHADOW_VIEW, &crate::textures::SURFACE_POINT],
+    };
     compose(&[&SHADOW])
 }
 /// The shadow-map format: `R32Float` where it is renderable, else `R16Float`.
@@ -124,6 +127,8 @@ impl ShadowMaps {
 pub struct ShadowPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    /// Group 1: the scene's surfaces and textures (cut-outs).
+    scene_layout: wgpu::BindGroupLayout,
     format: wgpu::TextureFormat,
 }
 
@@ -138,7 +143,16 @@ impl ShadowPass {
             label: Some("shadow view"),
             entries: &[crate::binding::entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, crate::binding::uniform())],
         });
-        let pipeline_layout = crate::binding::pipeline_layout(device, "shadow", &layout);
+        let storage = |b| crate::binding::entry(b, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true));
+        let scene_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow scene"),
+            entries: &[storage(0), storage(1)],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow"),
+            bind_group_layouts: &[Some(&layout), Some(&scene_layout)],
+            immediate_size: 0,
+        });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow"),
             layout: Some(&pipeline_layout),
@@ -149,7 +163,11 @@ impl ShadowPass {
                 buffers: &[Some(wgpu::VertexBufferLayout {
                     array_stride: std::mem::size_of::<GpuVertex>() as u64,
                     step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &crate::gbuffer::VERTEX_ATTRIBUTES[..1],
+                    attributes: &[
+                        crate::gbuffer::VERTEX_ATTRIBUTES[0],
+                        crate::gbuffer::VERTEX_ATTRIBUTES[3],
+                        crate::gbuffer::VERTEX_ATTRIBUTES[4],
+                    ],
                 })],
             },
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
@@ -164,7 +182,19 @@ impl ShadowPass {
             multiview_mask: None,
             cache: None,
         });
-        ShadowPass { pipeline, layout, format }
+        ShadowPass { pipeline, layout, scene_layout, format }
+    }
+
+    /// The bind group of `scene`'s surfaces and textures, made once per scene.
+    pub fn bind_scene(&self, device: &wgpu::Device, scene: &SceneBuffers) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow scene"),
+            layout: &self.scene_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: scene.surfaces.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: scene.textures.as_entire_binding() },
+            ],
+        })
     }
 
     /// One layer per view of `lights`, each `size²`, for a scene within `bounds`.
@@ -250,8 +280,14 @@ impl ShadowPass {
         }
     }
 
-    /// Renders every shadow view of `maps`.
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, scene: &SceneBuffers, maps: &ShadowMaps) {
+    /// Renders every shadow view of `maps`; `scene_group` is `bind_scene`'s.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &SceneBuffers,
+        scene_group: &wgpu::BindGroup,
+        maps: &ShadowMaps,
+    ) {
         let depth_view = maps.depth.create_view(&Default::default());
         for (layer, bind_group) in maps.view_bind_groups.iter().enumerate() {
             let target = maps.texture.create_view(&wgpu::TextureViewDescriptor {
@@ -283,6 +319,7 @@ impl ShadowPass {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, bind_group, &[]);
+            pass.set_bind_group(1, scene_group, &[]);
             pass.set_vertex_buffer(0, scene.vertices.slice(..));
             pass.draw(0..scene.occluder_count, 0..1);
             // Emissive meshes are scene surfaces: they shadow every light but themselves.

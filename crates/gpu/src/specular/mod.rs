@@ -8,6 +8,7 @@ use crate::direct::DirectParams;
 use crate::gbuffer::GBuffer;
 use crate::media::GpuMedia;
 use crate::photon_grid::PhotonGrid;
+use crate::scene_upload::SceneBuffers;
 use crate::shadow::ShadowMaps;
 use crate::shadow::light_samples::GpuLights;
 use bytemuck::{Pod, Zeroable};
@@ -28,7 +29,15 @@ pub fn has_specular_surfaces(scene: &Scene) -> bool {
     scene.surfaces.iter().any(|s| match &scene.materials[s.material as usize] {
         Material::Mirror { .. } | Material::Glass { .. } => true,
         Material::Diffuse { specular, .. } => specular.max_element() > 0.0,
-        Material::Pbr(bsdf) => bsdf.has_specular() && !bsdf.gathers_specular(),
+        Material::Pbr(bsdf) => {
+            // A metallic–roughness texture may make it smoother somewhere.
+            let textured = scene
+                .texturing
+                .as_ref()
+                .and_then(|t| t.materials.get(s.material as usize).copied().flatten())
+                .is_some_and(|t| t.metallic_roughness.is_some());
+            bsdf.has_specular() && (!bsdf.gathers_specular() || textured)
+        }
         Material::Emitter => false,
     })
 }
@@ -46,6 +55,7 @@ pub fn shader_source() -> String {
         &BVH,
         &OPTICS,
         &crate::wgsl::SURFACE,
+        &crate::wgsl::CUT_OUTS,
         &crate::wgsl::VOLUME_CHORD,
         &SPECULAR,
     ])
@@ -166,8 +176,7 @@ struct SceneData {
 }
 
 impl SceneData {
-    fn upload(device: &wgpu::Device, scene: &Scene, lights: &GpuLights, maps: &ShadowMaps, bias: f32) -> Self {
-        let bvh = FlatBvh::new(&scene.accel);
+    fn upload(device: &wgpu::Device, bvh: &FlatBvh, lights: &GpuLights, maps: &ShadowMaps, bias: f32) -> Self {
         let storage = wgpu::BufferUsages::STORAGE;
         let direct_params =
             DirectParams { light_count: lights.lights.len() as u32, shadow_size: maps.size, bias, pass_index: 0 };
@@ -200,6 +209,7 @@ struct Bindings {
     nodes: wgpu::Buffer,
     prims: wgpu::Buffer,
     surfaces: wgpu::Buffer,
+    textures: wgpu::Buffer,
     regions: wgpu::Buffer,
     direct: wgpu::Buffer,
     lights: wgpu::Buffer,
@@ -250,6 +260,7 @@ impl Bindings {
                         size: std::num::NonZeroU64::new(std::mem::size_of::<SliceParams>() as u64),
                     }),
                 },
+                buffer(17, &self.textures),
             ],
         })
     }
@@ -311,7 +322,7 @@ impl SpecularPass {
     pub fn new(
         device: &wgpu::Device,
         scene: &Scene,
-        surfaces: &wgpu::Buffer,
+        scene_buffers: &SceneBuffers,
         lights: &GpuLights,
         maps: &ShadowMaps,
         gbuffer: &GBuffer,
@@ -347,6 +358,7 @@ impl SpecularPass {
                 entry(14, storage(false)),
                 entry(15, storage(false)),
                 entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
+                entry(17, storage(true)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
@@ -382,7 +394,7 @@ impl SpecularPass {
         let grid = padded_buffer(device, "photon grids", bytemuck::cast_slice(&words), storage_usage);
         let keep = |b: &wgpu::Buffer| b.clone();
         let SceneData { nodes, prims, direct, lights, samples } =
-            SceneData::upload(device, scene, lights, maps, inputs.shadow_bias);
+            SceneData::upload(device, &scene_buffers.bvh, lights, maps, inputs.shadow_bias);
         let output = crate::binding::storage_output_texture(device, "specular radiance", width, height);
         let accum = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("specular accumulation"),
@@ -409,7 +421,8 @@ impl SpecularPass {
             params: keep(&params_buffer),
             nodes,
             prims,
-            surfaces: keep(surfaces),
+            surfaces: keep(&scene_buffers.surfaces),
+            textures: keep(&scene_buffers.textures),
             regions: keep(&media.regions),
             direct,
             lights,
@@ -475,24 +488,25 @@ impl SpecularPass {
     }
 
     /// Traces the moved `scene` (same surfaces and lights, posed anew) from
-    /// the next frame on: a new BVH and lights; `surfaces` and `maps` are
-    /// the renderer's, which may be new buffers too. Photon grids stay (the
+    /// the next frame on: a new BVH and lights; `scene_buffers` (its BVH,
+    /// surfaces and textures) and `maps` are the renderer's, new buffers too. Photon grids stay (the
     /// renderer gives the moved scene's photons with `set_photons`).
     pub fn set_scene(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         scene: &Scene,
-        surfaces: &wgpu::Buffer,
+        scene_buffers: &SceneBuffers,
         lights: &GpuLights,
         maps: &ShadowMaps,
     ) {
         let sky_radiance = lights.sky_radiance.to_array();
         let SceneData { nodes, prims, direct, lights, samples } =
-            SceneData::upload(device, scene, lights, maps, self.shadow_bias);
+            SceneData::upload(device, &scene_buffers.bvh, lights, maps, self.shadow_bias);
         let b = &mut self.bindings;
         (b.nodes, b.prims, b.direct, b.lights, b.samples) = (nodes, prims, direct, lights, samples);
-        b.surfaces = surfaces.clone();
+        b.surfaces = scene_buffers.surfaces.clone();
+        b.textures = scene_buffers.textures.clone();
         b.views = maps.views_buffer.clone();
         b.maps = maps.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

@@ -74,6 +74,7 @@ struct SpecularParams {
 // [pixels over budget, most iterations one invocation ran, unused, unused].
 @group(0) @binding(15) var<storage, read_write> status: array<atomic<u32>, 4>;
 @group(0) @binding(16) var<uniform> slice: SliceParams;
+@group(0) @binding(17) var<storage, read> texture_data: array<u32>;
 
 // Which slice this dispatch computes (mirrors specular::SliceParams).
 struct SliceParams {
@@ -94,10 +95,10 @@ fn bucket_of(cell: vec3<i32>, buckets: u32) -> u32 {
 // over this dispatch's slice of each cell's photons. A bucket shared by two
 // of the 27 cells is read twice: a photon counts only from its own cell
 // (which costs no loop, unlike remembering the buckets read). A glossy
-// surface `s` weights each photon by its BRDF seen from `eye`.
-fn gather(x: vec3<f32>, n: vec3<f32>, s: Surface, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
+// surface weights each photon by its BRDF `bsdf` seen from `eye`; a
+// Lambertian one takes its base colour as its albedo.
+fn gather(x: vec3<f32>, n: vec3<f32>, glossy: bool, bsdf: Bsdf, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
     let centre = vec3<i32>(floor(x / radius));
-    let glossy = s.glossy != 0u;
     var power = vec3<f32>(0.0);
     for (var k = 0u; k < 27u; k++) {
         if (!loop_iteration()) {
@@ -121,7 +122,7 @@ fn gather(x: vec3<f32>, n: vec3<f32>, s: Surface, eye: vec3<f32>, radius: f32, b
             if (photon_accepted(dot(d, d), dir, n, radius, params.normal_test != 0u)) {
                 var p_power = decode_rgb9e5(grid[base + 3u]);
                 if (glossy) {
-                    p_power *= photon_brdf(s, s.albedo, eye, n, dir);
+                    p_power *= photon_brdf(bsdf, eye, n, dir);
                 }
                 power += p_power;
             }
@@ -130,7 +131,7 @@ fn gather(x: vec3<f32>, n: vec3<f32>, s: Surface, eye: vec3<f32>, radius: f32, b
     if (glossy) {
         return power * (radiance_per_weighted_power(radius) * params.power_unit);
     }
-    return radiance_per_power(s.albedo, radius) * power * params.power_unit;
+    return radiance_per_power(bsdf.base_color, radius) * power * params.power_unit;
 }
 
 fn has_media() -> bool {
@@ -252,10 +253,17 @@ struct Branch {
     weight: vec3<f32>,
 }
 
-// A glossy surface whose specular lobe the eye follows (smoother than
-// GATHER_ROUGHNESS; the photon maps stand for rougher ones).
-fn follows_lobe(s: Surface) -> bool {
-    return s.kind == 0u && s.glossy != 0u && s.roughness < GATHER_ROUGHNESS;
+// A glossy surface of BRDF `b` (textures applied) whose specular lobe the
+// eye follows (smoother than GATHER_ROUGHNESS; the photon maps stand for
+// rougher ones).
+fn follows_lobe(s: Surface, b: Bsdf) -> bool {
+    return s.kind == 0u && s.glossy != 0u && b.roughness < GATHER_ROUGHNESS;
+}
+
+// Whether surface `s` may follow its lobe somewhere: smooth enough, or
+// made so by a metallic–roughness texture.
+fn may_follow_lobe(s: Surface) -> bool {
+    return s.kind == 0u && s.glossy != 0u && (s.roughness < GATHER_ROUGHNESS || s.metallic_roughness_texture != NO_TEXTURE);
 }
 
 const STACK: u32 = 16u;
@@ -273,7 +281,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // w = 0 everywhere, so check coverage through the normal's length).
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let first = surfaces[u32(g.w)];
-    let mirror_part = first.kind == 0u && (any(first.specular > vec3<f32>(0.0)) || follows_lobe(first));
+    let mirror_part = first.kind == 0u && (any(first.specular > vec3<f32>(0.0)) || may_follow_lobe(first));
     if (dot(g.xyz, g.xyz) == 0.0 || (first.kind != 1u && first.kind != 2u && !mirror_part)) {
         if (slice.index + 1u == slice.count) {
             textureStore(output, pixel, vec4<f32>(0.0));
@@ -323,33 +331,37 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             ng = normalize(x - p.a);
         }
         let s = surfaces[p.surface];
+        // The surface here with its textures (level 0, as the CPU reads).
+        let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
         let front = dot(b.dir, ng) < 0.0;
         let n = select(-ng, ng, front);
         let can_bounce = b.depth < params.max_depth;
         // Emitted light (Light::emitted_radiance), besides what the surface
         // reflects; a primary hit's is the G-buffer's.
         if ((b.depth > 0u || s.kind == 3u) && slice.index == 0u && (front || s.two_sided != 0u) && b.sees_emission != 0u) {
-            radiance += weight * s.emission;
+            radiance += weight * point.emission;
         }
         switch s.kind {
             case 0u: {
                 // A diffuse primary hit is shaded by the raster passes; here
                 // only its mirror part or followed lobe is.
                 let eye = -b.dir;
+                let bsdf = Bsdf(point.base, point.metallic, point.roughness, s.specular_factor);
+                let glossy = s.glossy != 0u;
                 if (b.depth > 0u) {
                     if (slice.index == 0u) {
                         // Its own stream, so slice 0's draws leave the path's alone.
                         var light_rng = hash_u32(path_rng ^ 0x68bc21ebu);
-                        let r = surface_reflector(s, s.albedo, eye, n);
+                        let r = surface_reflector(s, bsdf, eye, n);
                         radiance += weight * direct_radiance(x, n, r, &light_rng);
                     }
-                    let g = gather(x, n, s, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
-                    let c = gather(x, n, s, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    let g = gather(x, n, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
+                    let c = gather(x, n, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
                     radiance += weight * (g + c);
                 }
-                if (follows_lobe(s)) {
+                if (follows_lobe(s, bsdf)) {
                     // One direction of the specular lobe per pass.
-                    let sample = bsdf_sample_specular(surface_bsdf(s, s.albedo), to_shading(eye, n), stream_next_2d(&path_rng));
+                    let sample = bsdf_sample_specular(bsdf, to_shading(eye, n), stream_next_2d(&path_rng));
                     if (sample.valid && can_bounce && top < STACK) {
                         let dir = local_to_world(sample.wi, n);
                         stack[top] = Branch(x, b.depth + 1u, dir, select(0u, 1u, sample.is_delta), weight * sample.weight);

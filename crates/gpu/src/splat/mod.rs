@@ -107,6 +107,7 @@ impl SplatPass {
                 entry(2, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(3, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(4, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
+                entry(5, wgpu::ShaderStages::FRAGMENT, texture(D2)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "splat", &layout);
@@ -132,6 +133,7 @@ impl SplatPass {
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
+        let emission = view(&gbuffer.emission);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat"),
             layout: &self.layout,
@@ -141,6 +143,7 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&normal) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&albedo) },
                 wgpu::BindGroupEntry { binding: 4, resource: surfaces.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&emission) },
             ],
         });
         SplatBinding { uniforms, bind_group }

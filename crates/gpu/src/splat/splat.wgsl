@@ -20,6 +20,7 @@ struct SplatParams {
 @group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(5) var gbuffer_emission: texture_2d<f32>;
 
 @fragment
 fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
@@ -38,7 +39,9 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
         discard;
     }
     let eye = unit(params.camera_position - position.xyz);
-    let weight = photon_weight(surfaces[u32(g.w)], albedo.rgb, eye, normal, direction, params.radius);
+    let surface = surfaces[u32(g.w)];
+    let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
+    let weight = photon_weight(surface.glossy != 0u, b, eye, normal, direction, params.radius);
     let radiance = weight * decode_rgb9e5(in.power_rgb9e5) * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);

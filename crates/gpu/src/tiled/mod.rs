@@ -165,6 +165,7 @@ impl TiledPass {
                 compute(14, storage(true)),
                 compute(15, texture(wgpu::TextureViewDimension::D2Array)),
                 compute(16, storage(true)),
+                compute(17, texture(wgpu::TextureViewDimension::D2)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "tiled", &layout);
@@ -222,6 +223,7 @@ impl TiledPass {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo, output) =
             (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo), view(target));
+        let emission = view(&gbuffer.emission);
         let slices_view = media.slices.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -260,6 +262,7 @@ impl TiledPass {
                 whole(14, &media.regions),
                 texture(15, &slices_view),
                 whole(16, surfaces),
+                texture(17, &emission),
             ],
         });
         TiledBinding {

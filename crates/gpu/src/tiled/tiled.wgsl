@@ -62,6 +62,7 @@ struct TiledParams {
 @group(0) @binding(14) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(15) var slices_tex: texture_2d_array<f32>;
 @group(0) @binding(16) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(17) var gbuffer_emission: texture_2d<f32>;
 
 const TILE: u32 = 16u;
 
@@ -243,6 +244,7 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
     let surface = surfaces[u32(g.w)];
     let glossy = surface.glossy != 0u;
+    let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let eye = unit(media.camera_position - position.xyz);
     // Only visible diffuse surfaces (kind 0) take photon light.
     if (position.w != 0.0 && albedo.a == 0.0) {
@@ -254,7 +256,7 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
             if (photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
                 var power = decode_rgb9e5(p.power_rgb9e5) * p.scale;
                 if (glossy) {
-                    power *= photon_brdf(surface, albedo.rgb, eye, normal, direction);
+                    power *= photon_brdf(b, eye, normal, direction);
                 }
                 add_to_sum(&sum, power);
             }

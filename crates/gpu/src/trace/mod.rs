@@ -43,6 +43,7 @@ pub fn trace_shader_source() -> String {
             &BVH,
             &SURFACE,
             &crate::wgsl::BSDF,
+            &crate::wgsl::CUT_OUTS,
             &SPOT,
             &PHOTON_ENCODING,
             &RECORD,
@@ -255,6 +256,8 @@ struct TraceScene {
     global_mask: u32,
     /// The emissive meshes' triangles, and each light's first one there.
     emissive: wgpu::Buffer,
+    /// The packed textures, coordinates in the BVH's order (`textures::pack_scene`).
+    textures: wgpu::Buffer,
     first_triangles: Vec<u32>,
     distant_disc: [f32; 4],
     lights: Vec<Light>,
@@ -329,6 +332,11 @@ impl TraceScene {
             region_triangles: regions.len() as u32,
             global_mask: media.global_mask(),
             emissive: storage_buffer(device, "trace emissive triangles", bytemuck::cast_slice(&triangles)),
+            textures: storage_buffer(
+                device,
+                "trace textures",
+                bytemuck::cast_slice(&crate::textures::pack_scene(scene, Some(&bvh))),
+            ),
             first_triangles,
             distant_disc: scene
                 .lights
@@ -423,6 +431,7 @@ impl GpuTracer {
                     compute(9, storage(false)),
                     compute(10, storage(true)),
                     compute(11, storage(true)),
+                    compute(12, storage(true)),
                 ],
             });
             let compact_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -676,6 +685,7 @@ impl GpuTracer {
                 &status,
                 &s.regions,
                 &s.emissive,
+                &s.textures,
             ],
         );
         let compact_bind_group = bind(

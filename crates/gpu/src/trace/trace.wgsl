@@ -117,6 +117,7 @@ struct FlatShading {
 @group(0) @binding(9) var<storage, read_write> status: array<atomic<u32>, 4>;
 @group(0) @binding(10) var<storage, read> regions: array<TraceRegionTriangle>;
 @group(0) @binding(11) var<storage, read> emissive: array<TraceTriangle>;
+@group(0) @binding(12) var<storage, read> texture_data: array<u32>;
 
 const GLOBAL_MAP: u32 = 0u;
 const CAUSTIC_MAP: u32 = 1u;
@@ -383,6 +384,8 @@ fn trace_one(rng: ptr<function, Rng>) {
         let x = ray.origin + ray.dir * hit.t;
         let normals = hit_normals(hit.prim, ray.origin, ray.dir, x);
         let s = surfaces[prims[hit.prim].surface];
+        // The surface here with its textures (Scene::material_at).
+        let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
         // Normals on the side the photon arrives from.
         let facing = select(-1.0, 1.0, dot(ray.dir, normals.geometric) < 0.0);
         let ng = normals.geometric * facing;
@@ -408,7 +411,7 @@ fn trace_one(rng: ptr<function, Rng>) {
             // The glTF BRDF (photon::trace's Pbr arm): stored where the
             // photon maps stand for some lobe, then a bounce sampling the
             // whole BRDF with roulette on the sample's weight.
-            let b = surface_bsdf(s, s.albedo);
+            let b = Bsdf(point.base, point.metallic, point.roughness, s.specular_factor);
             if (bsdf_has_diffuse(b) || bsdf_gathers_specular(b)) {
                 store_surface(x, power, ray.dir, diffuse_bounces, specular_bounces);
             }
@@ -430,7 +433,7 @@ fn trace_one(rng: ptr<function, Rng>) {
             }
             next_dir = local_to_world(sample.wi, ns);
         } else {
-            let rho_d = select(vec3<f32>(0.0), s.albedo, s.kind == 0u);
+            let rho_d = select(vec3<f32>(0.0), point.base, s.kind == 0u);
             let rho_s = select(s.albedo, s.specular, s.kind == 0u);
             if (max(max(rho_d.x, rho_d.y), rho_d.z) > 0.0) {
                 store_surface(x, power, ray.dir, diffuse_bounces, specular_bounces);

@@ -270,3 +270,16 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
     return Bsdf(base, s.metallic, s.roughness, s.specular_factor);
 }
+
+// The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the
+// G-buffer's albedo, metallic and roughness from `packed` (its emission.w,
+// surface_point.wgsl's `pack_metal_rough`) where a texture varies them.
+fn pixel_bsdf(s: Surface, base: vec3<f32>, packed: f32) -> Bsdf {
+    var b = surface_bsdf(s, base);
+    if (s.metallic_roughness_texture != 0xffffffffu) {
+        let bits = u32(packed);
+        b.metallic = f32(bits / 4096u) / 4095.0;
+        b.roughness = f32(bits % 4096u) / 4095.0;
+    }
+    return b;
+}

@@ -1,7 +1,9 @@
 // Closest hits in the scene's flat BVH (hikari_core::geometry::FlatBvh),
 // step for step as its CPU `intersect`: the specular pass and the photon
 // tracer share this one copy. The includer declares the storage arrays
-// `nodes` and `prims`, and `loop_iteration()` (its loop accounting).
+// `nodes` and `prims`, `loop_iteration()` (its loop accounting) and
+// `prim_is_there(prim, barycentrics)`: false where a cut-out (alphaMode
+// MASK) is cut, so the ray goes on (Accel's alpha test; CUT_OUTS).
 
 struct FlatNode {
     min: vec3<f32>,
@@ -36,8 +38,10 @@ fn slab_hit(o: vec3<f32>, inv: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>, t_max: f
     return near <= far;
 }
 
-// Nearest hit in (epsilon, t_max), as hikari_core's Triangle/Sphere::intersect.
-fn intersect_prim(p: FlatPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32, eps: f32) -> f32 {
+// Nearest hit in (epsilon, t_max), as hikari_core's Triangle/Sphere::intersect:
+// (t, b1, b2), t = NO_HIT for none; a triangle's barycentrics b1, b2 are
+// the weights of its vertices 1 and 2 (zero for spheres).
+fn intersect_prim(p: FlatPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32, eps: f32) -> vec3<f32> {
     if (p.is_sphere != 0u) {
         let radius = p.b.x;
         let oc = o - p.a;
@@ -46,7 +50,7 @@ fn intersect_prim(p: FlatPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32, eps: f32)
         let closest = oc - d * (half_b / a);
         let disc = radius * radius - dot(closest, closest);
         if (disc < 0.0) {
-            return NO_HIT;
+            return vec3<f32>(NO_HIT, 0.0, 0.0);
         }
         let root = sqrt(a * disc);
         let q = -half_b - select(-root, root, half_b >= 0.0);
@@ -58,46 +62,48 @@ fn intersect_prim(p: FlatPrim, o: vec3<f32>, d: vec3<f32>, t_max: f32, eps: f32)
             t1 = tmp;
         }
         if (t0 > eps && t0 < t_max) {
-            return t0;
+            return vec3<f32>(t0, 0.0, 0.0);
         }
         if (t1 > eps && t1 < t_max) {
-            return t1;
+            return vec3<f32>(t1, 0.0, 0.0);
         }
-        return NO_HIT;
+        return vec3<f32>(NO_HIT, 0.0, 0.0);
     }
     let e1 = p.b;
     let e2 = p.c;
     let pv = cross(d, e2);
     let det = dot(e1, pv);
     if (abs(det) < 1.0e-12) {
-        return NO_HIT;
+        return vec3<f32>(NO_HIT, 0.0, 0.0);
     }
     let inv = 1.0 / det;
     let s = o - p.a;
     let b1 = dot(s, pv) * inv;
     if (b1 < 0.0 || b1 > 1.0) {
-        return NO_HIT;
+        return vec3<f32>(NO_HIT, 0.0, 0.0);
     }
     let qv = cross(s, e1);
     let b2 = dot(d, qv) * inv;
     if (b2 < 0.0 || b1 + b2 > 1.0) {
-        return NO_HIT;
+        return vec3<f32>(NO_HIT, 0.0, 0.0);
     }
     let t = dot(e2, qv) * inv;
     if (t > eps && t < t_max) {
-        return t;
+        return vec3<f32>(t, b1, b2);
     }
-    return NO_HIT;
+    return vec3<f32>(NO_HIT, 0.0, 0.0);
 }
 
 struct Hit {
     t: f32,
     prim: u32,
+    // Barycentrics (weights of vertices 1 and 2) of a triangle hit.
+    b: vec2<f32>,
 }
 
 // Closest hit by stack traversal of the flat BVH (FlatBvh::intersect).
 fn trace_bvh(o: vec3<f32>, d: vec3<f32>, eps: f32) -> Hit {
-    var hit = Hit(NO_HIT, 0u);
+    var hit = Hit(NO_HIT, 0u, vec2<f32>(0.0));
     if (arrayLength(&nodes) == 0u) {
         return hit;
     }
@@ -126,9 +132,9 @@ fn trace_bvh(o: vec3<f32>, d: vec3<f32>, eps: f32) -> Hit {
             if (!loop_iteration()) {
                 break;
             }
-            let t = intersect_prim(prims[i], o, d, hit.t, eps);
-            if (t < hit.t) {
-                hit = Hit(t, i);
+            let r = intersect_prim(prims[i], o, d, hit.t, eps);
+            if (r.x < hit.t && prim_is_there(i, r.yz)) {
+                hit = Hit(r.x, i, r.yz);
             }
         }
     }

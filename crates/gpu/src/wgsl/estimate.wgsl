@@ -18,18 +18,18 @@ fn radiance_per_weighted_power(radius: f32) -> f32 {
 }
 
 // The BRDF a photon arriving along `photon_dir` (its travel direction) is
-// weighted by at a glossy pixel of base colour `base` on `surface`, seen
-// from `eye` (world, from the point toward the viewer), shading normal `n`:
-// the lobes the photon maps stand for (photon-cpu's `part`).
-fn photon_brdf(surface: Surface, base: vec3<f32>, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>) -> vec3<f32> {
-    return bsdf_f_gathered(surface_bsdf(surface, base), to_shading(eye, n), to_shading(-photon_dir, n));
+// weighted by at a glossy point of BRDF `b`, seen from `eye` (world, from
+// the point toward the viewer), shading normal `n`: the lobes the photon
+// maps stand for (photon-cpu's `part`).
+fn photon_brdf(b: Bsdf, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>) -> vec3<f32> {
+    return bsdf_f_gathered(b, to_shading(eye, n), to_shading(-photon_dir, n));
 }
 
 // What a photon adds per unit power there: f·(1/π r²) on a glossy
-// surface, ρ/(π² r²) on a Lambertian one.
-fn photon_weight(surface: Surface, base: vec3<f32>, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>, radius: f32) -> vec3<f32> {
-    if (surface.glossy == 0u) {
-        return radiance_per_power(base, radius);
+// surface, ρ/(π² r²) (ρ = b's base colour) on a Lambertian one.
+fn photon_weight(glossy: bool, b: Bsdf, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>, radius: f32) -> vec3<f32> {
+    if (!glossy) {
+        return radiance_per_power(b.base_color, radius);
     }
-    return photon_brdf(surface, base, eye, n, photon_dir) * radiance_per_weighted_power(radius);
+    return photon_brdf(b, eye, n, photon_dir) * radiance_per_weighted_power(radius);
 }

@@ -74,6 +74,21 @@ pub static REGION_CROSSING: Module =
 /// Closest hits in the flat BVH (hikari_core::geometry::FlatBvh).
 pub static BVH: Module = Module { name: "bvh.wgsl", source: include_str!("bvh.wgsl"), requires: &[] };
 
+/// `prim_is_there` for bvh.wgsl: the alpha test of cut-outs (alphaMode
+/// MASK) at a candidate hit, as `Accel` tests it. The includer declares
+/// `prims`, `surfaces` and `texture_data`.
+pub static CUT_OUTS: Module = Module {
+    name: "cut_outs",
+    source: "fn prim_is_there(prim: u32, b: vec2<f32>) -> bool {\n\
+             let p = prims[prim];\n\
+             if (p.is_sphere != 0u) { return true; }\n\
+             let s = surfaces[p.surface];\n\
+             if (s.alpha_cutoff < 0.0) { return true; }\n\
+             return surface_point(s, primitive_uv(prim, b), vec2<f32>(0.0), vec2<f32>(0.0)).opaque;\n\
+             }\n",
+    requires: &[&crate::textures::SURFACE_POINT],
+};
+
 /// Prefix sums across workgroups for order-keeping compaction.
 pub static PREFIX_SUM: Module =
     Module { name: "prefix_sum.wgsl", source: include_str!("prefix_sum.wgsl"), requires: &[] };

@@ -18,4 +18,13 @@ struct Surface {
     roughness: f32,
     specular_factor: f32,
     glossy: u32,
+    // Textures (textures.wgsl's `surface_point`): `emission` per unit of
+    // the emissive texture, MASK's cut-off (negative: opaque), texture
+    // references (0xffffffff: none) and the base colour factor's alpha.
+    emission_per_texel: vec3<f32>,
+    alpha_cutoff: f32,
+    base_color_texture: u32,
+    metallic_roughness_texture: u32,
+    emissive_texture: u32,
+    alpha_factor: f32,
 }

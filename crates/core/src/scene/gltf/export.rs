@@ -8,6 +8,8 @@ use crate::light::Light;
 use crate::material::{Material, Rgb};
 use crate::scene::Scene;
 use glam::{Mat3, Quat, Vec2, Vec3};
+/// The wrap modes `GltfBuilder::texture` takes, for writers outside this crate.
+pub use gltf::json::texture::WrappingMode;
 use gltf::json::{self, Index, validation::Checked::Valid, validation::USize64};
 
 /// A glTF material in the metallic–roughness model.

@@ -1,0 +1,215 @@
+//! The scene's textures on the GPU: every image of `Scene::texturing` with
+//! its mip chain, packed into one storage buffer of 32-bit texels (8 bits a
+//! channel, sRGB-encoded where the image holds colour), then the texture
+//! coordinates of every BVH primitive. `textures.wgsl` samples them with
+//! the CPU's bilinear filter and wrap modes (`hikari_core::texture::Image::sample`,
+//! pinned by a test); the G-buffer pass picks a mip level from the pixel's
+//! footprint, the passes that trace rays read level 0 as the CPU does.
+//!
+//! One buffer, not texture arrays: it works in every stage on every
+//! adapter the project supports (no bindless on GL), costs one binding,
+//! holds images of any size without size classes, and the filter is
+//! written once, twin of the CPU's.
+//!
+//! # Layout (u32 words)
+//!
+//! * `[0]` image count, `[1]` word offset of the texture coordinates (0:
+//!   none), `[2..4]` unused.
+//! * per image, `IMAGE_WORDS` words from `HEADER_WORDS`: width, height,
+//!   level count, 1 if sRGB-encoded, then the word offset of each level.
+//! * the levels' texels, row by row from the top, `pack4x8unorm` order
+//!   (r in the low byte).
+//! * per BVH primitive (`FlatBvh::prims` order), its three vertices' (u, v)
+//!   as f32 bits; six `NO_TEXTURE` words for primitives without coordinates.
+
+use hikari_core::geometry::FlatBvh;
+use hikari_core::scene::Scene;
+use hikari_core::texture::{ColorSpace, Image, TextureRef, Texturing, Wrap};
+
+/// The texture lookups; the includer declares `texture_data`.
+pub static TEXTURES: crate::wgsl::Module =
+    crate::wgsl::Module { name: "textures.wgsl", source: include_str!("textures.wgsl"), requires: &[] };
+
+/// A surface at a point with its textures (`surface_point`), and the
+/// G-buffer's packing of textured metallic and roughness.
+pub static SURFACE_POINT: crate::wgsl::Module = crate::wgsl::Module {
+    name: "surface_point.wgsl",
+    source: include_str!("surface_point.wgsl"),
+    requires: &[&TEXTURES, &crate::wgsl::SURFACE, &crate::wgsl::BSDF],
+};
+
+/// A surface without this texture (`GpuSurface`'s texture fields).
+pub const NO_TEXTURE: u32 = u32::MAX;
+const HEADER_WORDS: usize = 4;
+/// Width, height, levels, sRGB, then up to `MAX_LEVELS` level offsets.
+const IMAGE_WORDS: usize = 4 + MAX_LEVELS;
+/// Levels of a 32768-texel side: more than any adapter draws.
+const MAX_LEVELS: usize = 16;
+
+/// A texture reference as `GpuSurface` holds it: the image index in bits
+/// 0–23, wrap s in 24–25 and wrap t in 26–27 (0 repeat, 1 clamp to edge,
+/// 2 mirrored repeat); `NO_TEXTURE` for None.
+pub fn texture_ref(texture: Option<TextureRef>) -> u32 {
+    let wrap = |w: Wrap| match w {
+        Wrap::Repeat => 0,
+        Wrap::ClampToEdge => 1,
+        Wrap::MirroredRepeat => 2,
+    };
+    texture
+        .map_or(NO_TEXTURE, |t| (t.image & 0x00ff_ffff) | wrap(t.sampler.wrap_s) << 24 | wrap(t.sampler.wrap_t) << 26)
+}
+
+/// How each image is encoded: sRGB where some material reads it as colour
+/// (base colour, emission), linear where it holds data (metallic–roughness).
+fn color_spaces(texturing: &Texturing) -> Vec<ColorSpace> {
+    let mut spaces = vec![ColorSpace::Linear; texturing.images.len()];
+    for m in texturing.materials.iter().flatten() {
+        for t in [m.base_color, m.emissive].into_iter().flatten() {
+            spaces[t.image as usize] = ColorSpace::Srgb;
+        }
+    }
+    spaces
+}
+
+/// One texel's 8-bit channels from linear values.
+fn encode(texel: glam::Vec4, space: ColorSpace) -> u32 {
+    let byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u32;
+    let colour = |v: f32| match space {
+        ColorSpace::Srgb => byte(hikari_core::output::linear_to_srgb(v)),
+        ColorSpace::Linear => byte(v),
+    };
+    colour(texel.x) | colour(texel.y) << 8 | colour(texel.z) << 16 | byte(texel.w) << 24
+}
+
+/// The mip chain of `image` below level 0: each level the 2×2 box mean of
+/// the one above, in linear values (odd sides clamp their last texel).
+pub fn mip_chain(image: &Image) -> Vec<Image> {
+    let mut levels: Vec<Image> = Vec::new();
+    loop {
+        let above = levels.last().unwrap_or(image);
+        let (w, h) = (above.width(), above.height());
+        if (w, h) == (1, 1) || levels.len() + 1 >= MAX_LEVELS {
+            return levels;
+        }
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut texels = Vec::with_capacity((nw * nh) as usize);
+        for y in 0..nh {
+            for x in 0..nw {
+                let at =
+                    |dx: u32, dy: u32| above.texel((2 * x + dx).min(w - 1) as usize, (2 * y + dy).min(h - 1) as usize);
+                texels.push((at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1)) * 0.25);
+            }
+        }
+        levels.push(Image::new(nw, nh, texels).expect("a non-empty level"));
+    }
+}
+
+/// The words of the texture buffer for `scene` with texture coordinates in
+/// the primitive order of `bvh`; a header of zeros for a scene without
+/// textures (wgpu refuses empty bindings).
+pub fn pack_scene(scene: &Scene, bvh: Option<&FlatBvh>) -> Vec<u32> {
+    match &scene.texturing {
+        Some(texturing) => pack(texturing, bvh),
+        None => vec![0; HEADER_WORDS],
+    }
+}
+
+/// The words of the texture buffer for `texturing` (see `pack_scene`).
+pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
+    if texturing.images.is_empty() {
+        return vec![0; HEADER_WORDS];
+    }
+    let spaces = color_spaces(texturing);
+    let images = &texturing.images;
+    let mut words = vec![0u32; HEADER_WORDS + IMAGE_WORDS * images.len()];
+    words[0] = images.len() as u32;
+    for (i, image) in images.iter().enumerate() {
+        let header = HEADER_WORDS + IMAGE_WORDS * i;
+        let chain = mip_chain(image);
+        words[header] = image.width();
+        words[header + 1] = image.height();
+        words[header + 2] = 1 + chain.len() as u32;
+        words[header + 3] = (spaces[i] == ColorSpace::Srgb) as u32;
+        for (level, texels) in std::iter::once(image).chain(chain.iter()).enumerate() {
+            words[header + 4 + level] = words.len() as u32;
+            for y in 0..texels.height() as usize {
+                for x in 0..texels.width() as usize {
+                    words.push(encode(texels.texel(x, y), spaces[i]));
+                }
+            }
+        }
+    }
+    if let Some(bvh) = bvh.filter(|_| !texturing.uvs.is_empty()) {
+        words[1] = words.len() as u32;
+        for &source in &bvh.source {
+            match texturing.uvs.triangle(source) {
+                Some(uvs) => words.extend(uvs.iter().flat_map(|uv| [uv.x.to_bits(), uv.y.to_bits()])),
+                None => words.extend([NO_TEXTURE; 6]),
+            }
+        }
+    }
+    words
+}
+
+/// Bytes of `pack`'s buffer for `scene`, without building it (the memory
+/// check before upload): the texels and their mip chains, and 24 bytes a
+/// primitive for texture coordinates.
+pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
+    let Some(texturing) = &scene.texturing else { return 16 };
+    let texels: u64 = texturing
+        .images
+        .iter()
+        .map(|image| {
+            let (mut w, mut h, mut sum) = (image.width() as u64, image.height() as u64, 0);
+            loop {
+                sum += w * h;
+                if w == 1 && h == 1 {
+                    return sum;
+                }
+                (w, h) = ((w / 2).max(1), (h / 2).max(1));
+            }
+        })
+        .sum();
+    let uvs = if texturing.uvs.is_empty() { 0 } else { primitives as u64 * 24 };
+    4 * (HEADER_WORDS + IMAGE_WORDS * texturing.images.len()) as u64 + 4 * texels + uvs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec4;
+    use hikari_core::texture::srgb_to_linear;
+
+    /// Every 8-bit sRGB value survives decoding (as the loader does) and
+    /// re-encoding: the GPU holds the file's own bytes.
+    #[test]
+    fn srgb_bytes_round_trip() {
+        for k in 0..=255u32 {
+            let linear = srgb_to_linear(k as f32 / 255.0);
+            let texel = Vec4::new(linear, linear, linear, k as f32 / 255.0);
+            assert_eq!(encode(texel, ColorSpace::Srgb), k * 0x0101_0101, "byte {k}");
+            assert_eq!(encode(Vec4::splat(k as f32 / 255.0), ColorSpace::Linear), k * 0x0101_0101, "byte {k}");
+        }
+    }
+
+    /// A 5×3 image halves to 2×1, then 1×1, each texel the mean of the
+    /// 2×2 texels above it.
+    #[test]
+    fn mip_levels_are_box_means() {
+        let texels = (0..15).map(|i| Vec4::splat(i as f32)).collect();
+        let image = Image::new(5, 3, texels).unwrap();
+        let chain = mip_chain(&image);
+        assert_eq!(chain.iter().map(|l| (l.width(), l.height())).collect::<Vec<_>>(), [(2, 1), (1, 1)]);
+        // Texels (0,0), (1,0), (0,1), (1,1) of the top level: 0, 1, 5, 6.
+        assert_eq!(chain[0].texel(0, 0), Vec4::splat(3.0));
+        assert_eq!(chain[1].texel(0, 0), (chain[0].texel(0, 0) + chain[0].texel(1, 0)) * 0.5);
+    }
+
+    #[test]
+    fn texture_references_pack_image_and_wraps() {
+        use hikari_core::texture::Sampler;
+        let t = TextureRef { image: 7, sampler: Sampler { wrap_s: Wrap::MirroredRepeat, wrap_t: Wrap::ClampToEdge } };
+        assert_eq!(texture_ref(Some(t)), 7 | 2 << 24 | 1 << 26);
+        assert_eq!(texture_ref(None), NO_TEXTURE);
+    }
+}

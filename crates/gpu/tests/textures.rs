@@ -1,0 +1,235 @@
+//! textures.wgsl against hikari_core::texture: the packed buffer read back
+//! through the WGSL filter gives the CPU's bilinear samples (sRGB colour
+//! and linear data, every wrap mode, coordinates far outside [0, 1]), and
+//! a mip level gives the CPU's sample of the same level.
+
+use glam::{Vec2, Vec4};
+use hikari_core::sampling::Rng;
+use hikari_core::texture::{ColorSpace, Image, MaterialTextures, Sampler, TextureRef, Texturing, Wrap};
+use hikari_gpu::test_support::{run_kernel_on, test_context};
+use hikari_gpu::textures::{TEXTURES, mip_chain, pack, texture_ref};
+
+/// An image of random 8-bit texels, decoded from `space` as the loader does.
+fn random_image(rng: &mut Rng, width: u32, height: u32, space: ColorSpace) -> Image {
+    let values: Vec<u32> = (0..width * height * 4).map(|_| rng.next_u32() & 0xff).collect();
+    Image::from_integers(width, height, 4, values.into_iter(), 255, space).unwrap()
+}
+
+#[test]
+fn wgsl_texture_samples_match_the_cpu() {
+    let ctx = test_context("wgsl_texture_samples_match_the_cpu");
+    let mut rng = Rng::for_item(21, 0);
+    let colour = random_image(&mut rng, 7, 5, ColorSpace::Srgb);
+    let data = random_image(&mut rng, 4, 9, ColorSpace::Linear);
+    let reference = |image: u32| TextureRef { image, sampler: Sampler::default() };
+    let texturing = Texturing {
+        images: vec![colour.clone(), data.clone()],
+        materials: vec![Some(MaterialTextures {
+            base_color: Some(reference(0)),
+            metallic_roughness: Some(reference(1)),
+            ..Default::default()
+        })],
+        ..Default::default()
+    };
+    let mut words = pack(&texturing, None);
+    let wraps = [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat];
+    // Per query: texture reference, level, u, v; then four outputs.
+    let first_query = words.len();
+    let mut queries = Vec::new();
+    for i in 0..4096 {
+        let image = (i % 2) as u32;
+        let sampler = Sampler { wrap_s: wraps[i % 3], wrap_t: wraps[(i / 3) % 3] };
+        let uv = (Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5) * 8.0;
+        let level = (i / 9 % 2) as u32;
+        let t = texture_ref(Some(TextureRef { image, sampler }));
+        words.extend([t, level, uv.x.to_bits(), uv.y.to_bits(), 0, 0, 0, 0]);
+        queries.push((image, sampler, uv, level));
+    }
+    let main = format!(
+        "let q = {first_query}u + 8u * id.x; if (q >= arrayLength(&texture_data)) {{ return; }}\n\
+         let uv = vec2<f32>(bitcast<f32>(texture_data[q + 2u]), bitcast<f32>(texture_data[q + 3u]));\n\
+         let v = sample_level(texture_data[q], uv, texture_data[q + 1u]);\n\
+         texture_data[q + 4u] = bitcast<u32>(v.x); texture_data[q + 5u] = bitcast<u32>(v.y);\n\
+         texture_data[q + 6u] = bitcast<u32>(v.z); texture_data[q + 7u] = bitcast<u32>(v.w);"
+    );
+    let gpu = run_kernel_on(&ctx, &[&TEXTURES], &main, "texture_data", &words);
+    let levels = [[colour.clone(), mip_chain(&colour).remove(0)], [data.clone(), mip_chain(&data).remove(0)]];
+    let mut worst = 0.0f32;
+    for (k, (image, sampler, uv, level)) in queries.iter().enumerate() {
+        let q = first_query + 8 * k;
+        let got = Vec4::from_array(std::array::from_fn(|c| f32::from_bits(gpu[q + 4 + c])));
+        let level_image = &levels[*image as usize][*level as usize];
+        let want = level_image.sample(*uv, *sampler);
+        // A mip level is held at 8 bits on the GPU and in f32 by the CPU:
+        // half a step of 8 bits in the encoded value.
+        let tolerance = if *level == 0 { 2e-5 } else { 4e-3 };
+        let err = (got - want).abs().max_element();
+        worst = worst.max(if *level == 0 { err } else { 0.0 });
+        assert!(err < tolerance, "query {k}: image {image} {sampler:?} uv {uv} level {level}: {got} vs {want}");
+    }
+    eprintln!("textures.wgsl: worst level-0 difference {worst:e}");
+}
+
+/// Two Lambertian quads with a grey checker in base colour (REPEAT and
+/// CLAMP_TO_EDGE) under the white sky, seen from above: the G-buffer holds
+/// the CPU's textured albedo at every pixel's point (sRGB decoding, the
+/// image's top row at v = 0, bilinear, wraps), and the image shows it
+/// (radiance 1 from the open sky).
+#[test]
+fn a_checker_texture_shows_on_the_gpu_as_on_the_cpu() {
+    use glam::Vec3;
+    use hikari_core::material::Material;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::test_scenes::gltf_textures::{checker_glb, load};
+    let mut scene = load("gpu-checker", &checker_glb());
+    // Both quads (x from 0 to 3, y from 0 to 1) fill the width.
+    let (width, height) = (96, 32);
+    let eye = Vec3::new(1.5, 0.5, 4.0);
+    scene.camera =
+        hikari_core::camera::Camera::new(eye, Vec3::new(1.5, 0.5, 0.0), Vec3::Y, 16.0, width, height).unwrap();
+    let ctx = test_context("a_checker_texture_shows_on_the_gpu_as_on_the_cpu");
+    let traced = trace_photons(&scene, &TraceSettings { photons: 2_000, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let settings = hikari_gpu::GpuSettings { area_light_samples: 16, ..hikari_gpu::GpuSettings::new(global, caustic) };
+    let gpu = hikari_gpu::GpuRenderer::new(ctx, &scene, &traced, settings).expect("GPU renderer");
+    gpu.render().unwrap();
+    let albedo = gpu.read(&gpu.targets.gbuffer.albedo).unwrap();
+    let image = gpu.read(gpu.resolved()).unwrap();
+    let (mut textured, mut worst) = (0, 0.0f32);
+    for y in 0..height {
+        for x in 0..width {
+            let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let Some(hit) = scene.accel.intersect(&ray) else { continue };
+            let Material::Diffuse { albedo: want, .. } = scene.material_at(&hit) else { panic!("Lambertian quads") };
+            let i = (y * width + x) as usize;
+            let got = albedo[i].truncate();
+            let err = (got - want).abs().max_element();
+            worst = worst.max(err);
+            assert!(err < 1e-4, "pixel ({x}, {y}): G-buffer {got} vs CPU {want}");
+            // Open sky of radiance 1 over a Lambertian quad: L = ρ.
+            let shown = image[i].truncate();
+            assert!((shown - want).abs().max_element() < 1e-3, "pixel ({x}, {y}): {shown} vs {want}");
+            textured += 1;
+        }
+    }
+    eprintln!("checker: {textured} textured pixels, worst albedo difference {worst:e}");
+    assert!(textured > 1500, "{textured} pixels see the quads");
+}
+
+/// A cut-out quad (alpha a 2×2 checker, cut-off 0.5) over a floor under a
+/// sun straight down: the G-buffer sees the floor through the cut texels,
+/// the sun's shadow map lets its light through them, and the GPU tracer
+/// sends photons through; the image matches photon-cpu's.
+#[test]
+fn a_cutout_lets_light_through_on_the_gpu() {
+    use glam::Vec3;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+    use hikari_core::test_scenes::gltf_textures::{cutout_glb, load};
+    let mut scene = load("gpu-cutout", &cutout_glb());
+    let size = 64;
+    scene.camera =
+        hikari_core::camera::Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 30.0, size, size).unwrap();
+    let ctx = test_context("a_cutout_lets_light_through_on_the_gpu");
+    let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, ..Default::default() }, &Silent);
+    let cpu_settings = PhotonCpuSettings { spp: 1, ..Default::default() };
+    let (global, caustic) = cpu_settings.estimate_params(&scene);
+    let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings).render(&Silent).0;
+    let settings = hikari_gpu::GpuSettings { shadow_map_size: 2048, ..hikari_gpu::GpuSettings::new(global, caustic) };
+    let gpu = hikari_gpu::GpuRenderer::new(ctx.clone(), &scene, &traced, settings).expect("GPU renderer");
+    gpu.render().unwrap();
+    let image = gpu.read(gpu.resolved()).unwrap();
+    // Lit floor where the sun shines through, black where the quad stands.
+    let lit = 0.5 / std::f32::consts::PI * 2.0;
+    let (mut same, mut open, mut total) = (0, 0, 0);
+    for (g, c) in image.iter().zip(&cpu.pixels) {
+        let (g, c) = (g.x, c.x);
+        total += 1;
+        open += (c > 0.5 * lit) as usize;
+        same += ((g - c).abs() < 0.02 * lit + 0.02 * c) as usize;
+    }
+    eprintln!("cut-out: {same} of {total} pixels agree, {open} see lit floor");
+    assert!(open > total / 4, "{open} of {total} see the lit floor");
+    // Texel-sized steps of the shadow map and the cut edges' pixels aside.
+    assert!(same as f64 > 0.97 * total as f64, "{same} of {total} pixels agree");
+    // The GPU tracer's photons pass the cut texels: under the quad half
+    // the density beside it, as the CPU's.
+    let mut tracer = hikari_gpu::trace::GpuTracer::new(&ctx, &scene).expect("GPU tracer");
+    let (photons, _) = tracer.trace(&ctx, &TraceSettings { photons: 200_000, ..Default::default() }).expect("photons");
+    let (mut under, mut beside) = (0usize, 0usize);
+    for p in &photons.global {
+        let [x, y, z] = p.position;
+        if y.abs() > 1e-3 {
+            continue;
+        }
+        let r = x.abs().max(z.abs());
+        if r < 0.5 {
+            under += 1;
+        } else if r < 1.5 {
+            beside += 1;
+        }
+    }
+    let ratio = under as f32 * 8.0 / beside as f32;
+    eprintln!("GPU photons under the cut-out {under}, beside {beside}: density ratio {ratio}");
+    assert!((ratio - 0.5).abs() < 0.05, "{ratio}");
+}
+
+/// A metallic–roughness texture (B metallic, G roughness, times their
+/// factors) reaches the G-buffer, which the direct pass and the estimates
+/// read: 12 bits each in emission.w, within a step of the CPU's material.
+#[test]
+fn metallic_roughness_textures_reach_the_gbuffer() {
+    use glam::Vec3;
+    use hikari_core::material::Material;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial, WrappingMode, png};
+    use hikari_core::test_scenes::gltf_textures::{load, quad};
+    let mut b = GltfBuilder::new();
+    // A 2×1 image: metallic 51/255 and 204/255, roughness 128/255 and 64/255.
+    let image = b.image(&png(2, 1, &[0, 128, 51, 255, 0, 64, 204, 255]), "image/png");
+    let t = b.texture(image, WrappingMode::ClampToEdge, WrappingMode::ClampToEdge);
+    let m = b.material(&PbrMaterial {
+        metallic: 1.0,
+        roughness: 0.5,
+        base_color: Vec3::splat(0.8),
+        metallic_roughness_texture: Some(t),
+        ..Default::default()
+    });
+    let node = quad(&mut b, Vec3::new(0.0, 1.0, 0.0), Vec3::X, -Vec3::Y, 1.0, m);
+    let mut scene = load("gpu-mr", &b.to_glb(vec![node]));
+    let size = 32;
+    scene.camera =
+        hikari_core::camera::Camera::new(Vec3::new(0.5, 0.5, 2.0), Vec3::new(0.5, 0.5, 0.0), Vec3::Y, 20.0, size, size)
+            .unwrap();
+    let ctx = test_context("metallic_roughness_textures_reach_the_gbuffer");
+    let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let gpu = hikari_gpu::GpuRenderer::new(ctx, &scene, &traced, hikari_gpu::GpuSettings::new(global, caustic))
+        .expect("GPU renderer");
+    gpu.render().unwrap();
+    let emission = gpu.read(&gpu.targets.gbuffer.emission).unwrap();
+    let mut checked = 0;
+    for y in 0..size {
+        for x in 0..size {
+            let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let Some(hit) = scene.accel.intersect(&ray) else { continue };
+            let Material::Pbr(want) = scene.material_at(&hit) else { panic!("a glossy quad") };
+            let bits = emission[(y * size + x) as usize].w as u32;
+            let (metallic, roughness) = ((bits / 4096) as f32 / 4095.0, (bits % 4096) as f32 / 4095.0);
+            let step = 0.5 / 4095.0 + 1e-6;
+            assert!((metallic - want.metallic).abs() <= step, "({x}, {y}): metallic {metallic} vs {}", want.metallic);
+            assert!(
+                (roughness - want.roughness).abs() <= step,
+                "({x}, {y}): roughness {roughness} vs {}",
+                want.roughness
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 500, "{checked} pixels see the quad");
+}
