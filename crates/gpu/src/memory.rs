@@ -26,6 +26,10 @@ pub struct FrameSize {
     pub photons: [u64; 3],
     /// The packed textures' buffer (`textures::packed_bytes`).
     pub texture_bytes: u64,
+    /// The vertex buffer and the BVH's largest storage buffer
+    /// (`scene_upload::scene_buffer_bytes`).
+    pub vertex_bytes: u64,
+    pub bvh_bytes: u64,
 }
 
 impl FrameSize {
@@ -41,7 +45,10 @@ impl FrameSize {
         // Each map: its photons, its LOD survivors, and (for the specular
         // pass) its hashed grid: the photons again plus two bucket starts each.
         let photons: u64 = self.photons.iter().map(|n| n * (2 * PHOTON_BYTES + SURVIVOR_BYTES + 8)).sum();
-        targets + shadows + slices + photons + self.texture_bytes
+        // The BVH's nodes, primitives and shading records: about 2.5 times
+        // the largest of them.
+        let scene = self.texture_bytes + self.vertex_bytes + self.bvh_bytes * 5 / 2;
+        targets + shadows + slices + photons + scene
     }
 
     /// Bytes of the shadow maps (one Depth32Float layer per view).
@@ -51,7 +58,14 @@ impl FrameSize {
 
     /// Every limit of `ctx` this frame would pass, in one line; Ok if none.
     pub fn check(&self, ctx: &GpuContext) -> Result<(), GpuError> {
-        let limits = &ctx.limits;
+        let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
+        let over = self.over_limits(&ctx.limits, software);
+        if over.is_empty() { Ok(()) } else { Err(GpuError::TooLarge(over.join("; "))) }
+    }
+
+    /// What this frame would pass of `limits` (and, on a `software`
+    /// adapter, of the memory a process may take), one item each.
+    pub fn over_limits(&self, limits: &wgpu::Limits, software: bool) -> Vec<String> {
         let mut over = Vec::new();
         let side = limits.max_texture_dimension_2d;
         if self.width > side || self.height > side {
@@ -91,6 +105,20 @@ impl FrameSize {
                 binding >> 20
             ));
         }
+        if self.vertex_bytes > limits.max_buffer_size {
+            over.push(format!(
+                "the scene's {} MiB of vertices exceed the adapter's {} MiB per buffer",
+                self.vertex_bytes >> 20,
+                limits.max_buffer_size >> 20
+            ));
+        }
+        if self.bvh_bytes > binding {
+            over.push(format!(
+                "the scene's BVH ({} MiB of primitive records) exceeds the adapter's {} MiB per buffer",
+                self.bvh_bytes >> 20,
+                binding >> 20
+            ));
+        }
         if self.texture_bytes > binding {
             over.push(format!(
                 "the scene's textures ({} MiB with their mip levels and coordinates, 4 bytes a texel) exceed the \
@@ -100,7 +128,7 @@ impl FrameSize {
             ));
         }
         let total = self.bytes();
-        if ctx.adapter_info.device_type == wgpu::DeviceType::Cpu && total > SOFTWARE_MEMORY_CAP {
+        if software && total > SOFTWARE_MEMORY_CAP {
             over.push(format!(
                 "the frame needs about {} MiB ({} MiB of them shadow maps: {} views of {}²), more than the {} MiB \
                  allowed on a software adapter",
@@ -111,7 +139,7 @@ impl FrameSize {
                 SOFTWARE_MEMORY_CAP >> 20
             ));
         }
-        if over.is_empty() { Ok(()) } else { Err(GpuError::TooLarge(over.join("; "))) }
+        over
     }
 }
 
@@ -128,6 +156,8 @@ mod tests {
             volume_slices: 0,
             photons: [200_000, 20_000, 0],
             texture_bytes: 16,
+            vertex_bytes: 48 << 10,
+            bvh_bytes: 64 << 10,
         }
     }
 
@@ -139,7 +169,28 @@ mod tests {
         assert!(FrameSize { volume_slices: 8, ..frame() }.bytes() > base);
         assert!(FrameSize { photons: [400_000, 20_000, 0], ..frame() }.bytes() > base);
         assert!(FrameSize { texture_bytes: 1 << 20, ..frame() }.bytes() > base);
+        assert!(FrameSize { vertex_bytes: 1 << 20, ..frame() }.bytes() > base);
+        assert!(FrameSize { bvh_bytes: 1 << 20, ..frame() }.bytes() > base);
         // 8192² shadow maps × 24 layers: 6 GiB of depth alone.
         assert!(FrameSize { shadow_map_size: 8192, shadow_layers: 24, ..frame() }.bytes() >= 6 << 30);
+    }
+
+    /// A scene larger than the adapter's buffers is refused with the
+    /// buffer that does not fit, never created.
+    #[test]
+    fn scene_buffers_beyond_the_limits_are_named() {
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: 16 << 20,
+            max_buffer_size: 16 << 20,
+            max_texture_dimension_2d: 8192,
+            max_texture_array_layers: 256,
+            ..Default::default()
+        };
+        assert!(frame().over_limits(&limits, false).is_empty(), "{:?}", frame().over_limits(&limits, false));
+        let big = FrameSize { vertex_bytes: 17 << 20, bvh_bytes: 17 << 20, texture_bytes: 17 << 20, ..frame() };
+        let over = big.over_limits(&limits, false).join("; ");
+        for what in ["vertices", "BVH", "textures"] {
+            assert!(over.contains(what), "{what} missing from: {over}");
+        }
     }
 }

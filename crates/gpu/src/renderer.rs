@@ -230,6 +230,7 @@ impl GpuRenderer {
     /// before tracing).
     pub fn frame_size(scene: &Scene, settings: &GpuSettings, photons: [u64; 3]) -> FrameSize {
         let lights = GpuLights::new(scene, settings.area_light_samples);
+        let (vertex_bytes, bvh_bytes) = crate::scene_upload::scene_buffer_bytes(scene);
         FrameSize {
             width: scene.camera.width,
             height: scene.camera.height,
@@ -241,6 +242,8 @@ impl GpuRenderer {
                 scene,
                 scene.accel.triangles().count() + scene.accel.spheres().count(),
             ),
+            vertex_bytes,
+            bvh_bytes,
         }
     }
 

@@ -92,6 +92,19 @@ pub struct SceneBuffers {
     pub textures: wgpu::Buffer,
 }
 
+/// Bytes of the scene's largest buffers before they are built: the vertex
+/// buffer (3 vertices a triangle, spheres tessellated) and the BVH's
+/// per-primitive shading records, its largest storage binding.
+pub fn scene_buffer_bytes(scene: &Scene) -> (u64, u64) {
+    let triangles = scene.accel.triangles().count() as u64;
+    let spheres = scene.accel.spheres().count() as u64;
+    let sphere_triangles = 2 * SPHERE_SEGMENTS as u64 * (SPHERE_SEGMENTS / 2) as u64;
+    let vertex = std::mem::size_of::<GpuVertex>() as u64;
+    let vertices = 3 * (triangles + spheres * sphere_triangles) * vertex;
+    let shading = (triangles + spheres) * std::mem::size_of::<hikari_core::geometry::FlatShading>() as u64;
+    (vertices, shading)
+}
+
 /// All vertices, area-light bodies last; returns them and the occluder count.
 pub fn scene_vertices(scene: &Scene) -> (Vec<GpuVertex>, u32) {
     let is_emitter = |surface: u32| scene.surfaces[(surface & !HAS_UV) as usize].emitter.is_some();
