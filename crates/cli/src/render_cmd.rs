@@ -102,6 +102,10 @@ pub struct RenderArgs {
     /// first perspective camera; without one, a camera framing the scene].
     #[arg(long)]
     pub camera: Option<String>,
+    /// Light the scene by this equirectangular sky image (.hdr or .exr,
+    /// Blender's orientation) in place of its environment.
+    #[arg(long, value_name = "FILE")]
+    pub environment: Option<std::path::PathBuf>,
     /// Random seed: the same seed gives the same image whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -246,8 +250,16 @@ pub fn parse_resolution(s: &str) -> Result<Resolution, String> {
 
 /// Loads `spec` (built-in name, `.toml`, `.gltf` or `.glb`) through
 /// `camera`, printing the loader's notes; a bad file is a usage error.
-pub fn load_scene(spec: &str, camera: Option<&str>, quiet: bool) -> Result<Scene, UsageError> {
-    let options = hikari_core::scene::LoadOptions { camera: camera.map(str::to_string) };
+pub fn load_scene(
+    spec: &str,
+    camera: Option<&str>,
+    environment: Option<&std::path::Path>,
+    quiet: bool,
+) -> Result<Scene, UsageError> {
+    let options = hikari_core::scene::LoadOptions {
+        camera: camera.map(str::to_string),
+        environment: environment.map(std::path::Path::to_path_buf),
+    };
     // A bar only for files that take over a second (a large glTF file).
     let progress = TerminalProgress::after(quiet, std::time::Duration::from_secs(1));
     let scene = Scene::load_with_progress(spec, &options, &progress).map_err(|e| UsageError(e.to_string()))?;
@@ -564,7 +576,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .context("setting the thread count")?;
     }
 
-    let mut scene = load_scene(&args.scene, args.camera.as_deref(), args.quiet)?;
+    let mut scene = load_scene(&args.scene, args.camera.as_deref(), args.environment.as_deref(), args.quiet)?;
     if scene.is_animated() {
         scene = scene.at_time(args.at);
     }

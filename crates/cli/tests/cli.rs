@@ -449,3 +449,33 @@ fn suns_skies_and_emissive_surfaces_render_on_the_gpu() {
         assert!(image.mean() > 0.0, "{file}: a black image");
     }
 }
+
+/// `--environment FILE` lights a file by a sky image (here a glTF file
+/// without lights, which would otherwise get the white sky): the GPU
+/// renderer says it cannot and photon-cpu renders it, lit; a missing or
+/// corrupt image is an error naming it, exit 2, no output.
+#[test]
+fn an_environment_map_lights_a_gltf_file() {
+    let dir = scratch_dir("environment-map");
+    std::fs::write(dir.join("unlit.glb"), unlit_glb()).unwrap();
+    let (w, h) = (16u32, 8u32);
+    let data: Vec<f32> = (0..w * h).flat_map(|i| if i / w < h / 2 { [2.0, 1.5, 1.0] } else { [0.1; 3] }).collect();
+    let sky = image::Rgb32FImage::from_raw(w, h, data).unwrap();
+    image::DynamicImage::ImageRgb32F(sky).save(dir.join("sky.exr")).unwrap();
+    let args = ["render", "unlit.glb", "--environment", "sky.exr", "--resolution", "24", "--photons", "5000"];
+    let out = hikari(&[&args[..], &["-o", "env.exr"]].concat(), &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("environment map"), "{err}");
+    assert!(!err.contains("white environment"), "{err}");
+    let image = hikari_core::output::read_exr(&dir.join("env.exr")).unwrap();
+    assert!(image.mean() > 0.0, "a black image");
+    std::fs::write(dir.join("broken.hdr"), b"#?RADIANCE\nnonsense").unwrap();
+    for (file, words) in [("missing.exr", "missing.exr"), ("broken.hdr", "broken.hdr")] {
+        let out = hikari(&["render", "unlit.glb", "--environment", file, "-o", "bad.png"], &dir);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
+        assert!(err.contains(words) && err.contains("environment map"), "{file}: {err}");
+        assert!(!dir.join("bad.png").exists(), "{file}: an image was written");
+    }
+}

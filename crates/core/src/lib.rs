@@ -28,6 +28,7 @@
 
 pub mod bsdf;
 pub mod camera;
+pub mod envmap;
 pub mod estimate;
 pub mod fuzz;
 pub mod geometry;

@@ -13,6 +13,7 @@
 //! what crosses the disc. Shadow rays toward them end at the same disc, so
 //! in a medium the path tracer attenuates them over the photons' path.
 
+use crate::envmap::EnvironmentMap;
 use crate::material::Rgb;
 use crate::sampling::{self, Rng, local_to_world, orthonormal_basis};
 use glam::{Vec2, Vec3};
@@ -34,9 +35,11 @@ pub enum Light {
     /// A sun: parallel light travelling along the unit `direction`, giving
     /// `irradiance` (W/m²) on a surface facing it. Power E·πr² across `disc`.
     Directional { direction: Vec3, irradiance: Rgb, disc: Disc },
-    /// A uniform sky: `radiance` (W/(m² sr)) arriving from every direction.
-    /// Power L·4π·πr² across `disc` (see [`Light::power`]).
-    Environment { radiance: Rgb, disc: Disc },
+    /// A sky: `radiance` (W/(m² sr)) arriving from every direction, times
+    /// the texel of `map` toward it where there is one (an `.hdr`/`.exr`
+    /// equirectangular image, [`EnvironmentMap`]). Power L·4π·πr² across
+    /// `disc`, or L·∫map dω·πr² (see [`Light::power`]).
+    Environment { radiance: Rgb, disc: Disc, map: Option<Arc<EnvironmentMap>> },
     /// Emissive triangles, which are also scene geometry with an ordinary
     /// (reflecting) material.
     Mesh(Arc<EmissiveMesh>),
@@ -209,11 +212,15 @@ pub struct LightSample {
     pub is_delta: bool,
 }
 
-/// A photon leaving a light: start point and unit direction.
+/// A photon leaving a light: start point, unit direction, and the factor
+/// (mean 1 over emissions) its power is scaled by where the light's
+/// direction sampling is not proportional to its radiance in every
+/// channel (an environment map's colours); 1 elsewhere.
 #[derive(Clone, Copy, Debug)]
 pub struct EmittedRay {
     pub origin: Vec3,
     pub dir: Vec3,
+    pub weight: Rgb,
 }
 
 impl Light {
@@ -231,7 +238,10 @@ impl Light {
             // with ω uniform (density 1/4π) and origins uniform on the disc
             // then arrive at any point the discs cover with L per unit
             // perpendicular area and solid angle: the sky, seen from inside.
-            Light::Environment { radiance, disc } => radiance * 4.0 * PI * disc.area(),
+            Light::Environment { radiance, disc, ref map } => match map {
+                Some(map) => radiance * map.integral() * disc.area(),
+                None => radiance * 4.0 * PI * disc.area(),
+            },
             // Lambertian: π·L per unit area, per emitting side.
             Light::Mesh(ref mesh) => mesh.radiance * PI * mesh.area() * if mesh.two_sided { 2.0 } else { 1.0 },
         }
@@ -405,35 +415,55 @@ impl Light {
     pub fn emit(&self, rng: &mut Rng) -> EmittedRay {
         match *self {
             Light::Point { position, .. } => {
-                EmittedRay { origin: position, dir: sampling::uniform_sphere(rng.next_2d()) }
+                EmittedRay { origin: position, dir: sampling::uniform_sphere(rng.next_2d()), weight: Rgb::ONE }
             }
             Light::Spot { position, axis, cutoff, falloff_start, .. } => {
                 let local = sample_spot_direction(cutoff, falloff_start, rng);
-                EmittedRay { origin: position, dir: local_to_world(local, axis) }
+                EmittedRay { origin: position, dir: local_to_world(local, axis), weight: Rgb::ONE }
             }
             Light::Sphere { center, radius, .. } => {
                 let n = sampling::uniform_sphere(rng.next_2d());
                 let dir = local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n);
-                EmittedRay { origin: center + n * radius, dir }
+                EmittedRay { origin: center + n * radius, dir, weight: Rgb::ONE }
             }
             Light::Quad { corner, edge_u, edge_v, .. } => {
                 let u = rng.next_2d();
                 let n = edge_u.cross(edge_v).normalize();
                 let dir = local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n);
-                EmittedRay { origin: corner + edge_u * u.x + edge_v * u.y, dir }
+                EmittedRay { origin: corner + edge_u * u.x + edge_v * u.y, dir, weight: Rgb::ONE }
             }
             Light::Directional { direction, disc, .. } => {
-                EmittedRay { origin: disc.emission_origin(direction, rng.next_2d()), dir: direction }
+                EmittedRay { origin: disc.emission_origin(direction, rng.next_2d()), dir: direction, weight: Rgb::ONE }
             }
-            Light::Environment { disc, .. } => {
+            Light::Environment { disc, map: None, .. } => {
                 let dir = sampling::uniform_sphere(rng.next_2d());
-                EmittedRay { origin: disc.emission_origin(dir, rng.next_2d()), dir }
+                EmittedRay { origin: disc.emission_origin(dir, rng.next_2d()), dir, weight: Rgb::ONE }
+            }
+            // From the map's sky direction ω, drawn ∝ luminance: the photon
+            // travels along −ω, its power scaled by L(ω)/(p(ω)·∫L dω) per
+            // channel (1 for a grey map).
+            Light::Environment { disc, map: Some(ref map), .. } => {
+                let Some(s) = map.sample(rng.next_2d()) else {
+                    return EmittedRay { origin: disc.center, dir: Vec3::Y, weight: Rgb::ZERO };
+                };
+                let dir = -s.dir;
+                let integral = map.integral();
+                let weight = Rgb::select(
+                    integral.cmpgt(Rgb::ZERO),
+                    s.radiance / (s.pdf * integral.max(Rgb::splat(f32::MIN_POSITIVE))),
+                    Rgb::ZERO,
+                );
+                EmittedRay { origin: disc.emission_origin(dir, rng.next_2d()), dir, weight }
             }
             Light::Mesh(ref mesh) => {
                 let (origin, n) = mesh.sample_point(rng.next_2d());
                 // Two-sided: either face, each with half the power.
                 let n = if mesh.two_sided && rng.next_f32() < 0.5 { -n } else { n };
-                EmittedRay { origin, dir: local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n) }
+                EmittedRay {
+                    origin,
+                    dir: local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n),
+                    weight: Rgb::ONE,
+                }
             }
         }
     }
@@ -495,13 +525,19 @@ impl Light {
             // normal, so the half of the samples below a surface's horizon
             // carry nothing there (the path tracer's MIS with cosine
             // sampling makes up for it).
-            Light::Environment { radiance, disc } => {
-                let wi = sampling::uniform_sphere(u);
+            Light::Environment { radiance, disc, ref map } => {
+                let (wi, radiance, pdf) = match map {
+                    None => (sampling::uniform_sphere(u), radiance, sampling::UNIFORM_SPHERE_PDF),
+                    Some(map) => {
+                        let s = map.sample(u)?;
+                        (s.dir, radiance * s.radiance, s.pdf)
+                    }
+                };
                 if !disc.covers(point, wi) {
                     return None;
                 }
                 let distance = disc.reach(point, wi);
-                Some(LightSample { wi, distance, radiance, pdf: sampling::UNIFORM_SPHERE_PDF, is_delta: false })
+                Some(LightSample { wi, distance, radiance, pdf, is_delta: false })
             }
             Light::Mesh(ref mesh) => {
                 let (p, normal) = mesh.sample_point(u);
@@ -537,7 +573,8 @@ impl Light {
                 let area = edge_u.cross(edge_v).length();
                 if cos_l <= 0.0 { 0.0 } else { d2 / (area * cos_l) }
             }
-            Light::Environment { .. } => sampling::UNIFORM_SPHERE_PDF,
+            Light::Environment { map: None, .. } => sampling::UNIFORM_SPHERE_PDF,
+            Light::Environment { map: Some(ref map), .. } => map.pdf((hit_point - point).normalize()),
             Light::Mesh(ref mesh) => mesh.solid_angle_pdf(hit_point - point, hit_normal),
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
         }
@@ -556,9 +593,10 @@ impl Light {
 
     /// Radiance reaching the origin of a ray that leaves the scene along
     /// `dir` (hits nothing): the sky's; zero for every other light.
-    pub fn escaped_radiance(&self, _dir: Vec3) -> Rgb {
+    pub fn escaped_radiance(&self, dir: Vec3) -> Rgb {
         match *self {
-            Light::Environment { radiance, .. } => radiance,
+            Light::Environment { radiance, map: None, .. } => radiance,
+            Light::Environment { radiance, map: Some(ref map), .. } => radiance * map.radiance(dir),
             _ => Rgb::ZERO,
         }
     }
@@ -865,7 +903,7 @@ mod tests {
         let direction = Vec3::new(1.0, -2.0, 0.5).normalize();
         let mut lights = [
             Light::Directional { direction, irradiance: Vec3::ONE, disc: Disc::UNIT },
-            Light::Environment { radiance: Vec3::ONE, disc: Disc::UNIT },
+            Light::Environment { radiance: Vec3::ONE, disc: Disc::UNIT, map: None },
         ];
         let (lo, hi) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(3.0, 1.0, 2.5));
         fit_distant_lights(&mut lights, (lo, hi));
@@ -902,7 +940,7 @@ mod tests {
     #[test]
     fn the_sky_is_sampled_uniformly_and_the_sun_along_its_direction() {
         let disc = Disc { center: Vec3::ZERO, radius: 10.0 };
-        let sky = Light::Environment { radiance: Vec3::splat(2.0), disc };
+        let sky = Light::Environment { radiance: Vec3::splat(2.0), disc, map: None };
         assert_direction_distribution(|u| sky.sample_incident(Vec3::ONE, u).unwrap().wi, |_| 1.0 / (4.0 * PI));
         let s = sky.sample_incident(Vec3::ONE, Vec2::new(0.2, 0.7)).unwrap();
         assert!(!s.is_delta && s.radiance == Vec3::splat(2.0));

@@ -132,7 +132,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             return Err(UsageError(format!("{}: unsupported image type (use .png or .exr)", path.display())).into());
         }
     }
-    let scene = load_scene(&args.scene, args.camera.as_deref(), false)?;
+    let scene = load_scene(&args.scene, args.camera.as_deref(), None, false)?;
     if let Some(size) = args.size {
         size.resolve(scene.camera.aspect()).map_err(UsageError)?;
     }
@@ -423,7 +423,7 @@ impl Viewer {
         if !self.watch.changed() {
             return Ok(());
         }
-        let options = hikari_core::scene::LoadOptions { camera: self.args.camera.clone() };
+        let options = hikari_core::scene::LoadOptions { camera: self.args.camera.clone(), environment: None };
         let scene = match Scene::load_with(&self.args.scene, &options) {
             Ok(scene) => scene,
             Err(e) => {

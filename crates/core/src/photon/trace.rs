@@ -152,7 +152,7 @@ impl PathTracer<'_> {
         let (light, power) = self.choose_light(rng.next_f32());
         let emitted = self.scene.lights[light].emit(&mut rng);
         // Power is tracked in units of `power_unit` from here on.
-        let mut power = power / self.power_unit;
+        let mut power = power * emitted.weight / self.power_unit;
         let mut ray = Ray::new(emitted.origin, emitted.dir);
         let (mut diffuse_bounces, mut specular_bounces) = (0u32, 0u32);
 

@@ -114,12 +114,15 @@ pub struct LightDesc {
     pub irradiance: Option<V3>,
 }
 
-/// A uniform sky.
+/// A sky: uniform, or an equirectangular map.
 #[derive(Deserialize, Debug)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
-    /// W/(m² sr), the same from every direction.
-    pub radiance: V3,
+    /// W/(m² sr), the same from every direction; with a `map`, the factor
+    /// its texels are multiplied by (1 by default).
+    pub radiance: Option<V3>,
+    /// An `.hdr` or `.exr` equirectangular image, relative to the scene file.
+    pub map: Option<String>,
 }
 
 #[derive(Deserialize, Debug)]

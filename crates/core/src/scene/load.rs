@@ -183,7 +183,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
     }
     if let Some(env) = &desc.environment {
         let p = place(env.span(), "[environment]".into());
-        lights.push(load_environment(env.get_ref(), &p)?);
+        lights.push(load_environment(env.get_ref(), &p, base_dir)?);
         names.lights.push(None);
     }
     if lights.is_empty() {
@@ -804,13 +804,28 @@ fn light_from_desc(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
     }
 }
 
-/// The `[environment]` table: a uniform sky, its disc fitted later.
-fn load_environment(e: &EnvironmentDesc, p: &Place) -> Result<Light, SceneError> {
-    let radiance = p.color("radiance", e.radiance, MAX_EMISSION)?;
+/// The `[environment]` table: a uniform sky or a map (read relative to
+/// `base_dir`), its disc fitted later.
+fn load_environment(e: &EnvironmentDesc, p: &Place, base_dir: Option<&Path>) -> Result<Light, SceneError> {
+    let map = match &e.map {
+        Some(file) => {
+            let path = base_dir.map_or_else(|| Path::new(file).to_path_buf(), |d| d.join(file));
+            Some(std::sync::Arc::new(crate::envmap::EnvironmentMap::load(&path).map_err(|e| p.error(e))?))
+        }
+        None => None,
+    };
+    let radiance = match (e.radiance, &map) {
+        (Some(radiance), _) => p.color("radiance", radiance, MAX_EMISSION)?,
+        (None, Some(_)) => Vec3::ONE,
+        (None, None) => return Err(p.error("`radiance` or `map` is needed: a uniform sky or an image of one")),
+    };
     if radiance.max_element() <= 0.0 {
         return Err(p.error("`radiance` is zero: the environment emits nothing"));
     }
-    Ok(Light::Environment { radiance, disc: Disc::UNIT })
+    if map.as_ref().is_some_and(|m| m.integral().max_element() <= 0.0) {
+        return Err(p.error("the environment map is black: it emits nothing"));
+    }
+    Ok(Light::Environment { radiance, disc: Disc::UNIT, map })
 }
 
 #[cfg(test)]
@@ -939,7 +954,7 @@ intensity = [1.0, 1.0, 1.0]
         let text = BASE.split("[[light]]").next().unwrap().to_string();
         let sky = |radiance: &str| format!("{text}[environment]\nradiance = {radiance}\n");
         let s = parse(&sky("[0.5, 1.0, 2.0]"), "test.toml", None).unwrap();
-        let Light::Environment { radiance, disc } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
+        let Light::Environment { radiance, disc, .. } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
         assert_eq!(radiance, Vec3::new(0.5, 1.0, 2.0));
         assert!((disc.radius / 3f32.sqrt() - 1.0).abs() < 0.01, "{disc:?}");
         assert_eq!(s.names.lights, vec![None]);

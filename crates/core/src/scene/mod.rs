@@ -73,11 +73,40 @@ impl Scene {
         options: &LoadOptions,
         progress: &dyn crate::progress::Progress,
     ) -> Result<Scene, SceneError> {
-        match builtin::source(spec) {
+        let mut scene = match builtin::source(spec) {
             Some(text) => load::parse(text, &format!("builtin:{spec}"), None),
             None if gltf::is_gltf(Path::new(spec)) => gltf::load_scene(Path::new(spec), options, progress),
             None => Self::from_file(Path::new(spec)),
+        }?;
+        if let Some(path) = &options.environment {
+            let map = crate::envmap::EnvironmentMap::load(path).map_err(|message| SceneError {
+                file: path.display().to_string(),
+                position: None,
+                context: String::new(),
+                message: message.trim_start_matches(&format!("{}: ", path.display())).to_string(),
+            })?;
+            scene.set_environment_map(std::sync::Arc::new(map), &path.display().to_string());
         }
+        Ok(scene)
+    }
+
+    /// Lights the scene by `map` (named `name` in the note) in place of its
+    /// environment: its sky (a scene has one at most: a glTF file's default
+    /// one, or TOML's `[environment]`) is replaced, radiance factor 1, in
+    /// place (light indices stay); a scene without one gains it. Distant
+    /// lights' discs are refitted.
+    pub fn set_environment_map(&mut self, map: std::sync::Arc<crate::envmap::EnvironmentMap>, name: &str) {
+        let sky = Light::Environment { radiance: glam::Vec3::ONE, disc: crate::light::Disc::UNIT, map: Some(map) };
+        match self.lights.iter().position(|l| matches!(l, Light::Environment { .. })) {
+            Some(i) => self.lights[i] = sky,
+            None => {
+                self.lights.push(sky);
+                self.names.lights.push(None);
+            }
+        }
+        crate::light::fit_distant_lights(&mut self.lights, self.accel.bounds());
+        self.notes.retain(|n| !n.contains("uniform white environment"));
+        self.notes.push(format!("lit by the environment map {name}"));
     }
 
     pub fn from_file(path: &Path) -> Result<Scene, SceneError> {

@@ -222,7 +222,7 @@ impl GpuLights {
                     };
                     out.add_distant_sample(index, direction, disc);
                 }
-                Light::Environment { radiance, disc } => {
+                Light::Environment { radiance, disc, .. } => {
                     record = GpuLight {
                         position: disc.center.to_array(),
                         kind: kind::ENVIRONMENT,

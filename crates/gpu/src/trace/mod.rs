@@ -410,8 +410,17 @@ pub struct GpuTracer {
     pub records_per_path: u32,
 }
 
+/// Why the GPU tracer cannot trace `scene`, or None.
+fn unsupported(scene: &Scene) -> Option<GpuError> {
+    let mapped = scene.lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. }));
+    mapped.then(|| GpuError::SceneUnsupported("environment maps are not traced on the GPU yet".into()))
+}
+
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
+        if let Some(e) = unsupported(scene) {
+            return Err(e);
+        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -497,6 +506,9 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
+        if let Some(e) = unsupported(scene) {
+            return Err(e);
+        }
         let scene = ctx.scoped(|| TraceScene::upload(&ctx.device, scene))?;
         self.scene = scene;
         // The bind groups hold the old scene's buffers.

@@ -656,6 +656,9 @@ mod texture_tests;
 pub struct LoadOptions {
     /// The camera to render through, by name (glTF files).
     pub camera: Option<String>,
+    /// An equirectangular `.hdr`/`.exr` sky that lights the scene in place
+    /// of its environment (`Scene::set_environment_map`).
+    pub environment: Option<std::path::PathBuf>,
 }
 
 /// Side of the longer image edge when the file gives only an aspect ratio.
@@ -745,7 +748,7 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
     accel.set_alpha_mask(texturing.clone());
     if lights.is_empty() {
         asset.notes.push("the file has no lights: lit by a uniform white environment (radiance 1)".into());
-        lights.push(Light::Environment { radiance: Rgb::ONE, disc: crate::light::Disc::UNIT });
+        lights.push(Light::Environment { radiance: Rgb::ONE, disc: crate::light::Disc::UNIT, map: None });
         light_names.push(None);
     }
     crate::light::fit_distant_lights(&mut lights, accel.bounds());

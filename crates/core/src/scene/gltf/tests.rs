@@ -268,7 +268,7 @@ fn broken_files_are_located_errors() {
     // `texture_tests::missing_and_corrupt_images_are_located_errors`).
     let dir = folder("camera-name");
     let path = write(&dir, "c.glb", &whole);
-    let options = LoadOptions { camera: Some("Front".into()) };
+    let options = LoadOptions { camera: Some("Front".into()), ..Default::default() };
     let e = crate::scene::Scene::load_with(path.to_str().unwrap(), &options).err().unwrap().to_string();
     assert_says(&e, &["cameras", "\"Front\""]);
 }
