@@ -189,11 +189,19 @@ pub struct MaterialTextures {
     /// `alphaMode` MASK's `alphaCutoff`: below it the surface is not there.
     /// None: opaque.
     pub alpha_cutoff: Option<f32>,
+    /// Linear tangent-space normals (RGB = 2n − 1 … ), read by the path
+    /// tracer (`Texturing::shading_normal`), with the file's `scale` of
+    /// their x and y.
+    pub normal: Option<TextureRef>,
+    pub normal_scale: f32,
 }
 
 impl MaterialTextures {
     pub fn is_textured(&self) -> bool {
-        self.base_color.is_some() || self.metallic_roughness.is_some() || self.emissive.is_some()
+        self.base_color.is_some()
+            || self.metallic_roughness.is_some()
+            || self.emissive.is_some()
+            || self.normal.is_some()
     }
 }
 
@@ -314,6 +322,47 @@ impl Texturing {
             Material::Diffuse { albedo, specular } => Material::Diffuse { albedo: albedo * base, specular },
             other => other,
         }
+    }
+
+    /// The shading normal `ns` (unit, of triangle `corners` with hit
+    /// barycentrics `b`) bent by the material's normal texture: the texel
+    /// n_t = (2·rgb − 1)·(scale, scale, 1) in the tangent frame whose
+    /// tangent follows the triangle's u and bitangent its v (one frame per
+    /// triangle, from its corners' coordinates; glTF's TANGENT attribute is
+    /// not read), orthonormalised against `ns`. `ns` itself where there is
+    /// no normal texture, no coordinates or a degenerate frame.
+    pub fn shading_normal(
+        &self,
+        material: u32,
+        prim: u32,
+        b: Vec2,
+        corners: [glam::Vec3; 3],
+        ns: glam::Vec3,
+    ) -> glam::Vec3 {
+        let Some(t) = self.textures(material) else { return ns };
+        let (Some(normal), Some(uvs)) = (t.normal, self.uvs.triangle(prim)) else { return ns };
+        let uv = self.uvs.at(prim, b).unwrap_or_default();
+        let texel = self.images[normal.image as usize].sample(uv, normal.sampler);
+        let local = glam::Vec3::new(
+            (2.0 * texel.x - 1.0) * t.normal_scale,
+            (2.0 * texel.y - 1.0) * t.normal_scale,
+            2.0 * texel.z - 1.0,
+        );
+        let (e1, e2) = (corners[1] - corners[0], corners[2] - corners[0]);
+        let (d1, d2) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if det.abs() < 1e-20 {
+            return ns;
+        }
+        let tangent = (e1 * d2.y - e2 * d1.y) / det;
+        let bitangent = (e2 * d1.x - e1 * d2.x) / det;
+        // Gram–Schmidt against the shading normal; the bitangent keeps the
+        // side the coordinates give it (mirrored textures).
+        let t_axis = (tangent - ns * ns.dot(tangent)).normalize_or_zero();
+        let handed = if ns.cross(t_axis).dot(bitangent) < 0.0 { -1.0 } else { 1.0 };
+        let b_axis = ns.cross(t_axis) * handed;
+        let bent = (t_axis * local.x + b_axis * local.y + ns * local.z).normalize_or_zero();
+        if t_axis == glam::Vec3::ZERO || bent == glam::Vec3::ZERO || !bent.is_finite() { ns } else { bent }
     }
 
     /// Per channel, the emissive texture at the point over its mean (1

@@ -243,6 +243,11 @@ impl Accel {
         self.spheres.iter().zip(self.surface_of[self.triangles.len()..].iter().copied())
     }
 
+    /// Triangle `prim` of the joint primitive space (None for a sphere).
+    pub fn triangle(&self, prim: u32) -> Option<&Triangle> {
+        self.triangles.get(prim as usize)
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()
     }

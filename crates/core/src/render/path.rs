@@ -102,7 +102,8 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
             }
         }
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
-        let (ng, ns) = (hit.geometric_normal * facing, hit.shading_normal * facing);
+        // Normal textures bend the shading normal here (only the path tracer reads them).
+        let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(&hit) * facing);
         let next_dir = match material {
             Material::Emitter => break,
             Material::Glass { ior } => {

@@ -149,6 +149,17 @@ impl Scene {
         }
     }
 
+    /// The shading normal at `hit`, bent by its material's normal texture
+    /// (`Texturing::shading_normal`); the path tracer shades with it, the
+    /// photon mappers with `hit.shading_normal`.
+    pub fn shading_normal_at(&self, hit: &Hit) -> glam::Vec3 {
+        let (Some(t), Some(triangle)) = (&self.texturing, self.accel.triangle(hit.prim)) else {
+            return hit.shading_normal;
+        };
+        let material = self.surfaces[hit.surface as usize].material;
+        t.shading_normal(material, hit.prim, hit.barycentrics, triangle.v, hit.shading_normal)
+    }
+
     pub fn emitter(&self, hit: &Hit) -> Option<&Light> {
         self.surfaces[hit.surface as usize].emitter.map(|l| &self.lights[l as usize])
     }

@@ -36,6 +36,8 @@ pub struct PbrMaterial {
     pub base_color_texture: Option<Index<json::Texture>>,
     pub metallic_roughness_texture: Option<Index<json::Texture>>,
     pub emissive_texture: Option<Index<json::Texture>>,
+    /// A normal texture and its `scale`.
+    pub normal_texture: Option<(Index<json::Texture>, f32)>,
 }
 
 impl Default for PbrMaterial {
@@ -54,6 +56,7 @@ impl Default for PbrMaterial {
             base_color_texture: None,
             metallic_roughness_texture: None,
             emissive_texture: None,
+            normal_texture: None,
         }
     }
 }
@@ -207,6 +210,13 @@ impl GltfBuilder {
             },
             emissive_factor: json::material::EmissiveFactor((m.emission / strength).to_array()),
             emissive_texture: info(m.emissive_texture),
+            normal_texture: m.normal_texture.map(|(index, scale)| json::material::NormalTexture {
+                index,
+                scale,
+                tex_coord: 0,
+                extensions: None,
+                extras: Default::default(),
+            }),
             alpha_mode: Valid(if m.alpha_cutoff.is_some() {
                 json::material::AlphaMode::Mask
             } else {

@@ -3,8 +3,9 @@
 //! transmissive material (`KHR_materials_transmission` ≥ 0.5) is smooth
 //! glass with `KHR_materials_ior`; `KHR_materials_specular`'s factor scales
 //! the dielectric's Fresnel (its colour is ignored). Base-colour,
-//! metallic–roughness and emissive textures are read (`crate::texture`);
-//! normal and occlusion textures are not. `alphaMode` MASK makes cut-outs,
+//! metallic–roughness, emissive and normal textures are read
+//! (`crate::texture`; normal maps are used by the path tracer only);
+//! occlusion textures are not. `alphaMode` MASK makes cut-outs,
 //! BLEND is drawn opaque. Each approximation made is reported in one note.
 
 use super::textures::Images;
@@ -35,6 +36,7 @@ pub struct Converted {
 /// Converts every material, reading its textures from `images`.
 pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -> Converted {
     let mut unread_maps = 0;
+    let mut normal_mapped = 0;
     let mut other_sets = 0;
     let mut approximated = 0;
     let mut blended = 0;
@@ -44,7 +46,9 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
         .materials()
         .map(|m| {
             let pbr = m.pbr_metallic_roughness();
-            unread_maps += (m.normal_texture().is_some() || m.occlusion_texture().is_some()) as usize;
+            unread_maps += m.occlusion_texture().is_some() as usize;
+            normal_mapped += m.normal_texture().is_some() as usize;
+            let normal = m.normal_texture().and_then(|n| images.normal(&n));
             let read = [
                 pbr.base_color_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Srgb))),
                 pbr.metallic_roughness_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Linear))),
@@ -85,6 +89,8 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 emissive_mean,
                 alpha_factor: sane(Vec3::splat(alpha), 1.0).x,
                 alpha_cutoff,
+                normal: normal.map(|(t, _)| t),
+                normal_scale: normal.map_or(1.0, |(_, scale)| if scale.is_finite() { scale } else { 1.0 }),
             };
             textures.push((t.is_textured() || alpha_cutoff.is_some()).then_some(t));
             (material, emission)
@@ -95,7 +101,13 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     emissions.push(None);
     textures.push(None);
     if unread_maps > 0 {
-        notes.push(format!("{unread_maps} material(s) have normal or occlusion textures, which are ignored"));
+        notes.push(format!("{unread_maps} material(s) have occlusion textures, which are ignored"));
+    }
+    if normal_mapped > 0 {
+        notes.push(format!(
+            "{normal_mapped} material(s) have normal textures: the path tracer bends its shading normals by them, \
+             the photon mappers (CPU and GPU) do not"
+        ));
     }
     if other_sets > 0 {
         notes.push(format!(

@@ -1,7 +1,7 @@
 //! Textures and cut-outs of glTF files written here, through the loader
 //! and the CPU renderers.
 
-use super::export::{GltfBuilder, PbrMaterial, glb, png};
+use super::export::{GltfBuilder, PbrMaterial, glb, looking, png};
 use super::*;
 use crate::geometry::Ray;
 use crate::photon::{TraceSettings, trace_photons};
@@ -215,4 +215,55 @@ fn an_emissive_texture_varies_the_radiance_seen() {
         let le = scene.emitted_radiance(&hit, -Vec3::Z).unwrap();
         assert!((le - Vec3::splat(4.0 * texel[t])).abs().max_element() < 1e-4, "({x}, {y}): {le}");
     }
+}
+
+/// A normal texture tilting the normal 45° toward +u (world +X) on a floor
+/// under a sun 45° from the zenith toward +X: the path tracer shades with
+/// the bent normal, which faces the sun (1/cos 45° more light than flat; a
+/// tangent of the wrong sign would turn it away, no light), `scale` 0
+/// flattens it back, and photon-cpu ignores it.
+#[test]
+fn a_normal_texture_bends_the_path_tracers_normals() {
+    use crate::render::path::radiance as path_radiance;
+    // (sin 45°, 0, cos 45°) as 8-bit 2n − 1: 218, 128, 218.
+    let texel = [218u8, 128, 218, 255];
+    let decoded = glam::Vec3::new(218.0, 128.0, 218.0) / 255.0 * 2.0 - 1.0;
+    let floor_with = |scale: f32, tag: &str| {
+        let mut b = GltfBuilder::new();
+        let image = b.image(&png(1, 1, &texel), "image/png");
+        let t = b.texture(image, gltf::json::texture::WrappingMode::Repeat, gltf::json::texture::WrappingMode::Repeat);
+        let m = b.material(&PbrMaterial {
+            base_color: Vec3::splat(0.5),
+            specular: 0.0,
+            normal_texture: Some((t, scale)),
+            ..Default::default()
+        });
+        let floor = quad(&mut b, Vec3::new(-2.0, 0.0, 2.0), 4.0 * Vec3::X, -4.0 * Vec3::Z, 1.0, m);
+        use gltf::json::extensions::scene::khr_lights_punctual::Type;
+        let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+        let toward = Vec3::new(-1.0, -1.0, 0.0).normalize();
+        let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(toward, Vec3::Z)));
+        load(tag, &b.to_glb(vec![floor, sun]))
+    };
+    let look = Ray::new(Vec3::new(0.3, 1.0, 0.2), -Vec3::Y);
+    let settings = PathSettings { spp: 1, ..Default::default() };
+    let mut rng = Rng::for_item(2, 0);
+    // ρ/π·E·cos 45° on the flat floor.
+    let flat = 0.5 / PI * 2.0 * std::f32::consts::FRAC_1_SQRT_2;
+    // Direct light only along one sample: the sun is a delta light, and the
+    // floor alone reflects no indirect light. The bent normal (x, z, −y) of
+    // the texel (u along +X, v along −Z) against the sun's (1, 1, 0)/√2.
+    let bent = path_radiance(&floor_with(1.0, "normal-1"), look, &settings, &mut rng).x;
+    let n = Vec3::new(decoded.x, decoded.z, -decoded.y).normalize();
+    let want = 0.5 / PI * 2.0 * n.dot(Vec3::new(1.0, 1.0, 0.0).normalize());
+    assert!(want > 1.3 * flat, "the texel faces the sun");
+    assert!((bent - want).abs() < 1e-4 * want, "bent: {bent} vs {want}");
+    let unbent = path_radiance(&floor_with(0.0, "normal-0"), look, &settings, &mut rng).x;
+    assert!((unbent - flat).abs() < 1e-4 * flat, "scale 0: {unbent} vs {flat}");
+    let scene = floor_with(1.0, "normal-photon");
+    assert!(scene.notes.iter().any(|n| n.contains("normal textures")), "{:?}", scene.notes);
+    let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+    let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
+    let photon = renderer.radiance(&look, 0, &mut rng).x;
+    assert!((photon - flat).abs() < 1e-4 * flat, "photon-cpu ignores the map: {photon} vs {flat}");
 }

@@ -20,10 +20,18 @@ impl Images {
     /// The texture `info` reads in `space`; None if it reads a texture
     /// coordinate set other than 0 (the caller notes it) or has no image.
     pub fn texture(&self, info: &gltf::texture::Info, space: ColorSpace) -> Option<TextureRef> {
-        if info.tex_coord() != 0 {
+        self.reference(&info.texture(), info.tex_coord(), space)
+    }
+
+    /// A material's normal texture (linear data), with its `scale`.
+    pub fn normal(&self, info: &gltf::material::NormalTexture) -> Option<(TextureRef, f32)> {
+        Some((self.reference(&info.texture(), info.tex_coord(), ColorSpace::Linear)?, info.scale()))
+    }
+
+    fn reference(&self, texture: &gltf::Texture, tex_coord: u32, space: ColorSpace) -> Option<TextureRef> {
+        if tex_coord != 0 {
             return None;
         }
-        let texture = info.texture();
         let image = *self.index.get(&(texture.source().index(), space))?;
         let wrap = |w: gltf::texture::WrappingMode| match w {
             gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
@@ -36,19 +44,23 @@ impl Images {
 }
 
 /// The textures each material reads, with the glTF path that reads them.
-fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::texture::Info<'a>, ColorSpace)> {
+fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::Texture<'a>, ColorSpace)> {
     let mut used = Vec::new();
     for m in doc.materials() {
         let at = format!("materials[{}]", m.index().unwrap_or(0));
         let pbr = m.pbr_metallic_roughness();
-        let mut push = |name: &str, info: Option<gltf::texture::Info<'a>>, space| {
-            if let Some(info) = info.filter(|i| i.tex_coord() == 0) {
-                used.push((format!("{at}.{name}"), info, space));
+        let mut push = |name: &str, texture: Option<(gltf::Texture<'a>, u32)>, space| {
+            if let Some((texture, 0)) = texture {
+                used.push((format!("{at}.{name}"), texture, space));
             }
         };
-        push("pbrMetallicRoughness.baseColorTexture", pbr.base_color_texture(), ColorSpace::Srgb);
-        push("pbrMetallicRoughness.metallicRoughnessTexture", pbr.metallic_roughness_texture(), ColorSpace::Linear);
-        push("emissiveTexture", m.emissive_texture(), ColorSpace::Srgb);
+        let info = |i: Option<gltf::texture::Info<'a>>| i.map(|i| (i.texture(), i.tex_coord()));
+        push("pbrMetallicRoughness.baseColorTexture", info(pbr.base_color_texture()), ColorSpace::Srgb);
+        let mr = info(pbr.metallic_roughness_texture());
+        push("pbrMetallicRoughness.metallicRoughnessTexture", mr, ColorSpace::Linear);
+        push("emissiveTexture", info(m.emissive_texture()), ColorSpace::Srgb);
+        let normal = m.normal_texture().map(|n| (n.texture(), n.tex_coord()));
+        push("normalTexture", normal, ColorSpace::Linear);
     }
     used
 }
@@ -62,8 +74,8 @@ pub fn load(
     file: &str,
 ) -> Result<Images, SceneError> {
     let mut out = Images::default();
-    for (used_at, info, space) in used_textures(doc) {
-        let image = info.texture().source();
+    for (used_at, texture, space) in used_textures(doc) {
+        let image = texture.source();
         let key = (image.index(), space);
         if out.index.contains_key(&key) {
             continue;
