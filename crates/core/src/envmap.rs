@@ -142,6 +142,11 @@ impl EnvironmentMap {
         self.height
     }
 
+    /// The texels, row by row from the top.
+    pub fn texels(&self) -> &[Rgb] {
+        &self.texels
+    }
+
     /// ∫ L(ω) dω over the sphere, per channel.
     pub fn integral(&self) -> Rgb {
         self.integral

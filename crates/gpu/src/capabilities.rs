@@ -37,11 +37,11 @@ pub fn required_limits() -> wgpu::Limits {
         // The photon tracer: BVH nodes, primitives and shading normals,
         // surfaces, lights, media, photon records, counts, status words,
         // region triangles, emissive triangles and textures (the specular
-        // pass binds 11).
+        // pass binds 12).
         max_storage_buffers_per_shader_stage: 12,
         max_storage_textures_per_shader_stage: 1,
-        // The specular pass's bindings 0–17.
-        max_bindings_per_bind_group: 18,
+        // The specular pass's bindings 0–18.
+        max_bindings_per_bind_group: 19,
         max_compute_invocations_per_workgroup: 256,
         max_compute_workgroup_size_x: 256,
         max_compute_workgroup_storage_size: 1024,

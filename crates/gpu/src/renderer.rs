@@ -221,9 +221,6 @@ impl GpuRenderer {
     /// optical depths off by 8e-4 where they are 0, fog frames off by more
     /// than 2%).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
-        if scene.lights.iter().any(|l| matches!(l, hikari_core::light::Light::Environment { map: Some(_), .. })) {
-            return Some("environment maps are not drawn by the GPU renderer yet".to_string());
-        }
         (!ctx.float32_blend && !scene.media.is_empty())
             .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string())
     }
@@ -365,6 +362,7 @@ impl GpuRenderer {
             &t.gbuffer,
             &media,
             lights.sky_radiance,
+            &scene_buffers.environment,
         );
         GpuRenderer {
             resolve_pass,

@@ -90,6 +90,8 @@ pub struct SceneBuffers {
     /// The packed textures (`textures::pack_scene`), texture coordinates
     /// in `bvh`'s primitive order.
     pub textures: wgpu::Buffer,
+    /// The sky image (`textures::environment_words`).
+    pub environment: wgpu::Buffer,
 }
 
 /// Bytes of the scene's largest buffers before they are built: the vertex
@@ -249,6 +251,11 @@ impl SceneBuffers {
         let bvh = FlatBvh::new(&scene.accel);
         let textures = crate::textures::pack_scene(scene, Some(&bvh));
         SceneBuffers {
+            environment: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("sky image"),
+                contents: bytemuck::cast_slice(&crate::textures::environment_words(scene)),
+                usage: wgpu::BufferUsages::STORAGE,
+            }),
             bvh,
             textures: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene textures"),

@@ -131,10 +131,10 @@ fn shared_structs_match_wgsl_layouts() {
             falloff_start,
             sample_area,
             two_sided,
-            _pad
+            mapped
         ]
     );
-    assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, direction, view_count]);
+    assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, direction, view_count, weight, _pad]);
     let specular = hikari_gpu::specular::shader_source();
     assert_layout!(
         specular,

@@ -48,7 +48,8 @@ struct Light {
     // it emits from both faces.
     sample_area: f32,
     two_sided: u32,
-    _pad: u32,
+    // Sky: 1 when it is an image (its samples' `weight`s hold it).
+    mapped: u32,
 }
 
 struct LightSample {
@@ -58,6 +59,9 @@ struct LightSample {
     // Toward a distant light (sun, sky); a mesh sample's front normal.
     direction: vec3<f32>,
     view_count: u32,
+    // A sky image's direction: L(ω)/(K·p(ω)) (light_samples.rs).
+    weight: vec3<f32>,
+    _pad: u32,
 }
 
 const KIND_SUN: u32 = 4u;
@@ -325,6 +329,27 @@ fn sky_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<funct
     return l.emission * sum / f32(AREA_SAMPLES);
 }
 
+// A sky image's light reflected at x: its K directions were drawn from the
+// image in proportion to radiance × solid angle, each weighted L/(K·p), so
+// Σ_k f·L_k/(K·p_k)·cos·V_k estimates ∫ f L cos V dω: a sun in the image
+// gets many of them and its hard shadow; Lambertian and glossy points alike
+// (a glossy lobe narrower than the directions' spacing is a quadrature).
+fn sky_image(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < l.sample_count; k++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let s = samples[l.first_sample + k];
+        let cos = dot(n, s.direction);
+        if (cos > 0.0 && visible(s, x, n)) {
+            let t = light_transmittance(x, distant_start(l, x, s.direction));
+            sum += reflector_f(r, n, s.direction) * s.weight * cos * t;
+        }
+    }
+    return l.emission * sum;
+}
+
 // Radiance reflected at x (normal n) from a light whose samples are each
 // evaluated on their own, shadowed:
 // * the sky (radiance L from every direction): a Lambertian point takes
@@ -337,6 +362,9 @@ fn sky_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<funct
 //   a/d²), one-sided unless two-sided. On a glossy point a quadrature of
 //   the lobe by N points: exact as N grows (documented).
 fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
+    if (l.kind == KIND_SKY && l.mapped != 0u) {
+        return sky_image(l, x, n, r);
+    }
     if (l.kind == KIND_SKY && r.glossy) {
         return sky_glossy(l, x, n, r, rng);
     }

@@ -4,7 +4,13 @@
 pub fn shader_source() -> String {
     use crate::wgsl::{Module, UNCOUNTED_LOOPS, compose};
     static RESOLVE: Module = Module { name: "resolve.wgsl", source: include_str!("resolve.wgsl"), requires: &[] };
-    compose(&[&UNCOUNTED_LOOPS, &crate::media::MEDIA, &crate::media::VIEW_DEPTH, &RESOLVE])
+    compose(&[
+        &UNCOUNTED_LOOPS,
+        &crate::media::MEDIA,
+        &crate::media::VIEW_DEPTH,
+        &crate::textures::ENVIRONMENT,
+        &RESOLVE,
+    ])
 }
 /// Workgroup side (the `WORKGROUP` override of the shader).
 const WORKGROUP: u32 = 8;
@@ -45,7 +51,9 @@ pub struct ResolvePass {
 impl ResolvePass {
     /// `inputs`: emission, direct, indirect, caustic, specular (same size);
     /// `volume`: the volume splat's target; `sky`: the radiance of pixels
-    /// that see no surface.
+    /// that see no surface, times `environment`'s image where there is one
+    /// (`SceneBuffers::environment`; a moved scene keeps its sky).
+    #[allow(clippy::too_many_arguments)]
     pub fn new(
         device: &wgpu::Device,
         inputs: [&wgpu::Texture; 5],
@@ -53,6 +61,7 @@ impl ResolvePass {
         gbuffer: &crate::gbuffer::GBuffer,
         media: &crate::media::GpuMedia,
         sky: glam::Vec3,
+        environment: &wgpu::Buffer,
     ) -> Self {
         let (width, height) = (inputs[0].width(), inputs[0].height());
         use crate::binding::{entry, storage, storage_texture_rgba32f, texture, uniform};
@@ -71,6 +80,7 @@ impl ResolvePass {
         entries.push(entry(10, stage, texture(wgpu::TextureViewDimension::D2Array)));
         entries.push(entry(11, stage, uniform()));
         entries.push(entry(12, stage, uniform()));
+        entries.push(entry(13, stage, storage(true)));
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = crate::binding::pipeline_layout(device, "resolve", &layout);
@@ -107,6 +117,7 @@ impl ResolvePass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
         bind_entries.push(wgpu::BindGroupEntry { binding: 12, resource: sky.as_entire_binding() });
+        bind_entries.push(wgpu::BindGroupEntry { binding: 13, resource: environment.as_entire_binding() });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("resolve"),
             layout: &layout,

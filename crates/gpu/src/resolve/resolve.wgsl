@@ -31,6 +31,8 @@ struct Terms {
 @group(0) @binding(11) var<uniform> terms: Terms;
 // rgb: radiance of rays that leave the scene (the sky's; zero without one).
 @group(0) @binding(12) var<uniform> sky: vec4<f32>;
+// The sky image (textures::environment_words), by which `sky` is multiplied.
+@group(0) @binding(13) var<storage, read> environment: array<u32>;
 
 // Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
 override WORKGROUP: u32;
@@ -48,7 +50,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let position = textureLoad(gbuffer_position, p, 0);
     let ray = view_ray(position, vec2<f32>(p) + 0.5);
     if (position.w == 0.0) {
-        surface += sky.rgb;
+        surface += sky.rgb * environment_radiance(ray.xyz);
     }
     let transmittance = exp(-view_optical_depth(p, ray.w, ray.w));
     let sum = transmittance * surface + terms.volume * textureLoad(volume, p, 0).rgb;

@@ -42,7 +42,9 @@ pub struct GpuLight {
     pub sample_area: f32,
     /// Emissive mesh: 1 if it emits from both faces.
     pub two_sided: u32,
-    pub _pad: u32,
+    /// Sky: 1 when it is an image, its directions drawn from it, each with
+    /// its `GpuLightSample::weight`.
+    pub mapped: u32,
 }
 
 /// One shadow-mapped sample. Mirrors `LightSample` in light_eval.wgsl.
@@ -59,6 +61,11 @@ pub struct GpuLightSample {
     pub direction: [f32; 3],
     /// 6 for a cube of views, 1 for a single (spot or orthographic) view.
     pub view_count: u32,
+    /// A sky image's direction: L(ω)/(K·p(ω)), its share of the
+    /// irradiance integral (the light's radiance factor aside); zero
+    /// otherwise.
+    pub weight: [f32; 3],
+    pub _pad: u32,
 }
 
 pub mod kind {
@@ -222,19 +229,29 @@ impl GpuLights {
                     };
                     out.add_distant_sample(index, direction, disc);
                 }
-                Light::Environment { radiance, disc, .. } => {
+                Light::Environment { radiance, disc, ref map } => {
                     record = GpuLight {
                         position: disc.center.to_array(),
                         kind: kind::ENVIRONMENT,
                         emission: radiance.to_array(),
                         cutoff: disc.radius,
+                        mapped: map.is_some() as u32,
                         ..record
                     };
                     out.sky_radiance += radiance;
                     let k = sky_directions(n);
                     for i in 0..k {
-                        // Light arriving from ω travels along −ω.
-                        out.add_distant_sample(index, -uniform_sphere(lattice(i, k)), disc);
+                        // Light arriving from ω travels along −ω. An image's
+                        // directions are drawn from it (a sun in the map
+                        // gets its share of them), each weighted L/(K·p).
+                        match map.as_ref().and_then(|m| m.sample(lattice(i, k))) {
+                            Some(s) => {
+                                out.add_distant_sample(index, -s.dir, disc);
+                                let weight = s.radiance / (k as f32 * s.pdf);
+                                out.samples.last_mut().expect("just added").weight = weight.to_array();
+                            }
+                            None => out.add_distant_sample(index, -uniform_sphere(lattice(i, k)), disc),
+                        }
                     }
                 }
                 Light::Mesh(ref mesh) => {
@@ -286,6 +303,8 @@ impl GpuLights {
             first_view,
             direction: [0.0; 3],
             view_count,
+            weight: [0.0; 3],
+            _pad: 0,
         });
     }
 
@@ -315,6 +334,8 @@ impl GpuLights {
             first_view,
             direction: (-direction).to_array(),
             view_count: 1,
+            weight: [0.0; 3],
+            _pad: 0,
         });
     }
 }

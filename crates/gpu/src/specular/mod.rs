@@ -56,6 +56,7 @@ pub fn shader_source() -> String {
         &OPTICS,
         &crate::wgsl::SURFACE,
         &crate::wgsl::CUT_OUTS,
+        &crate::textures::ENVIRONMENT,
         &crate::wgsl::VOLUME_CHORD,
         &SPECULAR,
     ])
@@ -210,6 +211,7 @@ struct Bindings {
     prims: wgpu::Buffer,
     surfaces: wgpu::Buffer,
     textures: wgpu::Buffer,
+    environment: wgpu::Buffer,
     regions: wgpu::Buffer,
     direct: wgpu::Buffer,
     lights: wgpu::Buffer,
@@ -261,6 +263,7 @@ impl Bindings {
                     }),
                 },
                 buffer(17, &self.textures),
+                buffer(18, &self.environment),
             ],
         })
     }
@@ -359,6 +362,7 @@ impl SpecularPass {
                 entry(15, storage(false)),
                 entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
                 entry(17, storage(true)),
+                entry(18, storage(true)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
@@ -423,6 +427,7 @@ impl SpecularPass {
             prims,
             surfaces: keep(&scene_buffers.surfaces),
             textures: keep(&scene_buffers.textures),
+            environment: keep(&scene_buffers.environment),
             regions: keep(&media.regions),
             direct,
             lights,
@@ -507,6 +512,7 @@ impl SpecularPass {
         (b.nodes, b.prims, b.direct, b.lights, b.samples) = (nodes, prims, direct, lights, samples);
         b.surfaces = scene_buffers.surfaces.clone();
         b.textures = scene_buffers.textures.clone();
+        b.environment = scene_buffers.environment.clone();
         b.views = maps.views_buffer.clone();
         b.maps = maps.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

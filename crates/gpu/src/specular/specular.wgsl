@@ -75,6 +75,7 @@ struct SpecularParams {
 @group(0) @binding(15) var<storage, read_write> status: array<atomic<u32>, 4>;
 @group(0) @binding(16) var<uniform> slice: SliceParams;
 @group(0) @binding(17) var<storage, read> texture_data: array<u32>;
+@group(0) @binding(18) var<storage, read> environment: array<u32>;
 
 // Which slice this dispatch computes (mirrors specular::SliceParams).
 struct SliceParams {
@@ -320,7 +321,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (hit.t >= NO_HIT) {
             // Out of the scene: the sky (a primary ray's is the resolve's).
             if (b.depth > 0u && slice.index == 0u && b.sees_emission != 0u) {
-                radiance += weight * params.sky_radiance;
+                radiance += weight * params.sky_radiance * environment_radiance(b.dir);
             }
             continue;
         }

@@ -151,6 +151,29 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
     words
 }
 
+/// The scene's sky image for `environment.wgsl`: width, height, then each
+/// texel's linear RGB as f32 bits, row by row from the top; [0, 0] without
+/// one.
+pub fn environment_words(scene: &Scene) -> Vec<u32> {
+    use hikari_core::light::Light;
+    let map = scene.lights.iter().find_map(|l| match l {
+        Light::Environment { map: Some(map), .. } => Some(map),
+        _ => None,
+    });
+    let Some(map) = map else { return vec![0, 0] };
+    let mut words = vec![map.width(), map.height()];
+    words.extend(map.texels().iter().flat_map(|t| t.to_array().map(f32::to_bits)));
+    words
+}
+
+/// The environment lookup (`environment_radiance`); the includer declares
+/// `environment: array<u32>`.
+pub static ENVIRONMENT: crate::wgsl::Module = crate::wgsl::Module {
+    name: "environment.wgsl",
+    source: include_str!("environment.wgsl"),
+    requires: &[&crate::wgsl::CONSTANTS],
+};
+
 /// Bytes of `pack`'s buffer for `scene`, without building it (the memory
 /// check before upload): the texels and their mip chains, and 24 bytes a
 /// primitive for texture coordinates.

@@ -1,0 +1,131 @@
+//! A sky image on the GPU: pixels that see no surface show the image's
+//! texel (the resolve pass), mirrors reflect it (the specular pass), and a
+//! floor lit by it, a sun in the image included, matches photon-cpu's.
+
+use glam::{Vec2, Vec3};
+use hikari_core::envmap::EnvironmentMap;
+use hikari_core::photon::{TraceSettings, trace_photons};
+use hikari_core::progress::Silent;
+use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+use hikari_core::scene::Scene;
+use hikari_gpu::test_support::test_context;
+use hikari_gpu::{GpuRenderer, GpuSettings};
+
+/// A 32×16 sky: blue, a warm sun patch 40° above the horizon, dark ground.
+fn sky() -> EnvironmentMap {
+    let (w, h) = (32u32, 16u32);
+    let texels = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            if (22..24).contains(&x) && y == 4 {
+                Vec3::new(400.0, 300.0, 200.0)
+            } else if y >= h / 2 {
+                Vec3::splat(0.05)
+            } else {
+                Vec3::new(0.3, 0.4, 0.6)
+            }
+        })
+        .collect();
+    EnvironmentMap::new(w, h, texels).unwrap()
+}
+
+/// A grey floor, a box on it and a mirror ball under the sky image, seen
+/// from the side so the top rows see the sky.
+fn scene(size: u32) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 1.2, 3.0]
+look_at = [0.0, 0.3, 0.0]
+fov_y = 45.0
+resolution = [{size}, {size}]
+
+[[material]]
+name = "floor"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[material]]
+name = "mirror"
+type = "mirror"
+reflectance = [0.9, 0.9, 0.9]
+
+[[object]]
+shape = "quad"
+corner = [-2.0, 0.0, -2.0]
+edge_u = [0.0, 0.0, 4.0]
+edge_v = [4.0, 0.0, 0.0]
+material = "floor"
+
+[[object]]
+shape = "box"
+center = [-0.5, 0.25, -0.3]
+size = [0.5, 0.5, 0.5]
+material = "floor"
+
+[[object]]
+shape = "sphere"
+center = [0.6, 0.3, 0.2]
+radius = 0.3
+material = "mirror"
+
+[environment]
+radiance = [1.0, 1.0, 1.0]
+"#
+    );
+    let mut scene = Scene::from_toml(&text, "sky-image", None).unwrap_or_else(|e| panic!("{e}"));
+    scene.set_environment_map(std::sync::Arc::new(sky()), "sky");
+    scene
+}
+
+#[test]
+fn a_sky_image_lights_and_shows_on_the_gpu() {
+    let size = 48;
+    let scene = scene(size);
+    let ctx = test_context("a_sky_image_lights_and_shows_on_the_gpu");
+    let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, ..Default::default() }, &Silent);
+    let cpu_settings = PhotonCpuSettings { spp: 1, area_light_samples: 256, ..Default::default() };
+    let (global, caustic) = cpu_settings.estimate_params(&scene);
+    let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings).render(&Silent).0;
+    let settings = GpuSettings { area_light_samples: 64, ..GpuSettings::new(global, caustic) };
+    let gpu = GpuRenderer::new(ctx, &scene, &traced, settings).expect("the GPU draws sky images");
+    gpu.render().unwrap();
+    let image = gpu.read(gpu.resolved()).unwrap();
+    let albedo = gpu.read(&gpu.targets.gbuffer.albedo).unwrap();
+    let (mut sky, mut mirror, mut floor) = (Vec::new(), Vec::new(), Vec::new());
+    for y in 0..size {
+        for x in 0..size {
+            let i = (y * size + x) as usize;
+            let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let (g, c): (Vec3, Vec3) = (image[i].truncate(), cpu.pixels[i]);
+            let relative = (g - c).abs().max_element() / c.max_element().max(1e-3);
+            match scene.accel.intersect(&ray) {
+                None => sky.push(relative),
+                Some(_) if albedo[i].w == 1.0 => mirror.push(relative),
+                Some(_) => floor.push(((g - c).element_sum() / c.element_sum().max(1e-6)) as f64),
+            }
+        }
+    }
+    let worst = |v: &[f32]| v.iter().copied().fold(0.0f32, f32::max);
+    let mirror_mean = mirror.iter().sum::<f32>() / mirror.len().max(1) as f32;
+    let floor_mean = floor.iter().sum::<f64>() / floor.len() as f64;
+    let floor_abs = floor.iter().map(|d| d.abs()).sum::<f64>() / floor.len() as f64;
+    eprintln!(
+        "sky image: {} sky pixels (worst {:e}), {} mirror pixels (mean {:.2}%), {} lit pixels: mean signed {:.2}%, mean |difference| {:.2}%",
+        sky.len(),
+        worst(&sky),
+        mirror.len(),
+        100.0 * mirror_mean,
+        floor.len(),
+        100.0 * floor_mean,
+        100.0 * floor_abs
+    );
+    assert!(sky.len() > 100, "{} pixels see the sky", sky.len());
+    assert!(worst(&sky) < 1e-5, "the sky's texels");
+    // The ball reflects the sky's texels and the floor (whose shadows
+    // differ by shadow-map texels at their edges).
+    assert!(mirror.len() > 50 && mirror_mean < 0.05, "mirror: {mirror_mean}");
+    // The floor lit by K = 256 directions drawn from the image against 256
+    // shadow rays a point: the same light, the sun's shadow edges aside.
+    assert!(floor.len() > 500 && floor_mean.abs() < 0.03 && floor_abs < 0.05, "floor: {floor_mean}, {floor_abs}");
+}
