@@ -217,6 +217,13 @@ fn view_opens_gltf_files_under_a_sky_or_an_emissive_surface() {
     let brightest = mesh.iter().map(|p| p[0]).fold(0.0f32, f32::max);
     assert!((brightest - 12.0).abs() < 0.1, "the light shows {brightest}");
     assert!(image_mean(&mesh) > 0.1, "the box is dark: {}", image_mean(&mesh));
+    // `--environment`: an image of a sky (one colour) in place of the white one.
+    let sky_image = image::Rgb32FImage::from_raw(8, 4, [2.0f32, 1.0, 0.5].repeat(32)).unwrap();
+    image::DynamicImage::ImageRgb32F(sky_image).save(dir.join("sky-image.exr")).unwrap();
+    let args = [&["unlit.glb", "--environment", "sky-image.exr"], &common[..], &["--screenshot", "mapped.exr"]];
+    view(&dir, &args.concat());
+    let mapped = exr(&dir, "mapped.exr");
+    assert!(mapped[..32].iter().all(|p| (p[0] - 2.0).abs() < 1e-3 && (p[2] - 0.5).abs() < 1e-3), "{:?}", &mapped[..4]);
 }
 
 /// Runs `hikari view ARGS` under Xvfb in `dir`; returns its summary line.

@@ -96,6 +96,10 @@ pub struct ViewArgs {
     /// perspective camera; without one, a camera framing the scene].
     #[arg(long)]
     pub camera: Option<String>,
+    /// Light the scene by this equirectangular sky image (.hdr or .exr,
+    /// Blender's orientation) in place of its environment.
+    #[arg(long, value_name = "FILE")]
+    pub environment: Option<std::path::PathBuf>,
     /// Quit after this many frames (for tests and benchmarks).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
     pub frames: Option<u64>,
@@ -132,7 +136,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             return Err(UsageError(format!("{}: unsupported image type (use .png or .exr)", path.display())).into());
         }
     }
-    let scene = load_scene(&args.scene, args.camera.as_deref(), None, false)?;
+    let scene = load_scene(&args.scene, args.camera.as_deref(), args.environment.as_deref(), false)?;
     if let Some(size) = args.size {
         size.resolve(scene.camera.aspect()).map_err(UsageError)?;
     }
@@ -423,7 +427,10 @@ impl Viewer {
         if !self.watch.changed() {
             return Ok(());
         }
-        let options = hikari_core::scene::LoadOptions { camera: self.args.camera.clone(), environment: None };
+        let options = hikari_core::scene::LoadOptions {
+            camera: self.args.camera.clone(),
+            environment: self.args.environment.clone(),
+        };
         let scene = match Scene::load_with(&self.args.scene, &options) {
             Ok(scene) => scene,
             Err(e) => {
