@@ -142,6 +142,13 @@ impl EnvironmentMap {
         self.height
     }
 
+    /// The marginal CDF over rows (height + 1 entries) and, row after row,
+    /// each row's CDF over its texels (width + 1 entries each): what the
+    /// GPU tracer samples with (`sample`'s twin).
+    pub fn cdfs(&self) -> (&[f32], &[f32]) {
+        (&self.row_cdf, &self.column_cdf)
+    }
+
     /// The texels, row by row from the top.
     pub fn texels(&self) -> &[Rgb] {
         &self.texels

@@ -257,7 +257,11 @@ fn shared_structs_match_wgsl_layouts() {
             probability,
             first_triangle,
             triangle_count,
-            two_sided
+            two_sided,
+            sky_image,
+            _pad0,
+            _pad1,
+            _pad2
         ]
     );
     assert_layout!(

@@ -14,7 +14,8 @@
 //! # Layout (u32 words)
 //!
 //! * `[0]` image count, `[1]` word offset of the texture coordinates (0:
-//!   none), `[2..4]` unused.
+//!   none), `[2]` word offset of the sky image's sampling block (0: none;
+//!   `sky_block`), `[3]` unused.
 //! * per image, `IMAGE_WORDS` words from `HEADER_WORDS`: width, height,
 //!   level count, 1 if sRGB-encoded, then the word offset of each level.
 //! * the levels' texels, row by row from the top, `pack4x8unorm` order
@@ -105,13 +106,41 @@ pub fn mip_chain(image: &Image) -> Vec<Image> {
 }
 
 /// The words of the texture buffer for `scene` with texture coordinates in
-/// the primitive order of `bvh`; a header of zeros for a scene without
-/// textures (wgpu refuses empty bindings).
+/// the primitive order of `bvh`, and with `bvh` (the tracer's buffer) the
+/// sky image's sampling block; a header of zeros for a scene without
+/// either (wgpu refuses empty bindings).
 pub fn pack_scene(scene: &Scene, bvh: Option<&FlatBvh>) -> Vec<u32> {
-    match &scene.texturing {
+    let mut words = match &scene.texturing {
         Some(texturing) => pack(texturing, bvh),
         None => vec![0; HEADER_WORDS],
+    };
+    if let Some(map) = bvh.and(sky_image(scene)) {
+        words[2] = words.len() as u32;
+        words.extend(sky_block(map));
     }
+    words
+}
+
+/// The scene's sky image, if its environment has one.
+fn sky_image(scene: &Scene) -> Option<&hikari_core::envmap::EnvironmentMap> {
+    use hikari_core::light::Light;
+    scene.lights.iter().find_map(|l| match l {
+        Light::Environment { map: Some(map), .. } => Some(&**map),
+        _ => None,
+    })
+}
+
+/// What the GPU tracer samples a sky image with (trace.wgsl's
+/// `sample_sky_image`, `EnvironmentMap::sample`'s twin): width, height,
+/// ∫L dω (3 f32), the row CDF (height + 1 f32), the rows' CDFs
+/// (height × (width + 1) f32), the texels (3 f32 each).
+fn sky_block(map: &hikari_core::envmap::EnvironmentMap) -> Vec<u32> {
+    let (rows, columns) = map.cdfs();
+    let mut words = vec![map.width(), map.height()];
+    words.extend(map.integral().to_array().map(f32::to_bits));
+    words.extend(rows.iter().chain(columns).map(|c| c.to_bits()));
+    words.extend(map.texels().iter().flat_map(|t| t.to_array().map(f32::to_bits)));
+    words
 }
 
 /// The words of the texture buffer for `texturing` (see `pack_scene`).
@@ -155,12 +184,7 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
 /// texel's linear RGB as f32 bits, row by row from the top; [0, 0] without
 /// one.
 pub fn environment_words(scene: &Scene) -> Vec<u32> {
-    use hikari_core::light::Light;
-    let map = scene.lights.iter().find_map(|l| match l {
-        Light::Environment { map: Some(map), .. } => Some(map),
-        _ => None,
-    });
-    let Some(map) = map else { return vec![0, 0] };
+    let Some(map) = sky_image(scene) else { return vec![0, 0] };
     let mut words = vec![map.width(), map.height()];
     words.extend(map.texels().iter().flat_map(|t| t.to_array().map(f32::to_bits)));
     words
@@ -174,11 +198,20 @@ pub static ENVIRONMENT: crate::wgsl::Module = crate::wgsl::Module {
     requires: &[&crate::wgsl::CONSTANTS],
 };
 
+/// Bytes of the sky image's sampling block (and, as much again, of
+/// `environment_words`).
+fn sky_bytes(scene: &Scene) -> u64 {
+    sky_image(scene).map_or(0, |m| {
+        let (w, h) = (m.width() as u64, m.height() as u64);
+        4 * (5 + (h + 1) + h * (w + 1) + 3 * w * h) + 4 * (2 + 3 * w * h)
+    })
+}
+
 /// Bytes of `pack`'s buffer for `scene`, without building it (the memory
 /// check before upload): the texels and their mip chains, and 24 bytes a
 /// primitive for texture coordinates.
 pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
-    let Some(texturing) = &scene.texturing else { return 16 };
+    let Some(texturing) = &scene.texturing else { return 16 + sky_bytes(scene) };
     let texels: u64 = texturing
         .images
         .iter()
@@ -194,7 +227,7 @@ pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
         })
         .sum();
     let uvs = if texturing.uvs.is_empty() { 0 } else { primitives as u64 * 24 };
-    4 * (HEADER_WORDS + IMAGE_WORDS * texturing.images.len()) as u64 + 4 * texels + uvs
+    4 * (HEADER_WORDS + IMAGE_WORDS * texturing.images.len()) as u64 + 4 * texels + uvs + sky_bytes(scene)
 }
 
 #[cfg(test)]

@@ -99,6 +99,12 @@ pub struct TraceLight {
     pub first_triangle: u32,
     pub triangle_count: u32,
     pub two_sided: u32,
+    /// A sky image's sampling block in the texture buffer (word offset,
+    /// `textures::sky_block`); 0 for a uniform sky and the other lights.
+    pub sky_image: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// Mirrors `TraceTriangle` in trace.wgsl: a triangle of an emissive mesh
@@ -258,6 +264,8 @@ struct TraceScene {
     emissive: wgpu::Buffer,
     /// The packed textures, coordinates in the BVH's order (`textures::pack_scene`).
     textures: wgpu::Buffer,
+    /// Where the sky image's sampling block starts in `textures` (0: none).
+    sky_image: u32,
     first_triangles: Vec<u32>,
     distant_disc: [f32; 4],
     lights: Vec<Light>,
@@ -280,6 +288,7 @@ fn storage_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buf
 impl TraceScene {
     fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
         let bvh = FlatBvh::new(&scene.accel);
+        let texture_words = crate::textures::pack_scene(scene, Some(&bvh));
         // An empty scene: one node whose box no ray meets.
         let empty = [FlatNode { min: [1.0; 3], prim_count: 0, max: [-1.0; 3], first: 0 }];
         let nodes: &[FlatNode] = if bvh.nodes.is_empty() { &empty } else { &bvh.nodes };
@@ -332,11 +341,8 @@ impl TraceScene {
             region_triangles: regions.len() as u32,
             global_mask: media.global_mask(),
             emissive: storage_buffer(device, "trace emissive triangles", bytemuck::cast_slice(&triangles)),
-            textures: storage_buffer(
-                device,
-                "trace textures",
-                bytemuck::cast_slice(&crate::textures::pack_scene(scene, Some(&bvh))),
-            ),
+            textures: storage_buffer(device, "trace textures", bytemuck::cast_slice(&texture_words)),
+            sky_image: texture_words[2],
             first_triangles,
             distant_disc: scene
                 .lights
@@ -410,17 +416,8 @@ pub struct GpuTracer {
     pub records_per_path: u32,
 }
 
-/// Why the GPU tracer cannot trace `scene`, or None.
-fn unsupported(scene: &Scene) -> Option<GpuError> {
-    let mapped = scene.lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. }));
-    mapped.then(|| GpuError::SceneUnsupported("environment maps are not traced on the GPU yet".into()))
-}
-
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
-        if let Some(e) = unsupported(scene) {
-            return Err(e);
-        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -506,9 +503,6 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
-        if let Some(e) = unsupported(scene) {
-            return Err(e);
-        }
         let scene = ctx.scoped(|| TraceScene::upload(&ctx.device, scene))?;
         self.scene = scene;
         // The bind groups hold the old scene's buffers.
@@ -738,7 +732,13 @@ impl GpuTracer {
             .iter()
             .zip(&s.probabilities)
             .zip(&s.first_triangles)
-            .map(|((light, &p), &first)| trace_light(light, light.power() / (p * n as f32) / power_unit, p, first))
+            .map(|((light, &p), &first)| {
+                let mut t = trace_light(light, light.power() / (p * n as f32) / power_unit, p, first);
+                if matches!(light, Light::Environment { map: Some(_), .. }) {
+                    t.sky_image = s.sky_image;
+                }
+                t
+            })
             .collect();
         let (mixed_seed, increment) = Rng::seed_constants(settings.seed);
         let words = |x: u64| [x as u32, (x >> 32) as u32];

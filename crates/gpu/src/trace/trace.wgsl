@@ -57,6 +57,11 @@ struct TraceLight {
     first_triangle: u32,
     triangle_count: u32,
     two_sided: u32,
+    // A sky image's sampling block in `texture_data` (0: a uniform sky).
+    sky_image: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // A triangle of an emissive mesh (trace::TraceTriangle), with its mesh's
@@ -129,6 +134,9 @@ var<private> iterations_spent: u32 = 0u;
 var<private> over_budget: bool = false;
 var<private> path_index: u32;
 var<private> stored: array<u32, 3>;
+// The emitted photon's power factor (EmittedRay::weight): not 1 only for a
+// sky image's colours.
+var<private> emission_weight: vec3<f32>;
 
 // Loop accounting (capabilities::loop_budget): a path that would run past
 // the budget stops and is counted, and the host falls back to the CPU.
@@ -231,6 +239,12 @@ fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
             return Ray(disc_origin(l, l.axis, rng_next_2d(rng)), l.axis);
         }
         case 5u: {
+            if (l.sky_image != 0u) {
+                // From the image's sky direction ω, the photon travels along −ω.
+                let sky = sample_sky_image(l.sky_image, rng_next_2d(rng));
+                emission_weight = sky.weight;
+                return Ray(disc_origin(l, -sky.dir, rng_next_2d(rng)), -sky.dir);
+            }
             let dir = uniform_sphere(rng_next_2d(rng));
             return Ray(disc_origin(l, dir, rng_next_2d(rng)), dir);
         }
@@ -250,6 +264,70 @@ fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
 
 // Disc::emission_origin: a uniform point of the distant light's disc turned
 // perpendicular to `dir` and set back by its radius.
+// The entry i of the CDF of n + 1 entries at word `at` with
+// cdf[i] ≤ x < cdf[i + 1], and where x lies in it (envmap.rs's sample_cdf).
+fn sky_cdf_pick(at: u32, n: u32, x: f32) -> vec2<f32> {
+    // partition_point(c ≤ x): the first entry above x.
+    var lo = 0u;
+    var hi = n + 1u;
+    while (lo < hi) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let mid = (lo + hi) / 2u;
+        if (bitcast<f32>(texture_data[at + mid]) <= x) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let i = clamp(lo, 1u, n) - 1u;
+    let c0 = bitcast<f32>(texture_data[at + i]);
+    let width = bitcast<f32>(texture_data[at + i + 1u]) - c0;
+    var t = 0.5;
+    if (width > 0.0) {
+        t = clamp((x - c0) / width, 0.0, 1.0);
+    }
+    return vec2<f32>(f32(i), t);
+}
+
+struct SkySample {
+    // Toward the sky.
+    dir: vec3<f32>,
+    // L(ω)/(p(ω)·∫L dω) per channel.
+    weight: vec3<f32>,
+}
+
+// EnvironmentMap::sample from the block at `at` (textures::sky_block).
+fn sample_sky_image(at: u32, u: vec2<f32>) -> SkySample {
+    let w = texture_data[at];
+    let h = texture_data[at + 1u];
+    let integral = vec3<f32>(bitcast<f32>(texture_data[at + 2u]), bitcast<f32>(texture_data[at + 3u]), bitcast<f32>(texture_data[at + 4u]));
+    let rows = at + 5u;
+    let row_pick = sky_cdf_pick(rows, h, u.y);
+    let row = u32(row_pick.x);
+    let columns = rows + h + 1u + row * (w + 1u);
+    let column_pick = sky_cdf_pick(columns, w, u.x);
+    let column = u32(column_pick.x);
+    let inside = vec2<f32>(clamp(column_pick.y, 1.0e-4, 1.0 - 1.0e-4), clamp(row_pick.y, 1.0e-4, 1.0 - 1.0e-4));
+    let uv = vec2<f32>((f32(column) + inside.x) / f32(w), (f32(row) + inside.y) / f32(h));
+    // The texel's probability over its area of the unit square, over 2π² sin θ.
+    let p_row = bitcast<f32>(texture_data[rows + row + 1u]) - bitcast<f32>(texture_data[rows + row]);
+    let p_column = bitcast<f32>(texture_data[columns + column + 1u]) - bitcast<f32>(texture_data[columns + column]);
+    let sin_theta = sin(uv.y * PI);
+    let pdf = p_row * p_column * f32(w * h) / (2.0 * PI * PI * sin_theta);
+    let texel = rows + h + 1u + h * (w + 1u) + 3u * (row * w + column);
+    let radiance = vec3<f32>(bitcast<f32>(texture_data[texel]), bitcast<f32>(texture_data[texel + 1u]), bitcast<f32>(texture_data[texel + 2u]));
+    let phi = (uv.x - 0.5) * 2.0 * PI;
+    let theta = uv.y * PI;
+    let dir = vec3<f32>(-sin(theta) * cos(phi), cos(theta), -sin(theta) * sin(phi));
+    var weight = vec3<f32>(0.0);
+    if (pdf > 0.0) {
+        weight = select(vec3<f32>(0.0), radiance / (pdf * max(integral, vec3<f32>(1.0e-38))), integral > vec3<f32>(0.0));
+    }
+    return SkySample(dir, weight);
+}
+
 fn disc_origin(l: TraceLight, dir: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
     let basis = orthonormal_basis(dir);
     let p = unit_circle(u.y) * sqrt(u.x) * l.radius;
@@ -346,8 +424,9 @@ fn trace_paths(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 
 fn trace_one(rng: ptr<function, Rng>) {
     let light = lights[choose_light(rng_next_f32(rng))];
+    emission_weight = vec3<f32>(1.0);
     var ray = emit(light, rng);
-    var power = light.power;
+    var power = light.power * emission_weight;
     var diffuse_bounces = 0u;
     var specular_bounces = 0u;
     for (var bounce = 0u; bounce < params.max_bounces; bounce++) {
