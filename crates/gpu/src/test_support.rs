@@ -101,7 +101,7 @@ pub fn eye_near_the_floor(size: u32) -> hikari_core::camera::Camera {
 /// An open 4×4 floor at y = 0 (albedo 0.5) with `objects` on it and
 /// `lights`, seen at `size`² from above and in front, so that the top rows
 /// see past the floor's far edge (the sky, where there is one).
-fn open_floor(size: u32, objects: &str, lights: &str) -> Scene {
+pub fn open_floor(size: u32, objects: &str, lights: &str) -> Scene {
     let text = format!(
         r#"
 [camera]

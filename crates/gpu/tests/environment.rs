@@ -8,7 +8,7 @@ use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
-use hikari_gpu::test_support::test_context;
+use hikari_gpu::test_support::{open_floor, test_context};
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
 /// A 32×16 sky: blue, a warm sun patch 40° above the horizon, dark ground.
@@ -29,51 +29,12 @@ fn sky() -> EnvironmentMap {
     EnvironmentMap::new(w, h, texels).unwrap()
 }
 
-/// A grey floor, a box on it and a mirror ball under the sky image, seen
-/// from the side so the top rows see the sky.
+/// `test_support::open_floor` with a box and a mirror ball under the sky
+/// image, seen so that the top rows see the sky.
 fn scene(size: u32) -> Scene {
-    let text = format!(
-        r#"
-[camera]
-position = [0.0, 1.2, 3.0]
-look_at = [0.0, 0.3, 0.0]
-fov_y = 45.0
-resolution = [{size}, {size}]
-
-[[material]]
-name = "floor"
-type = "diffuse"
-albedo = [0.5, 0.5, 0.5]
-
-[[material]]
-name = "mirror"
-type = "mirror"
-reflectance = [0.9, 0.9, 0.9]
-
-[[object]]
-shape = "quad"
-corner = [-2.0, 0.0, -2.0]
-edge_u = [0.0, 0.0, 4.0]
-edge_v = [4.0, 0.0, 0.0]
-material = "floor"
-
-[[object]]
-shape = "box"
-center = [-0.5, 0.25, -0.3]
-size = [0.5, 0.5, 0.5]
-material = "floor"
-
-[[object]]
-shape = "sphere"
-center = [0.6, 0.3, 0.2]
-radius = 0.3
-material = "mirror"
-
-[environment]
-radiance = [1.0, 1.0, 1.0]
-"#
-    );
-    let mut scene = Scene::from_toml(&text, "sky-image", None).unwrap_or_else(|e| panic!("{e}"));
+    let objects = "[[object]]\nshape = \"box\"\ncenter = [-0.5, 0.25, -0.3]\nsize = [0.5, 0.5, 0.5]\nmaterial = \"grey\"\n\n\
+                   [[object]]\nshape = \"sphere\"\ncenter = [0.6, 0.3, 0.2]\nradius = 0.3\nmaterial = \"mirror\"\n";
+    let mut scene = open_floor(size, objects, "[environment]\nradiance = [1.0, 1.0, 1.0]\n");
     scene.set_environment_map(std::sync::Arc::new(sky()), "sky");
     scene
 }

@@ -38,10 +38,16 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     if (!photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
         discard;
     }
-    let eye = unit(params.camera_position - position.xyz);
+    // ρ/(π² r²) on a Lambertian surface; on a glossy one (the only ones
+    // that pay for the eye, the BRDF and the G-buffer's metal-roughness)
+    // the BRDF for the photon's own direction over π r².
+    var weight = radiance_per_power(albedo.rgb, params.radius);
     let surface = surfaces[u32(g.w)];
-    let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
-    let weight = photon_weight(surface.glossy != 0u, b, eye, normal, direction, params.radius);
+    if (surface.glossy != 0u) {
+        let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
+        let eye = unit(params.camera_position - position.xyz);
+        weight = photon_brdf(b, eye, normal, direction) * radiance_per_weighted_power(params.radius);
+    }
     let radiance = weight * decode_rgb9e5(in.power_rgb9e5) * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);

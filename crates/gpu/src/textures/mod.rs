@@ -15,7 +15,7 @@
 //!
 //! * `[0]` image count, `[1]` word offset of the texture coordinates (0:
 //!   none), `[2]` word offset of the sky image's sampling block (0: none;
-//!   `sky_block`), `[3]` unused.
+//!   `sky_block`, in the photon tracer's buffer only), `[3]` unused.
 //! * per image, `IMAGE_WORDS` words from `HEADER_WORDS`: width, height,
 //!   level count, 1 if sRGB-encoded, then the word offset of each level.
 //! * the levels' texels, row by row from the top, `pack4x8unorm` order
@@ -106,15 +106,21 @@ pub fn mip_chain(image: &Image) -> Vec<Image> {
 }
 
 /// The words of the texture buffer for `scene` with texture coordinates in
-/// the primitive order of `bvh`, and with `bvh` (the tracer's buffer) the
-/// sky image's sampling block; a header of zeros for a scene without
-/// either (wgpu refuses empty bindings).
+/// the primitive order of `bvh`; a header of zeros for a scene without
+/// textures (wgpu refuses empty bindings).
 pub fn pack_scene(scene: &Scene, bvh: Option<&FlatBvh>) -> Vec<u32> {
-    let mut words = match &scene.texturing {
+    match &scene.texturing {
         Some(texturing) => pack(texturing, bvh),
         None => vec![0; HEADER_WORDS],
-    };
-    if let Some(map) = bvh.and(sky_image(scene)) {
+    }
+}
+
+/// `pack_scene`'s words with the sky image's sampling block after them
+/// (header word 2 its offset): the GPU photon tracer's buffer, the only
+/// one that samples the image.
+pub fn pack_scene_for_tracing(scene: &Scene, bvh: &FlatBvh) -> Vec<u32> {
+    let mut words = pack_scene(scene, Some(bvh));
+    if let Some(map) = sky_image(scene) {
         words[2] = words.len() as u32;
         words.extend(sky_block(map));
     }
@@ -198,18 +204,14 @@ pub static ENVIRONMENT: crate::wgsl::Module = crate::wgsl::Module {
     requires: &[&crate::wgsl::CONSTANTS],
 };
 
-/// Bytes of the sky image's sampling block (and, as much again, of
-/// `environment_words`).
+/// Bytes of the renderer's sky image (`environment_words`).
 fn sky_bytes(scene: &Scene) -> u64 {
-    sky_image(scene).map_or(0, |m| {
-        let (w, h) = (m.width() as u64, m.height() as u64);
-        4 * (5 + (h + 1) + h * (w + 1) + 3 * w * h) + 4 * (2 + 3 * w * h)
-    })
+    sky_image(scene).map_or(0, |m| 4 * (2 + 3 * m.width() as u64 * m.height() as u64))
 }
 
-/// Bytes of `pack`'s buffer for `scene`, without building it (the memory
-/// check before upload): the texels and their mip chains, and 24 bytes a
-/// primitive for texture coordinates.
+/// Bytes of the renderer's texture buffers for `scene`, without building
+/// them (the memory check before upload): the texels and their mip
+/// chains, 24 bytes a primitive for texture coordinates, and the sky image.
 pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
     let Some(texturing) = &scene.texturing else { return 16 + sky_bytes(scene) };
     let texels: u64 = texturing

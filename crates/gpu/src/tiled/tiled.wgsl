@@ -240,7 +240,7 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let normal = g.xyz;
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
-    // A glossy surface weights each photon by its BRDF (photon_weight) in
+    // A glossy surface weights each photon by its BRDF (photon_brdf) in
     // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
     let surface = surfaces[u32(g.w)];
     let glossy = surface.glossy != 0u;

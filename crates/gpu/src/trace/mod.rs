@@ -288,7 +288,7 @@ fn storage_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buf
 impl TraceScene {
     fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
         let bvh = FlatBvh::new(&scene.accel);
-        let texture_words = crate::textures::pack_scene(scene, Some(&bvh));
+        let texture_words = crate::textures::pack_scene_for_tracing(scene, &bvh);
         // An empty scene: one node whose box no ray meets.
         let empty = [FlatNode { min: [1.0; 3], prim_count: 0, max: [-1.0; 3], first: 0 }];
         let nodes: &[FlatNode] = if bvh.nodes.is_empty() { &empty } else { &bvh.nodes };

@@ -24,12 +24,3 @@ fn radiance_per_weighted_power(radius: f32) -> f32 {
 fn photon_brdf(b: Bsdf, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>) -> vec3<f32> {
     return bsdf_f_gathered(b, to_shading(eye, n), to_shading(-photon_dir, n));
 }
-
-// What a photon adds per unit power there: f·(1/π r²) on a glossy
-// surface, ρ/(π² r²) (ρ = b's base colour) on a Lambertian one.
-fn photon_weight(glossy: bool, b: Bsdf, eye: vec3<f32>, n: vec3<f32>, photon_dir: vec3<f32>, radius: f32) -> vec3<f32> {
-    if (!glossy) {
-        return radiance_per_power(b.base_color, radius);
-    }
-    return photon_brdf(b, eye, n, photon_dir) * radiance_per_weighted_power(radius);
-}
