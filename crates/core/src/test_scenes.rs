@@ -116,6 +116,12 @@ pub fn cornell_quad_light(size: u32) -> Scene {
 /// diffuse material instead of `Material::Emitter`: the same light, carried
 /// by the code paths of emissive meshes.
 pub fn quad_lights_as_meshes(scene: &Scene) -> Scene {
+    quad_lights_as_split_meshes(scene, 1)
+}
+
+/// [`quad_lights_as_meshes`] with each quad cut into `cuts`×`cuts` cells of
+/// two triangles each.
+pub fn quad_lights_as_split_meshes(scene: &Scene, cuts: u32) -> Scene {
     use crate::light::{EmissiveMesh, Light};
     use crate::material::Material;
     let mut scene = scene.clone();
@@ -124,10 +130,13 @@ pub fn quad_lights_as_meshes(scene: &Scene) -> Scene {
     for (i, light) in scene.lights.iter_mut().enumerate() {
         let Light::Quad { corner, edge_u, edge_v, radiance } = *light else { continue };
         // The loader's winding (`add_quad`): normal edge_u × edge_v.
-        let triangles = vec![
-            [corner, corner + edge_u, corner + edge_u + edge_v],
-            [corner, corner + edge_u + edge_v, corner + edge_v],
-        ];
+        let (du, dv) = (edge_u / cuts as f32, edge_v / cuts as f32);
+        let triangles = (0..cuts * cuts)
+            .flat_map(|k| {
+                let c = corner + du * (k % cuts) as f32 + dv * (k / cuts) as f32;
+                [[c, c + du, c + du + dv], [c, c + du + dv, c + dv]]
+            })
+            .collect();
         *light = Light::Mesh(std::sync::Arc::new(EmissiveMesh::new(triangles, radiance, false).unwrap()));
         for surface in scene.surfaces.iter_mut().filter(|s| s.emitter == Some(i as u32)) {
             surface.material = black;
@@ -244,8 +253,12 @@ pub mod glossy_lights {
     pub const SUN: &str =
         "[[light]]\ntype = \"directional\"\ndirection = [-0.3, -0.5, -1.0]\nirradiance = [3.0, 3.0, 3.0]";
     pub const SKY: &str = "[environment]\nradiance = [1.0, 1.0, 1.0]";
-    /// Each with its name.
-    pub const ALL: [(&str, &str); 5] = [("point", POINT), ("spot", SPOT), ("quad", QUAD), ("sun", SUN), ("sky", SKY)];
+    /// A ball just under the ceiling, about the quad's power.
+    pub const SPHERE: &str =
+        "[[light]]\ntype = \"sphere\"\ncenter = [0.0, 0.8, 0.0]\nradius = 0.12\nradiance = [16.0, 16.0, 16.0]";
+    /// Each with its name. (An emissive mesh: `quad_lights_as_meshes` of the quad's box.)
+    pub const ALL: [(&str, &str); 6] =
+        [("point", POINT), ("spot", SPOT), ("quad", QUAD), ("sun", SUN), ("sky", SKY), ("sphere", SPHERE)];
 }
 
 /// glTF files with textures, written by code: what the texture tests of

@@ -9,7 +9,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, pho
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{glossy_box, glossy_lights::*};
+use hikari_core::test_scenes::{glossy_box, glossy_lights::*, quad_lights_as_meshes};
 
 /// The mean of passes 1..=n of `photons` paths each, at the default first radii.
 fn progressive(scene: &Scene, photons: u64, passes: u32) -> Image {
@@ -25,8 +25,7 @@ fn progressive(scene: &Scene, photons: u64, passes: u32) -> Image {
     mean.mean()
 }
 
-fn converges(name: &str, light: &str) {
-    let scene = glossy_box(light, 32);
+fn converges(name: &str, scene: Scene) {
     let reference_with = |seed| {
         let (image, nonfinite) =
             path::render(&scene, &path::PathSettings { spp: 2048, seed, ..Default::default() }, &Silent);
@@ -57,25 +56,35 @@ fn converges(name: &str, light: &str) {
 
 #[test]
 fn glossy_box_under_a_point_light() {
-    converges("point", POINT);
+    converges("point", glossy_box(POINT, 32));
 }
 
 #[test]
 fn glossy_box_under_a_spot_light() {
-    converges("spot", SPOT);
+    converges("spot", glossy_box(SPOT, 32));
 }
 
 #[test]
 fn glossy_box_under_a_quad_light() {
-    converges("quad", QUAD);
+    converges("quad", glossy_box(QUAD, 32));
 }
 
 #[test]
 fn glossy_box_under_a_sun() {
-    converges("sun", SUN);
+    converges("sun", glossy_box(SUN, 32));
 }
 
 #[test]
 fn glossy_box_under_a_sky() {
-    converges("sky", SKY);
+    converges("sky", glossy_box(SKY, 32));
+}
+
+#[test]
+fn glossy_box_under_a_sphere_light() {
+    converges("sphere", glossy_box(SPHERE, 32));
+}
+
+#[test]
+fn glossy_box_under_an_emissive_mesh() {
+    converges("mesh", quad_lights_as_meshes(&glossy_box(QUAD, 32)));
 }

@@ -10,7 +10,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, pas
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{glossy_box, glossy_lights};
+use hikari_core::test_scenes::{glossy_box, glossy_lights, quad_lights_as_meshes};
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
@@ -54,8 +54,7 @@ fn gpu_progressive(scene: &Scene, photons: u64, checkpoints: &[u32], area_light_
     images
 }
 
-fn converges(name: &str, light: &str, area_light_samples: u32) {
-    let scene = glossy_box(light, 32);
+fn converges(name: &str, scene: Scene, area_light_samples: u32) {
     let reference_with = |seed| {
         let (image, nonfinite) =
             path::render(&scene, &path::PathSettings { spp: 2048, seed, ..Default::default() }, &Silent);
@@ -89,25 +88,35 @@ fn converges(name: &str, light: &str, area_light_samples: u32) {
 
 #[test]
 fn glossy_box_on_the_gpu_under_a_point_light() {
-    converges("point", glossy_lights::POINT, 4);
+    converges("point", glossy_box(glossy_lights::POINT, 32), 4);
 }
 
 #[test]
 fn glossy_box_on_the_gpu_under_a_spot_light() {
-    converges("spot", glossy_lights::SPOT, 4);
+    converges("spot", glossy_box(glossy_lights::SPOT, 32), 4);
 }
 
 #[test]
 fn glossy_box_on_the_gpu_under_a_quad_light() {
-    converges("quad", glossy_lights::QUAD, 4);
+    converges("quad", glossy_box(glossy_lights::QUAD, 32), 4);
 }
 
 #[test]
 fn glossy_box_on_the_gpu_under_a_sun() {
-    converges("sun", glossy_lights::SUN, 4);
+    converges("sun", glossy_box(glossy_lights::SUN, 32), 4);
 }
 
 #[test]
 fn glossy_box_on_the_gpu_under_a_sky() {
-    converges("sky", glossy_lights::SKY, 16);
+    converges("sky", glossy_box(glossy_lights::SKY, 32), 16);
+}
+
+#[test]
+fn glossy_box_on_the_gpu_under_a_sphere_light() {
+    converges("sphere", glossy_box(glossy_lights::SPHERE, 32), 4);
+}
+
+#[test]
+fn glossy_box_on_the_gpu_under_an_emissive_mesh() {
+    converges("mesh", quad_lights_as_meshes(&glossy_box(glossy_lights::QUAD, 32)), 4);
 }

@@ -477,9 +477,14 @@ fn block_difference(
 /// smoother lobes followed one sampled direction per pass).
 #[test]
 fn gpu_image_matches_photon_cpu_on_a_glossy_box_under_every_light() {
-    use hikari_core::test_scenes::{glossy_box, glossy_lights};
-    for (light, text) in glossy_lights::ALL {
-        let scene = glossy_box(text, SIZE);
+    use hikari_core::test_scenes::{glossy_box, glossy_lights, quad_lights_as_meshes, quad_lights_as_split_meshes};
+    let mut scenes: Vec<(&str, _)> =
+        glossy_lights::ALL.iter().map(|&(light, text)| (light, glossy_box(text, SIZE))).collect();
+    scenes.push(("emissive mesh", quad_lights_as_meshes(&glossy_box(glossy_lights::QUAD, SIZE))));
+    // Over `MESH_MIS_TRIANGLES`: light samples alone.
+    let split = quad_lights_as_split_meshes(&glossy_box(glossy_lights::QUAD, SIZE), 8);
+    scenes.push(("emissive mesh of 128 triangles", split));
+    for (light, scene) in scenes {
         let name = format!("glossy box, {light}");
         let frames = render_both(&name, &scene, 20_000, 8, Samples { cpu: 64, gpu: 16 });
         let mask = comparison_mask(&scene, &frames.albedo);

@@ -12,8 +12,11 @@
 // of f·L·cos over the light is estimated with `AREA_SAMPLES` light samples
 // and as many BRDF samples, weighted by multiple importance sampling, from
 // the caller's random stream (a new one each progressive pass, so passes
-// converge), and the sky's from BRDF samples alone (`sky_glossy`). The
-// shadow-mapped samples give the fraction seen, as for Lambertian points. The includer declares `direct_params`, `lights`,
+// converge), and the sky's from BRDF samples alone (`sky_glossy`); an
+// emissive mesh's likewise from area-uniform points on its triangles and,
+// for small meshes, BRDF samples (`mesh_glossy`). The shadow-mapped samples
+// give the fraction seen, as for Lambertian points. The includer declares
+// `direct_params`, `lights`,
 // `samples`, `views`, `shadow_maps`, and `light_transmittance(x, end)` (the
 // media's transmittance from x to a point toward the light; 1 where media
 // are not drawn).
@@ -50,6 +53,9 @@ struct Light {
     two_sided: u32,
     // Sky: 1 when it is an image (its samples' `weight`s hold it).
     mapped: u32,
+    // Emissive mesh: its triangles in the samples array (`mesh_triangle`).
+    first_triangle: u32,
+    triangle_count: u32,
 }
 
 struct LightSample {
@@ -350,6 +356,164 @@ fn sky_image(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector) -> vec3<f32> {
     return l.emission * sum;
 }
 
+// Meshes of at most this many triangles take BRDF samples too (each tested
+// against every triangle); larger ones light samples alone (unbiased, but
+// noisy on narrow lobes).
+const MESH_MIS_TRIANGLES: u32 = 64u;
+
+// One triangle of an emissive mesh: a vertex, its two edges from it (front
+// normal e1 × e2) and the mesh's area up to and including it
+// (light_samples.rs, `add_triangles`).
+struct MeshTriangle {
+    v0: vec3<f32>,
+    e1: vec3<f32>,
+    e2: vec3<f32>,
+    cumulative_area: f32,
+}
+
+fn mesh_triangle(l: Light, i: u32) -> MeshTriangle {
+    let s = samples[l.first_triangle + i];
+    return MeshTriangle(s.position, s.direction, s.weight, bitcast<f32>(s.first_view));
+}
+
+// The cosine at the light of a ray leaving mesh triangle normal `nl`
+// toward −wi, zero where that face does not emit.
+fn mesh_emitting_cos(l: Light, nl: vec3<f32>, wi: vec3<f32>) -> f32 {
+    let c = -dot(wi, nl);
+    if (l.two_sided != 0u) {
+        return abs(c);
+    }
+    return max(c, 0.0);
+}
+
+// A point of mesh l, uniform in area (its triangle by cumulative area, u.x
+// reused inside it, then the square-root map), and its triangle's unit normal.
+struct MeshPoint {
+    position: vec3<f32>,
+    normal: vec3<f32>,
+}
+
+fn mesh_sample_point(l: Light, area: f32, u: vec2<f32>) -> MeshPoint {
+    let target_area = u.x * area;
+    var lo = 0u;
+    var hi = l.triangle_count - 1u;
+    while (lo < hi) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let mid = (lo + hi) / 2u;
+        if (mesh_triangle(l, mid).cumulative_area <= target_area) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let t = mesh_triangle(l, lo);
+    var start = 0.0;
+    if (lo > 0u) {
+        start = mesh_triangle(l, lo - 1u).cumulative_area;
+    }
+    let width = t.cumulative_area - start;
+    var ux = 0.5;
+    if (width > 0.0) {
+        ux = clamp((target_area - start) / width, 0.0, 1.0);
+    }
+    let a = sqrt(ux);
+    let p = t.v0 + t.e1 * (a * (1.0 - u.y)) + t.e2 * (a * u.y);
+    return MeshPoint(p, unit(cross(t.e1, t.e2)));
+}
+
+// ∫ f L cos dω over emissive mesh l at a glossy point, unshadowed (its own
+// faces do not hide each other, as its shadow views leave them out):
+// `AREA_SAMPLES` area-uniform light samples a pass, and for small meshes as
+// many BRDF samples counted at every emitting triangle they cross, combined
+// by the power heuristic; then scaled by the fraction of the f-weighted
+// light its N shadow-mapped points see (as a quad's fraction scales its
+// closed form).
+fn mesh_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
+    let area = mesh_triangle(l, l.triangle_count - 1u).cumulative_area;
+    if (area <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let brdf_samples = l.triangle_count <= MESH_MIS_TRIANGLES;
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < AREA_SAMPLES; k++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let m = mesh_sample_point(l, area, stream_next_2d(rng));
+        let to_light = m.position - x;
+        let d2 = dot(to_light, to_light);
+        if (d2 > 0.0) {
+            let wi = to_light / sqrt(d2);
+            let cos_l = mesh_emitting_cos(l, m.normal, wi);
+            let local = to_shading(wi, n);
+            if (cos_l > 0.0 && local.z > 0.0) {
+                let pdf_light = d2 / (area * cos_l);
+                var weight = 1.0;
+                if (brdf_samples) {
+                    weight = power_heuristic(pdf_light, bsdf_pdf(r.bsdf, r.wo, local));
+                }
+                sum += bsdf_f(r.bsdf, r.wo, local) * (local.z / pdf_light * weight);
+            }
+        }
+        if (!brdf_samples) {
+            continue;
+        }
+        let s = glossy_sample(r, rng);
+        if (!s.valid) {
+            continue;
+        }
+        let dir = local_to_world(s.wi, n);
+        for (var i = 0u; i < l.triangle_count; i++) {
+            if (!loop_iteration()) {
+                break;
+            }
+            let t = mesh_triangle(l, i);
+            // Möller–Trumbore.
+            let p = cross(dir, t.e2);
+            let det = dot(t.e1, p);
+            if (det == 0.0) {
+                continue;
+            }
+            let to_x = x - t.v0;
+            let b1 = dot(to_x, p) / det;
+            let q = cross(to_x, t.e1);
+            let b2 = dot(dir, q) / det;
+            let dist = dot(t.e2, q) / det;
+            if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || dist <= 0.0) {
+                continue;
+            }
+            let cos_l = mesh_emitting_cos(l, unit(cross(t.e1, t.e2)), dir);
+            if (cos_l > 0.0) {
+                let pdf_light = dist * dist / (area * cos_l);
+                sum += s.weight * power_heuristic(s.pdf, pdf_light);
+            }
+        }
+    }
+    let unshadowed = l.emission * sum / f32(AREA_SAMPLES);
+    var seen = vec3<f32>(0.0);
+    var total = vec3<f32>(0.0);
+    for (var k = 0u; k < l.sample_count; k++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let s = samples[l.first_sample + k];
+        let to_light = s.position - x;
+        let d2 = dot(to_light, to_light);
+        if (d2 <= 0.0) {
+            continue;
+        }
+        let wi = to_light / sqrt(d2);
+        let weight = reflector_f(r, n, wi) * (max(dot(n, wi), 0.0) * mesh_emitting_cos(l, s.direction, wi) / (d2 + l.sample_area / PI));
+        total += weight;
+        if (any(weight > vec3<f32>(0.0)) && visible(s, x, n)) {
+            seen += weight * light_transmittance(x, s.position);
+        }
+    }
+    return unshadowed * select(vec3<f32>(0.0), seen / total, total > vec3<f32>(0.0));
+}
+
 // Radiance reflected at x (normal n) from a light whose samples are each
 // evaluated on their own, shadowed:
 // * the sky (radiance L from every direction): a Lambertian point takes
@@ -357,16 +521,19 @@ fn sky_image(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector) -> vec3<f32> {
 //   fraction of its K fixed directions that see x. Exact where all or none
 //   see it; in between a sky seen through K hard shadows, as an area light
 //   is N hard shadows. A glossy point: `sky_glossy`.
-// * an emissive mesh: Σ_k f·L·a·cos_l·cos_x/(d² + a/π) over its N points,
-//   each standing for its share a = A/N of the area (the small-disc form of
-//   a/d²), one-sided unless two-sided. On a glossy point a quadrature of
-//   the lobe by N points: exact as N grows (documented).
+// * an emissive mesh at a Lambertian point: Σ_k ρ/π·L·a·cos_l·cos_x/(d² + a/π)
+//   over its N points, each standing for its share a = A/N of the area (the
+//   small-disc form of a/d²), one-sided unless two-sided. A glossy point:
+//   `mesh_glossy`.
 fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
     if (l.kind == KIND_SKY && l.mapped != 0u) {
         return sky_image(l, x, n, r);
     }
     if (l.kind == KIND_SKY && r.glossy) {
         return sky_glossy(l, x, n, r, rng);
+    }
+    if (l.kind == KIND_MESH && r.glossy) {
+        return mesh_glossy(l, x, n, r, rng);
     }
     var seen = vec3<f32>(0.0);
     var total_weight = 0.0;
@@ -377,7 +544,6 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
         let s = samples[l.first_sample + k];
         var weight = 0.0;
         var end = s.position;
-        var f = vec3<f32>(1.0);
         if (l.kind == KIND_SKY) {
             weight = max(dot(n, s.direction), 0.0);
             total_weight += weight;
@@ -389,20 +555,14 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
                 continue;
             }
             let wi = to_light / sqrt(d2);
-            var cos_l = -dot(s.direction, wi);
-            if (l.two_sided != 0u) {
-                cos_l = abs(cos_l);
-            }
+            let cos_l = mesh_emitting_cos(l, s.direction, wi);
             // Each point stands for a disc of its share of the area: on its
             // axis that gives L·a/(d² + a/π) exactly, which stays finite
             // (at most πL) where a point's a/d² would not.
-            weight = max(dot(n, wi), 0.0) * max(cos_l, 0.0) / (d2 + l.sample_area / PI);
-            if (r.glossy) {
-                f = reflector_f(r, n, wi);
-            }
+            weight = max(dot(n, wi), 0.0) * cos_l / (d2 + l.sample_area / PI);
         }
         if (weight > 0.0 && visible(s, x, n)) {
-            seen += weight * f * light_transmittance(x, end);
+            seen += weight * light_transmittance(x, end);
         }
     }
     if (l.kind == KIND_SKY) {
@@ -411,10 +571,7 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
         }
         return r.albedo * l.emission * seen / total_weight;
     }
-    if (!r.glossy) {
-        return r.albedo / PI * l.emission * l.sample_area * seen;
-    }
-    return l.emission * l.sample_area * seen;
+    return r.albedo / PI * l.emission * l.sample_area * seen;
 }
 
 // Direct radiance leaving x (normal n toward the viewer) toward the viewer.

@@ -31,13 +31,19 @@ pub fn shader_source() -> String {
 /// in light_eval.wgsl; a test reads it back).
 pub const AREA_SAMPLES: u32 = 4;
 
+/// Emissive meshes of at most this many triangles take BRDF samples at a
+/// glossy point too (`MESH_MIS_TRIANGLES` in light_eval.wgsl).
+pub const MESH_MIS_TRIANGLES: u32 = 64;
+
 /// Loop iterations one pixel of the direct pass runs at most: per light,
 /// the quad's 4 corners, then per sample (every light's, the sky's
 /// directions and a mesh's points included) the region triangles crossed
 /// on the way to the light (light_eval.wgsl's `direct_radiance` and
 /// `sampled_radiance`). A glossy point adds `AREA_SAMPLES` for a sphere or
-/// quad light (`area_glossy`), and for the sky (`sky_glossy`) a search of
-/// its directions and the region triangles toward the nearest, per sample.
+/// quad light (`area_glossy`), for the sky (`sky_glossy`) a search of its
+/// directions and the region triangles toward the nearest, per sample, and
+/// for an emissive mesh (`mesh_glossy`) per sample a binary search of its
+/// triangles and, on small meshes, a test of each, then its points again.
 pub fn loop_iterations(lights: &GpuLights, region_triangles: usize) -> u64 {
     use crate::shadow::light_samples::kind;
     let regions = region_triangles as u64;
@@ -50,6 +56,12 @@ pub fn loop_iterations(lights: &GpuLights, region_triangles: usize) -> u64 {
             let glossy = match l.kind {
                 kind::SPHERE | kind::QUAD => area,
                 kind::ENVIRONMENT => area * (1 + samples + regions),
+                kind::MESH => {
+                    let triangles = l.triangle_count as u64;
+                    let search = 64 - triangles.leading_zeros() as u64;
+                    let tests = if l.triangle_count <= MESH_MIS_TRIANGLES { triangles } else { 0 };
+                    area * (1 + search + tests) + samples * (1 + regions)
+                }
                 _ => 0,
             };
             1 + 4 + samples * (1 + regions) + glossy
@@ -190,10 +202,14 @@ pub struct DirectBinding {
 
 #[cfg(test)]
 mod tests {
-    /// `AREA_SAMPLES` is the WGSL's.
+    /// `AREA_SAMPLES` and `MESH_MIS_TRIANGLES` are the WGSL's.
     #[test]
-    fn area_samples_match_the_wgsl() {
-        let line = format!("const AREA_SAMPLES: u32 = {}u;", super::AREA_SAMPLES);
-        assert!(include_str!("light_eval.wgsl").contains(&line), "light_eval.wgsl lacks `{line}`");
+    fn constants_match_the_wgsl() {
+        for line in [
+            format!("const AREA_SAMPLES: u32 = {}u;", super::AREA_SAMPLES),
+            format!("const MESH_MIS_TRIANGLES: u32 = {}u;", super::MESH_MIS_TRIANGLES),
+        ] {
+            assert!(include_str!("light_eval.wgsl").contains(&line), "light_eval.wgsl lacks `{line}`");
+        }
     }
 }

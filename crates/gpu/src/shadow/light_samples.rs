@@ -45,6 +45,11 @@ pub struct GpuLight {
     /// Sky: 1 when it is an image, its directions drawn from it, each with
     /// its `GpuLightSample::weight`.
     pub mapped: u32,
+    /// Emissive mesh: where its triangles start in the samples array (after
+    /// its shadow-mapped points, [`GpuLights::add_triangles`]) and how many.
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    pub _pad: [u32; 2],
 }
 
 /// One shadow-mapped sample. Mirrors `LightSample` in light_eval.wgsl.
@@ -269,6 +274,12 @@ impl GpuLights {
                         out.samples.last_mut().expect("just added").direction = normal.to_array();
                     }
                     out.occluders.add(index, mesh);
+                    record.sample_count = out.samples.len() as u32 - first_sample;
+                    record.first_triangle = out.samples.len() as u32;
+                    record.triangle_count = mesh.triangles().len() as u32;
+                    out.add_triangles(mesh);
+                    out.lights.push(record);
+                    continue;
                 }
             }
             record.sample_count = out.samples.len() as u32 - first_sample;
@@ -306,6 +317,26 @@ impl GpuLights {
             weight: [0.0; 3],
             _pad: 0,
         });
+    }
+
+    /// The triangles of an emissive mesh, for the glossy points' light
+    /// samples (`mesh_glossy` in light_eval.wgsl), appended to the samples
+    /// array: the passes that shade have no storage binding to spare on
+    /// every adapter (12 per stage, the specular pass's all taken). Each is
+    /// one record: `position` its first vertex, `direction` and `weight`
+    /// its two edges from it (front normal e1 × e2), `first_view` the bits
+    /// of the area up to and including it (f32), `view_count` 0.
+    fn add_triangles(&mut self, mesh: &EmissiveMesh) {
+        for ([v0, v1, v2], cumulative) in mesh.triangles().iter().zip(mesh.cumulative_areas()) {
+            self.samples.push(GpuLightSample {
+                position: v0.to_array(),
+                first_view: cumulative.to_bits(),
+                direction: (*v1 - *v0).to_array(),
+                view_count: 0,
+                weight: (*v2 - *v0).to_array(),
+                _pad: 0,
+            });
+        }
     }
 
     /// A sample of light travelling along unit `direction` from the plane
@@ -412,17 +443,34 @@ mod tests {
 
         let scene = quad_lights_as_meshes(&cornell_quad_light(8));
         let mesh = GpuLights::new(&scene, 16);
-        assert_eq!(mesh.samples.len(), 16);
+        // 16 shadow-mapped points, then the two triangles.
+        assert_eq!(mesh.samples.len(), 16 + 2);
         assert_eq!(mesh.views.len(), 16 * 6);
-        assert!((mesh.lights[0].sample_area - 0.25 / 16.0).abs() < 1e-7);
-        for s in &mesh.samples {
+        let light = mesh.lights[0];
+        assert!((light.sample_area - 0.25 / 16.0).abs() < 1e-7);
+        assert_eq!((light.sample_count, light.first_triangle, light.triangle_count), (16, 16, 2));
+        let Light::Mesh(ref emissive) = scene.lights[0] else { unreachable!() };
+        for (record, (&[v0, v1, v2], &cumulative)) in
+            mesh.samples[16..].iter().zip(emissive.triangles().iter().zip(emissive.cumulative_areas()))
+        {
+            assert_eq!(record.position, v0.to_array());
+            assert_eq!(record.direction, (v1 - v0).to_array());
+            assert_eq!(record.weight, (v2 - v0).to_array());
+            assert_eq!(f32::from_bits(record.first_view), cumulative);
+        }
+        assert!((f32::from_bits(mesh.samples[17].first_view) - 0.25).abs() < 1e-6);
+        // Per light 1 + 4, per point 1; a glossy point adds per sample a
+        // search (2 steps) and a test of both triangles, and its points again.
+        let area = crate::direct::AREA_SAMPLES as u64;
+        assert_eq!(crate::direct::loop_iterations(&mesh, 0), 1 + 4 + 16 + area * (1 + 2 + 2) + 16);
+        for s in &mesh.samples[..16] {
             let p = Vec3::from(s.position);
             assert!((p.y - 0.999).abs() < 1e-3 && p.x.abs() <= 0.25 && p.z.abs() <= 0.25, "{p}");
             // The quad faces down (edge_u × edge_v = x × z = −y).
             assert_eq!(s.direction, [0.0, -1.0, 0.0]);
         }
         // Stratified: every quarter of the light holds a quarter of the samples.
-        let quarter = mesh.samples.iter().filter(|s| s.position[0] < 0.0 && s.position[2] < 0.0).count();
+        let quarter = mesh.samples[..16].iter().filter(|s| s.position[0] < 0.0 && s.position[2] < 0.0).count();
         assert!((3..=5).contains(&quarter), "{quarter} of 16 in one quarter");
         // The mesh shadows other lights' views, not its own.
         assert_eq!(mesh.occluders.vertices.len(), 6);
