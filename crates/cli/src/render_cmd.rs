@@ -169,7 +169,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_seconds, allow_negative_numbers = true)]
     pub checkpoint: Option<f64>,
     /// An image of the same size (e.g. a long path-traced EXR): print the
-    /// relative RMSE and mean ratio against it at each checkpoint and at the end.
+    /// error against it at each checkpoint and at the end: the per-pixel RMS
+    /// error over the reference's mean (relRMSE), the image means' ratio,
+    /// the same error on 16×16 blocks, and the older RMS-relative figure.
     #[arg(long)]
     pub reference: Option<PathBuf>,
     /// No progress bars.
