@@ -1,6 +1,6 @@
 //! `hikari render`: load a scene, trace photons, render, write the image.
 
-use crate::passes::renderers::{CpuPasses, GpuPasses, PathPasses};
+use crate::passes::renderers::{CpuPasses, GpuPasses, PathPasses, VcmPasses};
 use crate::passes::{self, PassPlan, read_reference};
 use crate::progress_bar::TerminalProgress;
 use crate::tracing::{PhotonTracer, TraceDevice};
@@ -12,7 +12,10 @@ use hikari_core::photon::TracedPhotons;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_trace_settings};
-use hikari_core::render::{Image, path, photon_cpu};
+use hikari_core::render::{Image, path, photon_cpu, vcm};
+
+/// Passes `--renderer vcm` renders without --passes or --time.
+const VCM_DEFAULT_PASSES: u32 = 16;
 use hikari_core::scene::{Scene, builtin};
 use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
@@ -36,6 +39,35 @@ pub enum RendererKind {
     PhotonCpu,
     /// Path tracer: the unbiased ground truth (next-event estimation with MIS; equiangular sampling of point and spot lights in fog).
     Path,
+    /// Vertex connection and merging: light tracing, bidirectional
+    /// connections and photon merging weighted by MIS, in progressive
+    /// passes (16 unless --passes or --time says otherwise). No fog yet.
+    Vcm,
+}
+
+/// Which of VCM's strategies `--renderer vcm` uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VcmStrategies {
+    /// Connections and merging.
+    All,
+    /// Connections only: bidirectional path tracing (unbiased).
+    Connections,
+    /// Merging only: progressive photon mapping at every eye vertex.
+    Merging,
+    /// Light tracing alone (and the lights the eye sees directly).
+    LightTracing,
+}
+
+impl From<VcmStrategies> for hikari_core::render::vcm::Strategies {
+    fn from(s: VcmStrategies) -> Self {
+        use hikari_core::render::vcm::Strategies;
+        match s {
+            VcmStrategies::All => Strategies::All,
+            VcmStrategies::Connections => Strategies::Connections,
+            VcmStrategies::Merging => Strategies::Merging,
+            VcmStrategies::LightTracing => Strategies::LightTracing,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -106,6 +138,9 @@ pub struct RenderArgs {
     /// Blender's orientation) in place of its environment.
     #[arg(long, value_name = "FILE")]
     pub environment: Option<std::path::PathBuf>,
+    /// With --renderer vcm: which of its strategies to use.
+    #[arg(long, value_enum, default_value_t = VcmStrategies::All)]
+    pub vcm_strategies: VcmStrategies,
     /// Random seed: the same seed gives the same image whatever the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
@@ -448,8 +483,9 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
     if args.checkpoint.is_some() && args.passes.is_none_or(|n| n == 1) && args.time.is_none() {
         usage!("--checkpoint needs --passes (more than 1) or --time");
     }
+    let single = if kind == RendererKind::Vcm { VCM_DEFAULT_PASSES } else { 1 };
     let plan = PassPlan {
-        passes: args.passes.unwrap_or(if args.time.is_some() { u32::MAX } else { 1 }),
+        passes: args.passes.unwrap_or(if args.time.is_some() { u32::MAX } else { single }),
         time: args.time.map(Duration::from_secs_f64),
         checkpoint: args.checkpoint.map(Duration::from_secs_f64),
         reference,
@@ -462,6 +498,26 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
         let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
         eprintln!("path tracing in passes of {} spp", settings.spp);
         let mut passes = PathPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
+        let (image, _) = passes::run(&mut passes, &plan)?;
+        return Ok((image, passes.nonfinite));
+    }
+    if kind == RendererKind::Vcm {
+        let settings = vcm::VcmSettings {
+            seed: args.seed,
+            strategies: args.vcm_strategies.into(),
+            radius: args.radius,
+            alpha: args.alpha,
+            ..Default::default()
+        };
+        if let Some(why) = vcm::unsupported(scene) {
+            usage!("{}: {why}", args.scene);
+        }
+        let radius = settings.radius.unwrap_or_else(|| vcm::default_radius(scene));
+        eprintln!(
+            "vcm ({:?}): one light and one camera subpath per pixel a pass, first merging radius {radius:.4}, α = {}",
+            settings.strategies, args.alpha
+        );
+        let mut passes = VcmPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
         let (image, _) = passes::run(&mut passes, &plan)?;
         return Ok((image, passes.nonfinite));
     }
@@ -603,6 +659,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             result
         }
         RendererKind::Gpu | RendererKind::PhotonCpu => render_photons(args, renderer, &scene, &progress)?,
+        RendererKind::Vcm => render_in_passes(args, renderer, &scene)?,
     };
     if nonfinite > 0 {
         eprintln!("warning: {nonfinite} non-finite samples were dropped");

@@ -480,3 +480,27 @@ fn an_environment_map_lights_a_gltf_file() {
         assert!(!dir.join("bad.png").exists(), "{file}: an image was written");
     }
 }
+
+/// `--renderer vcm` renders in passes (16 by default) with each of its
+/// strategy sets; a scene with fog is refused (exit 2, nothing written).
+#[test]
+fn vertex_connection_and_merging_renders_and_refuses_fog() {
+    let dir = scratch_dir("vcm");
+    let run =
+        |args: &[&str]| hikari(&[&["render", "cornell-caustic", "--resolution", "16x16", "-q"], args].concat(), &dir);
+    let out = run(&["--renderer", "vcm", "-o", "v.exr"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("16 passes"), "{}", String::from_utf8_lossy(&out.stderr));
+    for strategies in ["connections", "merging", "light-tracing"] {
+        let out = run(&["--renderer", "vcm", "--vcm-strategies", strategies, "--passes", "2", "-o", "s.png"]);
+        assert!(out.status.success(), "{strategies}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    let image = hikari_core::output::read_exr(&dir.join("v.exr")).unwrap();
+    assert!(image.pixels.iter().all(|p| p.is_finite()) && image.mean() > 0.0);
+    let fog = scratch_dir("vcm-fog");
+    assert_fails_with(
+        &hikari(&["render", "fog-stage", "--renderer", "vcm", "-o", "fog.png"], &fog),
+        &fog,
+        &["fog-stage", "participating media"],
+    );
+}

@@ -85,6 +85,29 @@ impl Camera {
         self.forward
     }
 
+    /// The distance, in pixels, from the eye to an image plane whose pixels
+    /// are one unit square: a ray at angle θ off the axis then crosses
+    /// solid angle cos³θ / D² per pixel, what light tracing divides by.
+    pub fn image_plane_distance(&self) -> f32 {
+        self.height as f32 / (2.0 * self.tan_half_fov)
+    }
+
+    /// The continuous pixel coordinates `ray` would take to pass through
+    /// world point `p` (jitter included), or None for points behind the
+    /// eye or outside the image.
+    pub fn raster(&self, p: Vec3) -> Option<Vec2> {
+        let d = p - self.position;
+        let z = d.dot(self.forward);
+        if z <= 0.0 {
+            return None;
+        }
+        let x = d.dot(self.right) / (z * self.tan_half_fov * self.aspect());
+        let y = d.dot(self.true_up) / (z * self.tan_half_fov);
+        let pixel = Vec2::new((x + 1.0) * 0.5 * self.width as f32, (1.0 - y) * 0.5 * self.height as f32) - self.jitter;
+        let inside = pixel.x >= 0.0 && pixel.y >= 0.0 && pixel.x < self.width as f32 && pixel.y < self.height as f32;
+        inside.then_some(pixel)
+    }
+
     /// (forward, right, up, tan(fov_y/2)): what `ray` builds directions from,
     /// for shaders that cast the same primary rays.
     pub fn basis(&self) -> (Vec3, Vec3, Vec3, f32) {
@@ -137,6 +160,25 @@ pub fn clip_from_view(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `raster` inverts `ray`, and the image-plane distance gives each
+    /// pixel the solid angle its rays span.
+    #[test]
+    fn raster_inverts_ray() {
+        let camera = Camera::new(Vec3::new(0.3, 0.2, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 64, 48).unwrap();
+        for pixel in [Vec2::new(0.5, 0.5), Vec2::new(63.9, 20.25), Vec2::new(31.0, 47.5), Vec2::new(10.0, 0.1)] {
+            let ray = camera.ray(pixel);
+            let back = camera.raster(ray.at(2.5)).unwrap();
+            assert!((back - pixel).length() < 1e-3, "{pixel} -> {back}");
+        }
+        assert_eq!(camera.raster(camera.position - camera.forward()), None);
+        assert_eq!(camera.raster(camera.ray(Vec2::new(-0.5, 3.0)).at(1.0)), None);
+        // The centre pixel spans about 1/D² sr.
+        let d = camera.image_plane_distance();
+        let (a, b) = (camera.ray(Vec2::new(32.0, 24.0)), camera.ray(Vec2::new(33.0, 24.0)));
+        let angle = a.dir.angle_between(b.dir);
+        assert!((angle * d - 1.0).abs() < 1e-3, "{angle} rad per pixel, D = {d}");
+    }
 
     #[test]
     fn centre_ray_looks_at_target_and_top_left_is_up_left() {

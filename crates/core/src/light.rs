@@ -85,7 +85,7 @@ impl Disc {
         self.center - dir * self.radius + t * p.x + b * p.y
     }
 
-    fn area(&self) -> f32 {
+    pub fn area(&self) -> f32 {
         PI * self.radius * self.radius
     }
 }
@@ -163,7 +163,7 @@ impl EmissiveMesh {
     /// A point uniform on the mesh (triangle ∝ area, then uniform on it)
     /// and its unit winding normal. `u.x` picks the triangle and is reused,
     /// rescaled, inside it.
-    fn sample_point(&self, u: Vec2) -> (Vec3, Vec3) {
+    pub fn sample_point(&self, u: Vec2) -> (Vec3, Vec3) {
         let target = u.x * self.area();
         let i = self.cumulative_area.partition_point(|&c| c <= target).min(self.triangles.len() - 1);
         let start = if i == 0 { 0.0 } else { self.cumulative_area[i - 1] };
@@ -180,7 +180,7 @@ impl EmissiveMesh {
     /// Area density of `sample_point` converted to solid angle at `point`
     /// for a light point `to_light` away with unit normal `normal`; 0 where
     /// the light emits nothing (its back, unless two-sided).
-    fn solid_angle_pdf(&self, to_light: Vec3, normal: Vec3) -> f32 {
+    pub fn solid_angle_pdf(&self, to_light: Vec3, normal: Vec3) -> f32 {
         let d2 = to_light.length_squared();
         let cos_l = -to_light.dot(normal) / d2.sqrt();
         let cos_l = if self.two_sided { cos_l.abs() } else { cos_l };
@@ -221,6 +221,9 @@ pub struct EmittedRay {
     pub origin: Vec3,
     pub dir: Vec3,
     pub weight: Rgb,
+    /// The unit normal of the emitting face at `origin` (area lights;
+    /// `dir` lies on its side); zero for the others.
+    pub normal: Vec3,
 }
 
 impl Light {
@@ -414,37 +417,48 @@ impl Light {
     /// (METHOD.md §2), so every photon of a light carries the same power.
     pub fn emit(&self, rng: &mut Rng) -> EmittedRay {
         match *self {
-            Light::Point { position, .. } => {
-                EmittedRay { origin: position, dir: sampling::uniform_sphere(rng.next_2d()), weight: Rgb::ONE }
-            }
+            Light::Point { position, .. } => EmittedRay {
+                origin: position,
+                dir: sampling::uniform_sphere(rng.next_2d()),
+                weight: Rgb::ONE,
+                normal: Vec3::ZERO,
+            },
             Light::Spot { position, axis, cutoff, falloff_start, .. } => {
                 let local = sample_spot_direction(cutoff, falloff_start, rng);
-                EmittedRay { origin: position, dir: local_to_world(local, axis), weight: Rgb::ONE }
+                EmittedRay { origin: position, dir: local_to_world(local, axis), weight: Rgb::ONE, normal: Vec3::ZERO }
             }
             Light::Sphere { center, radius, .. } => {
                 let n = sampling::uniform_sphere(rng.next_2d());
                 let dir = local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n);
-                EmittedRay { origin: center + n * radius, dir, weight: Rgb::ONE }
+                EmittedRay { origin: center + n * radius, dir, weight: Rgb::ONE, normal: n }
             }
             Light::Quad { corner, edge_u, edge_v, .. } => {
                 let u = rng.next_2d();
                 let n = edge_u.cross(edge_v).normalize();
                 let dir = local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n);
-                EmittedRay { origin: corner + edge_u * u.x + edge_v * u.y, dir, weight: Rgb::ONE }
+                EmittedRay { origin: corner + edge_u * u.x + edge_v * u.y, dir, weight: Rgb::ONE, normal: n }
             }
-            Light::Directional { direction, disc, .. } => {
-                EmittedRay { origin: disc.emission_origin(direction, rng.next_2d()), dir: direction, weight: Rgb::ONE }
-            }
+            Light::Directional { direction, disc, .. } => EmittedRay {
+                origin: disc.emission_origin(direction, rng.next_2d()),
+                dir: direction,
+                weight: Rgb::ONE,
+                normal: Vec3::ZERO,
+            },
             Light::Environment { disc, map: None, .. } => {
                 let dir = sampling::uniform_sphere(rng.next_2d());
-                EmittedRay { origin: disc.emission_origin(dir, rng.next_2d()), dir, weight: Rgb::ONE }
+                EmittedRay {
+                    origin: disc.emission_origin(dir, rng.next_2d()),
+                    dir,
+                    weight: Rgb::ONE,
+                    normal: Vec3::ZERO,
+                }
             }
             // From the map's sky direction ω, drawn ∝ luminance: the photon
             // travels along −ω, its power scaled by L(ω)/(p(ω)·∫L dω) per
             // channel (1 for a grey map).
             Light::Environment { disc, map: Some(ref map), .. } => {
                 let Some(s) = map.sample(rng.next_2d()) else {
-                    return EmittedRay { origin: disc.center, dir: Vec3::Y, weight: Rgb::ZERO };
+                    return EmittedRay { origin: disc.center, dir: Vec3::Y, weight: Rgb::ZERO, normal: Vec3::ZERO };
                 };
                 let dir = -s.dir;
                 let integral = map.integral();
@@ -453,7 +467,7 @@ impl Light {
                     s.radiance / (s.pdf * integral.max(Rgb::splat(f32::MIN_POSITIVE))),
                     Rgb::ZERO,
                 );
-                EmittedRay { origin: disc.emission_origin(dir, rng.next_2d()), dir, weight }
+                EmittedRay { origin: disc.emission_origin(dir, rng.next_2d()), dir, weight, normal: Vec3::ZERO }
             }
             Light::Mesh(ref mesh) => {
                 let (origin, n) = mesh.sample_point(rng.next_2d());
@@ -463,6 +477,7 @@ impl Light {
                     origin,
                     dir: local_to_world(sampling::cosine_hemisphere(rng.next_2d()), n),
                     weight: Rgb::ONE,
+                    normal: n,
                 }
             }
         }
@@ -617,7 +632,7 @@ fn delta_sample(point: Vec3, position: Vec3, intensity: Rgb) -> Option<LightSamp
 }
 
 /// Uniform-cone density, with 1 − cos θ_max computed without cancellation.
-fn cone_pdf(sin2_max: f32, cos_max: f32) -> f32 {
+pub fn cone_pdf(sin2_max: f32, cos_max: f32) -> f32 {
     let one_minus_cos = sin2_max / (1.0 + cos_max);
     1.0 / (2.0 * PI * one_minus_cos)
 }

@@ -10,7 +10,7 @@ use hikari_core::progress::Silent;
 use hikari_core::progressive::{
     ImageMean, Schedules, pass_jitter, pass_seed, pass_trace_settings, photon_cpu_estimate_pass,
 };
-use hikari_core::render::{Image, path, photon_cpu};
+use hikari_core::render::{Image, path, photon_cpu, vcm};
 use hikari_core::scene::Scene;
 use hikari_gpu::accumulate::AccumulatePass;
 use hikari_gpu::{GpuContext, GpuRenderer, GpuSettings};
@@ -69,6 +69,33 @@ impl PassRenderer for PathPasses<'_> {
 
     fn radius(&self, _: u32) -> Option<f32> {
         None
+    }
+}
+
+/// Vertex connection and merging: each pass is one light and one camera
+/// subpath per pixel at the pass's merging radius.
+pub struct VcmPasses<'a> {
+    pub scene: &'a Scene,
+    pub settings: vcm::VcmSettings,
+    pub mean: ImageMean,
+    pub nonfinite: u64,
+}
+
+impl PassRenderer for VcmPasses<'_> {
+    fn render_pass(&mut self, pass: u32) -> Result<()> {
+        let (image, nonfinite) = vcm::render_pass(self.scene, &self.settings, pass).map_err(anyhow::Error::msg)?;
+        self.nonfinite += nonfinite;
+        self.mean.add(&image);
+        Ok(())
+    }
+
+    fn mean(&mut self) -> Result<Image> {
+        Ok(self.mean.mean())
+    }
+
+    fn radius(&self, pass: u32) -> Option<f32> {
+        let first = self.settings.radius.unwrap_or_else(|| vcm::default_radius(self.scene));
+        Some(hikari_core::progressive::RadiusSchedule::disc(first, self.settings.alpha).radius(pass))
     }
 }
 

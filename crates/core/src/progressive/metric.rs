@@ -45,6 +45,43 @@ impl std::fmt::Display for ImageError {
 /// is black; non-finite pixels of either are an error too (they would make
 /// every figure meaningless).
 pub fn compare(image: &Image, reference: &Image) -> Result<ImageError, String> {
+    compare_where(image, reference, &vec![true; reference.pixels.len()])
+}
+
+/// The pixels that are not a light's own (relerr.py's `--exclude-brightest`):
+/// false where either image's brightest channel is at least 50 times the
+/// median of the reference's values, grown by one pixel. A directly seen
+/// light's edge pixels carry sub-pixel noise hundreds of times the scene's,
+/// which would drown every other error.
+pub fn without_lights(image: &Image, reference: &Image) -> Vec<bool> {
+    let brightest = |p: &glam::Vec3| p.max_element();
+    let mut values: Vec<f32> = reference.pixels.iter().flat_map(|p| p.to_array()).collect();
+    values.sort_by(f32::total_cmp);
+    let median = values.get(values.len() / 2).copied().unwrap_or(0.0);
+    let (w, h) = (reference.width as i64, reference.height as i64);
+    let lit: Vec<bool> = image
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, b)| brightest(a) >= 50.0 * median || brightest(b) >= 50.0 * median)
+        .collect();
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            !(-1..=1).any(|dy| {
+                (-1..=1).any(|dx| {
+                    // np.roll wraps around the edges; so does this.
+                    let (nx, ny) = ((x + dx).rem_euclid(w), (y + dy).rem_euclid(h));
+                    lit[(ny * w + nx) as usize]
+                })
+            })
+        })
+        .collect()
+}
+
+/// [`compare`] over the pixels where `mask` is true (blocks count when 90%
+/// of their pixels do, as relerr.py's).
+pub fn compare_where(image: &Image, reference: &Image, mask: &[bool]) -> Result<ImageError, String> {
     if (image.width, image.height) != (reference.width, reference.height) {
         return Err(format!(
             "the image is {}x{} and the reference {}x{}",
@@ -52,10 +89,15 @@ pub fn compare(image: &Image, reference: &Image) -> Result<ImageError, String> {
         ));
     }
     let (mut diff2, mut ref2, mut sum, mut ref_sum) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for (a, b) in image.pixels.iter().zip(&reference.pixels) {
+    let mut values = 0.0;
+    for ((a, b), &kept) in image.pixels.iter().zip(&reference.pixels).zip(mask) {
         if !a.is_finite() || !b.is_finite() {
             return Err("a pixel is not finite".into());
         }
+        if !kept {
+            continue;
+        }
+        values += 3.0;
         for c in 0..3 {
             let (a, b) = (a[c] as f64, b[c] as f64);
             diff2 += (a - b) * (a - b);
@@ -67,12 +109,14 @@ pub fn compare(image: &Image, reference: &Image) -> Result<ImageError, String> {
     if ref2 == 0.0 || ref_sum == 0.0 {
         return Err("the reference is black".into());
     }
-    let values = 3.0 * image.pixels.len() as f64;
-    let (block_image, block_reference) = (block_means(image), block_means(reference));
-    let block_relative_to_mean = (!block_reference.is_empty()).then(|| {
-        let diff2: f64 = block_image.iter().zip(&block_reference).map(|(a, b)| (a - b) * (a - b)).sum();
-        let mean = block_reference.iter().sum::<f64>() / block_reference.len() as f64;
-        (diff2 / block_reference.len() as f64).sqrt() / mean
+    let (block_image, kept) = block_means(image, mask);
+    let (block_reference, _) = block_means(reference, mask);
+    let whole: Vec<usize> = (0..kept.len()).filter(|&b| kept[b]).collect();
+    let block_relative_to_mean = (!whole.is_empty()).then(|| {
+        let channels = || whole.iter().flat_map(|&b| 3 * b..3 * b + 3);
+        let diff2: f64 = channels().map(|i| (block_image[i] - block_reference[i]).powi(2)).sum();
+        let mean = channels().map(|i| block_reference[i]).sum::<f64>() / (3 * whole.len()) as f64;
+        (diff2 / (3 * whole.len()) as f64).sqrt() / mean
     });
     Ok(ImageError {
         relative_rmse: (diff2 / ref2).sqrt(),
@@ -82,20 +126,31 @@ pub fn compare(image: &Image, reference: &Image) -> Result<ImageError, String> {
     })
 }
 
-/// Each channel's mean over each whole [`BLOCK`]² block, block by block.
-fn block_means(image: &Image) -> Vec<f64> {
+/// Each channel's mean over the kept pixels of each whole [`BLOCK`]²
+/// block, block by block, and whether 90% of a block's pixels are kept.
+fn block_means(image: &Image, mask: &[bool]) -> (Vec<f64>, Vec<bool>) {
     let (columns, rows) = (image.width / BLOCK, image.height / BLOCK);
-    let mut means = vec![0.0f64; (columns * rows * 3) as usize];
+    let blocks = (columns * rows) as usize;
+    let (mut sums, mut counts) = (vec![0.0f64; 3 * blocks], vec![0u32; blocks]);
     for y in 0..rows * BLOCK {
         for x in 0..columns * BLOCK {
-            let p = image.pixels[(y * image.width + x) as usize];
+            let i = (y * image.width + x) as usize;
+            if !mask[i] {
+                continue;
+            }
             let block = ((y / BLOCK) * columns + x / BLOCK) as usize;
+            counts[block] += 1;
             for c in 0..3 {
-                means[3 * block + c] += p[c] as f64 / (BLOCK * BLOCK) as f64;
+                sums[3 * block + c] += image.pixels[i][c] as f64;
             }
         }
     }
-    means
+    for (b, &n) in counts.iter().enumerate() {
+        for c in 0..3 {
+            sums[3 * b + c] /= n.max(1) as f64;
+        }
+    }
+    (sums, counts.iter().map(|&n| n as f64 >= 0.9 * (BLOCK * BLOCK) as f64).collect())
 }
 
 #[cfg(test)]
@@ -149,6 +204,25 @@ mod tests {
         assert!((e.block_relative_to_mean.unwrap() - 0.0229144).abs() < 1e-6, "{e:?}");
         assert!((e.relative_rmse - 0.1).abs() < 1e-6, "{e:?}");
         assert!(e.to_string().starts_with("relRMSE 0."), "{e}");
+    }
+
+    /// One light pixel masks itself and its 8 neighbours (wrapping at the
+    /// edges, as relerr.py's np.roll); the rest compares as before.
+    #[test]
+    fn lights_are_left_out() {
+        let mut reference = Image::new(16, 16);
+        reference.pixels.fill(Vec3::ONE);
+        reference.pixels[5 * 16 + 7] = Vec3::splat(1000.0);
+        let mut test = reference.clone();
+        test.pixels[5 * 16 + 7] = Vec3::splat(10.0);
+        test.pixels[15 * 16 + 15] = Vec3::splat(60.0);
+        let mask = without_lights(&test, &reference);
+        assert_eq!(mask.iter().filter(|&&k| !k).count(), 18);
+        assert!(!mask[4 * 16 + 6] && !mask[6 * 16 + 8] && mask[7 * 16 + 7]);
+        assert!(!mask[0] && !mask[15], "the corner's neighbours wrap around");
+        let e = compare_where(&test, &reference, &mask).unwrap();
+        assert_eq!((e.relative_to_mean, e.mean_ratio), (0.0, 1.0));
+        assert_eq!(e.block_relative_to_mean, Some(0.0), "238 of 256 kept: the block counts");
     }
 
     #[test]

@@ -10,7 +10,7 @@ pub mod schedule;
 
 use crate::render::Image;
 use glam::{Vec2, Vec3};
-pub use metric::{ImageError, compare};
+pub use metric::{ImageError, compare, compare_where, without_lights};
 pub use schedule::{DEFAULT_ALPHA, RadiusSchedule};
 
 /// The schedules of the three maps (global, caustic, volume).

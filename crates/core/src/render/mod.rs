@@ -5,6 +5,7 @@ mod direct;
 mod image;
 pub mod path;
 pub mod photon_cpu;
+pub mod vcm;
 
 pub use self::image::Image;
 pub use direct::{direct_diffuse, direct_reflected};

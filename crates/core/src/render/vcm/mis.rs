@@ -1,0 +1,196 @@
+//! The multiple-importance weights of vertex connection and merging, in the
+//! recursive form of Georgiev et al.'s technical report ("Implementing
+//! vertex connection and merging", 2012; SmallVCM follows it): each subpath
+//! carries three running sums (dVCM, dVC, dVM) from which the weight of
+//! every strategy that completes a path at its end vertex follows in O(1).
+//! The weights use the balance heuristic (`mis` is the identity).
+//!
+//! Every function here is a pure function of the subpaths' sums and the
+//! densities at the vertices a strategy joins, so the test below can check
+//! them against Veach's explicit formula on paths given vertex by vertex.
+
+use std::f32::consts::PI;
+
+/// The heuristic's power of a density ratio: 1, the balance heuristic.
+pub fn mis(x: f32) -> f32 {
+    x
+}
+
+/// Which strategies an iteration uses: connections (next-event estimation,
+/// bidirectional connections, light tracing), merging (photon density
+/// estimation), or both; their per-iteration constants.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Factors {
+    /// η = π r² N_L to the heuristic's power, when merging is on (else 0):
+    /// how a connection's weight counts the merges at its vertices.
+    pub vm_weight: f32,
+    /// 1/η likewise, when connections are on (else 0).
+    pub vc_weight: f32,
+    /// 1 / (π r² N_L): a merge's density-estimation kernel and path count.
+    pub vm_normalization: f32,
+    /// N_L: light subpaths per iteration (one per pixel).
+    pub light_paths: f32,
+}
+
+impl Factors {
+    pub fn new(radius: f32, light_paths: f32, connect: bool, merge: bool) -> Self {
+        let radius = radius.max(1e-7);
+        let eta = PI * radius * radius * light_paths;
+        Factors {
+            vm_weight: if merge { mis(eta) } else { 0.0 },
+            vc_weight: if connect { mis(1.0 / eta) } else { 0.0 },
+            vm_normalization: 1.0 / eta,
+            light_paths,
+        }
+    }
+}
+
+/// A subpath's running sums (tech. rep. eqs. 31–36).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubpathMis {
+    pub d_vcm: f32,
+    pub d_vc: f32,
+    pub d_vm: f32,
+}
+
+impl SubpathMis {
+    /// A light subpath leaving its light: `emission_pdf_w` is the density
+    /// of its start (position × direction, light choice included),
+    /// `direct_pdf` that of next-event estimation choosing the same light
+    /// point (area measure for finite lights, solid angle for distant ones;
+    /// 1 for a delta position; for lights whose direct sampling depends on
+    /// the receiver, pass 1 and call [`SubpathMis::direct_pdf_known`] at the
+    /// first hit), `cos_light` the cosine at the light (1 for distant
+    /// lights). Delta lights cannot be hit, so dVC starts at 0.
+    pub fn light_start(emission_pdf_w: f32, direct_pdf: f32, cos_light: f32, delta: bool, f: &Factors) -> Self {
+        let d_vc = if delta { 0.0 } else { mis(cos_light / emission_pdf_w) };
+        SubpathMis { d_vcm: mis(direct_pdf / emission_pdf_w), d_vc, d_vm: d_vc * f.vc_weight }
+    }
+
+    /// Multiplies in the direct-sampling density that `light_start` was
+    /// given as 1 (a sphere light's cone depends on the receiver).
+    pub fn direct_pdf_known(&mut self, direct_pdf: f32) {
+        self.d_vcm *= mis(direct_pdf);
+    }
+
+    /// A camera subpath leaving the eye with the solid-angle density
+    /// `camera_pdf_w` of its first direction (per unit pixel area).
+    pub fn camera_start(camera_pdf_w: f32, f: &Factors) -> Self {
+        SubpathMis { d_vcm: mis(f.light_paths / camera_pdf_w), d_vc: 0.0, d_vm: 0.0 }
+    }
+
+    /// The subpath's ray arrived `distance` away at a surface with cosine
+    /// `cos` to it. `finite`: false for the first segment of a distant
+    /// light's subpath (its densities are per solid angle, not per area).
+    pub fn arrive(&mut self, distance_squared: f32, cos: f32, finite: bool) {
+        if finite {
+            self.d_vcm *= mis(distance_squared);
+        }
+        let cos = mis(cos.abs());
+        self.d_vcm /= cos;
+        self.d_vc /= cos;
+        self.d_vm /= cos;
+    }
+
+    /// The subpath scattered by a delta lobe (the forward and reverse
+    /// densities are the same choice and cancel), leaving with cosine `cos_out`.
+    pub fn scatter_delta(&mut self, cos_out: f32) {
+        self.d_vcm = 0.0;
+        self.d_vc *= mis(cos_out);
+        self.d_vm *= mis(cos_out);
+    }
+
+    /// The subpath scattered by a non-delta lobe: `pdf_dir` the density of
+    /// the direction taken, `pdf_rev` that of the reverse (both per
+    /// steradian, continuation included), leaving with cosine `cos_out`.
+    pub fn scatter(&mut self, cos_out: f32, pdf_dir: f32, pdf_rev: f32, f: &Factors) {
+        let g = mis(cos_out / pdf_dir);
+        let d_vc = g * (self.d_vc * mis(pdf_rev) + self.d_vcm + f.vm_weight);
+        let d_vm = g * (self.d_vm * mis(pdf_rev) + self.d_vcm * f.vc_weight + 1.0);
+        *self = SubpathMis { d_vcm: mis(1.0 / pdf_dir), d_vc, d_vm };
+    }
+}
+
+/// Weight of a camera subpath that hits an emitter (or escapes to the sky):
+/// `direct_pdf` the density of next-event estimation choosing that point
+/// (area; solid angle for the sky), `emission_pdf_w` that of a light
+/// subpath starting there toward the camera vertex, both with the light's
+/// choice. A camera ray that hits it first gets 1 (no other strategy
+/// draws it).
+pub fn emitter_hit(camera: &SubpathMis, direct_pdf: f32, emission_pdf_w: f32) -> f32 {
+    let w_camera = mis(direct_pdf) * camera.d_vcm + mis(emission_pdf_w) * camera.d_vc;
+    1.0 / (1.0 + w_camera)
+}
+
+/// Densities of next-event estimation at a camera vertex.
+#[derive(Clone, Copy, Debug)]
+pub struct NextEvent {
+    /// Of the BSDF sampling toward the light (continuation included; 0 for
+    /// a delta light, which BSDF sampling never finds).
+    pub bsdf_dir_pdf_w: f32,
+    /// Of the BSDF sampling the camera subpath's incoming direction from
+    /// the light's (continuation included).
+    pub bsdf_rev_pdf_w: f32,
+    /// Of the light's choice × its direct sampling, per steradian at the
+    /// vertex (point lights: the squared distance).
+    pub direct_pdf_w: f32,
+    /// Of a light subpath starting at the light point toward the vertex
+    /// (light choice included).
+    pub emission_pdf_w: f32,
+    pub cos_at_vertex: f32,
+    /// Cosine at the light point (1 for point and distant lights).
+    pub cos_at_light: f32,
+}
+
+pub fn next_event(camera: &SubpathMis, d: &NextEvent, f: &Factors) -> f32 {
+    let w_light = mis(d.bsdf_dir_pdf_w / d.direct_pdf_w);
+    let w_camera = mis(d.emission_pdf_w * d.cos_at_vertex / (d.direct_pdf_w * d.cos_at_light))
+        * (f.vm_weight + camera.d_vcm + camera.d_vc * mis(d.bsdf_rev_pdf_w));
+    1.0 / (w_light + 1.0 + w_camera)
+}
+
+/// Weight of connecting a light vertex to the eye (light tracing):
+/// `camera_pdf_a` the density, per unit area at the vertex, of the camera
+/// choosing it; `bsdf_rev_pdf_w` that of the light vertex's BSDF sampling
+/// its incoming direction from the eye's (continuation included).
+pub fn light_tracing(light: &SubpathMis, camera_pdf_a: f32, bsdf_rev_pdf_w: f32, f: &Factors) -> f32 {
+    let w_light = mis(camera_pdf_a / f.light_paths) * (f.vm_weight + light.d_vcm + light.d_vc * mis(bsdf_rev_pdf_w));
+    1.0 / (w_light + 1.0)
+}
+
+/// Densities at the two ends of a connection between a camera vertex and
+/// a light vertex (continuations included).
+#[derive(Clone, Copy, Debug)]
+pub struct Connection {
+    /// The camera vertex's BSDF choosing the light vertex, per unit area there.
+    pub camera_dir_pdf_a: f32,
+    /// The camera vertex's BSDF choosing its own incoming direction from the connection's.
+    pub camera_rev_pdf_w: f32,
+    /// The light vertex's BSDF choosing the camera vertex, per unit area there.
+    pub light_dir_pdf_a: f32,
+    /// The light vertex's BSDF choosing its incoming direction from the connection's.
+    pub light_rev_pdf_w: f32,
+}
+
+pub fn connection(camera: &SubpathMis, light: &SubpathMis, d: &Connection, f: &Factors) -> f32 {
+    let w_light = mis(d.camera_dir_pdf_a) * (f.vm_weight + light.d_vcm + light.d_vc * mis(d.light_rev_pdf_w));
+    let w_camera = mis(d.light_dir_pdf_a) * (f.vm_weight + camera.d_vcm + camera.d_vc * mis(d.camera_rev_pdf_w));
+    1.0 / (w_light + 1.0 + w_camera)
+}
+
+/// Weight of merging a camera vertex with a light vertex at (nearly) the
+/// same point: `camera_dir_pdf_w` the camera vertex's BSDF choosing the
+/// light vertex's incoming direction (its continuation), `camera_rev_pdf_w`
+/// it choosing its own incoming direction from there (the light vertex's
+/// continuation, which would govern it).
+pub fn merge(
+    camera: &SubpathMis,
+    light: &SubpathMis,
+    camera_dir_pdf_w: f32,
+    camera_rev_pdf_w: f32,
+    f: &Factors,
+) -> f32 {
+    let w_light = light.d_vcm * f.vc_weight + light.d_vm * mis(camera_dir_pdf_w);
+    let w_camera = camera.d_vcm * f.vc_weight + camera.d_vm * mis(camera_rev_pdf_w);
+    1.0 / (w_light + 1.0 + w_camera)
+}

@@ -1,0 +1,205 @@
+//! A surface vertex as vertex connection and merging sees it: its material
+//! at the point, the direction its subpath arrived from, and what the
+//! strategies ask of it: f and both sampling densities toward any
+//! direction (connections, merges), a sampled continuation, and the
+//! Russian-roulette probability of going on, which every density includes.
+//!
+//! Shading uses the interpolated normal, as the photon mappers do (normal
+//! textures are the path tracer's alone); f is symmetric, so light and
+//! camera subpaths evaluate it alike.
+
+use crate::bsdf::{Bsdf, ShadingFrame};
+use crate::geometry::Hit;
+use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
+use crate::sampling::{Rng, cosine_hemisphere};
+use glam::Vec3;
+use std::f32::consts::PI;
+
+#[derive(Clone, Copy, Debug)]
+enum Lobes {
+    /// The glTF BRDF (its smooth mirror a delta lobe).
+    Pbr(Bsdf),
+    /// Lambertian `albedo` chosen with probability `p_diffuse`, else a
+    /// perfect mirror of reflectance `mirror` (hikari's `diffuse` and `mirror`).
+    Lambert { albedo: Rgb, mirror: Rgb, p_diffuse: f32 },
+    /// Smooth glass: Fresnel reflection or refraction, both deltas.
+    Glass { ior: f32 },
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Scatter {
+    lobes: Lobes,
+    frame: ShadingFrame,
+    /// The shading and geometric normals, turned toward `wo`.
+    normal: Vec3,
+    geometric: Vec3,
+    /// The geometric normal as the primitive defines it (glass's outside).
+    outward: Vec3,
+    /// Unit, toward where the subpath came from.
+    wo: Vec3,
+    wo_local: Vec3,
+    continuation: f32,
+}
+
+/// f toward a direction and the two sampling densities (per steradian,
+/// without the continuation).
+#[derive(Clone, Copy, Debug)]
+pub struct Evaluation {
+    pub f: Rgb,
+    /// |n · wi|.
+    pub cos: f32,
+    /// Of sampling wi given wo.
+    pub pdf_dir: f32,
+    /// Of sampling wo given wi.
+    pub pdf_rev: f32,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct Sampled {
+    pub wi: Vec3,
+    /// f·|cos|/pdf.
+    pub weight: Rgb,
+    /// Densities as in [`Evaluation`]; for a delta lobe its choice's probability.
+    pub pdf_dir: f32,
+    pub pdf_rev: f32,
+    pub cos: f32,
+    pub delta: bool,
+}
+
+impl Scatter {
+    /// The vertex at `hit`, reached along `dir`; None where nothing
+    /// scatters (the black bodies of area lights, black materials).
+    pub fn at(material: Material, hit: &Hit, dir: Vec3) -> Option<Scatter> {
+        let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+        let (lobes, continuation) = match material {
+            Material::Emitter => return None,
+            Material::Pbr(bsdf) => (Lobes::Pbr(bsdf), bsdf.albedo_estimate().max_element()),
+            Material::Glass { ior } => (Lobes::Glass { ior }, 1.0),
+            Material::Diffuse { .. } | Material::Mirror { .. } => {
+                let (albedo, mirror) = (material.diffuse_albedo(), material.mirror_reflectance());
+                let (p_d, p_s) = (mean(albedo), mean(mirror));
+                if p_d + p_s <= 0.0 {
+                    return None;
+                }
+                (Lobes::Lambert { albedo, mirror, p_diffuse: p_d / (p_d + p_s) }, (albedo + mirror).max_element())
+            }
+        };
+        if continuation <= 0.0 {
+            return None;
+        }
+        let normal = hit.shading_normal * facing;
+        let frame = ShadingFrame::new(normal);
+        let wo = -dir;
+        Some(Scatter {
+            lobes,
+            frame,
+            normal,
+            geometric: hit.geometric_normal * facing,
+            outward: hit.geometric_normal,
+            wo,
+            wo_local: frame.to_local(wo),
+            continuation: continuation.min(1.0),
+        })
+    }
+
+    /// Every lobe is a delta: no connection or merge can use this vertex.
+    pub fn is_delta(&self) -> bool {
+        match self.lobes {
+            Lobes::Pbr(bsdf) => bsdf.is_delta() && !bsdf.has_diffuse(),
+            Lobes::Lambert { p_diffuse, .. } => p_diffuse == 0.0,
+            Lobes::Glass { .. } => true,
+        }
+    }
+
+    /// |n · wo|: the cosine the subpath arrived with.
+    pub fn cos_in(&self) -> f32 {
+        self.wo_local.z.abs()
+    }
+
+    /// The probability that a subpath goes on from here.
+    pub fn continuation(&self) -> f32 {
+        self.continuation
+    }
+
+    /// Toward where the subpath came from.
+    pub fn wo(&self) -> Vec3 {
+        self.wo
+    }
+
+    /// f and densities toward world direction `wi` (non-delta lobes);
+    /// None where they carry nothing.
+    pub fn evaluate(&self, wi: Vec3) -> Option<Evaluation> {
+        // Reflection only, on the side the subpath arrived from.
+        if wi.dot(self.geometric) <= 0.0 {
+            return None;
+        }
+        let wi_local = self.frame.to_local(wi);
+        if wi_local.z <= 0.0 || self.wo_local.z <= 0.0 {
+            return None;
+        }
+        let (f, pdf_dir, pdf_rev) = match self.lobes {
+            Lobes::Pbr(bsdf) => {
+                (bsdf.f(self.wo_local, wi_local), bsdf.pdf(self.wo_local, wi_local), bsdf.pdf(wi_local, self.wo_local))
+            }
+            Lobes::Lambert { albedo, p_diffuse, .. } => {
+                (albedo / PI, p_diffuse * wi_local.z / PI, p_diffuse * self.wo_local.z / PI)
+            }
+            Lobes::Glass { .. } => return None,
+        };
+        (f.max_element() > 0.0 && pdf_dir > 0.0).then_some(Evaluation { f, cos: wi_local.z, pdf_dir, pdf_rev })
+    }
+
+    /// A continuation direction (before Russian roulette).
+    pub fn sample(&self, rng: &mut Rng) -> Option<Sampled> {
+        let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
+        let sampled = match self.lobes {
+            Lobes::Pbr(bsdf) => {
+                let s = bsdf.sample(self.wo_local, u_lobe, u)?;
+                let pdf_rev = if s.is_delta { s.pdf } else { bsdf.pdf(s.wi, self.wo_local) };
+                Sampled {
+                    wi: self.frame.to_world(s.wi),
+                    weight: s.weight,
+                    pdf_dir: s.pdf,
+                    pdf_rev,
+                    cos: s.wi.z,
+                    delta: s.is_delta,
+                }
+            }
+            Lobes::Lambert { albedo, mirror, p_diffuse } => {
+                if u_lobe < p_diffuse {
+                    let local = cosine_hemisphere(u);
+                    Sampled {
+                        wi: self.frame.to_world(local),
+                        weight: albedo / p_diffuse,
+                        pdf_dir: p_diffuse * local.z / PI,
+                        pdf_rev: p_diffuse * self.wo_local.z / PI,
+                        cos: local.z,
+                        delta: false,
+                    }
+                } else {
+                    let p = 1.0 - p_diffuse;
+                    let wi = reflect(-self.wo, self.normal);
+                    Sampled { wi, weight: mirror / p, pdf_dir: p, pdf_rev: p, cos: wi.dot(self.normal), delta: true }
+                }
+            }
+            Lobes::Glass { ior } => {
+                let split = dielectric_split(-self.wo, self.outward, ior);
+                let (wi, p) = match split.refracted {
+                    Some(t) if u_lobe >= split.reflectance => (t, 1.0 - split.reflectance),
+                    _ => (split.reflected, split.reflectance.max(f32::MIN_POSITIVE)),
+                };
+                Sampled { wi, weight: Rgb::ONE, pdf_dir: p, pdf_rev: p, cos: wi.dot(self.normal).abs(), delta: true }
+            }
+        };
+        if sampled.pdf_dir.is_nan() || sampled.pdf_dir <= 0.0 || sampled.weight.max_element() <= 0.0 {
+            return None;
+        }
+        // A reflection must leave on the side it arrived from (a shading
+        // normal can point a sample through the surface); glass may cross it.
+        let crosses = sampled.wi.dot(self.geometric) <= 0.0;
+        if crosses && !matches!(self.lobes, Lobes::Glass { .. }) {
+            return None;
+        }
+        Some(sampled)
+    }
+}

@@ -1,0 +1,109 @@
+//! Vertex connection and merging (`render::vcm`) against the path tracer:
+//! without merging it is unbiased and converges to `path`; light tracing
+//! alone does too; with merging its bias vanishes as the radius shrinks.
+//! Errors are relative to the reference's mean (the project's metric,
+//! `progressive::compare`'s `relative_to_mean`), the references' own
+//! noise taken out.
+
+use hikari_core::progress::Silent;
+use hikari_core::progressive::{ImageMean, compare_where, without_lights};
+use hikari_core::render::vcm::{Strategies, VcmSettings, render_pass};
+use hikari_core::render::{Image, path};
+use hikari_core::scene::Scene;
+
+fn small(name: &str, size: u32) -> Scene {
+    let mut scene = Scene::load(name).unwrap();
+    scene.camera = scene.camera.with_resolution(size, size).unwrap();
+    scene
+}
+
+/// The mean of `passes` VCM passes.
+fn vcm(scene: &Scene, settings: &VcmSettings, passes: u32) -> Image {
+    let mut mean = ImageMean::new(scene.camera.width, scene.camera.height);
+    for pass in 1..=passes {
+        let (image, nonfinite) = render_pass(scene, settings, pass).unwrap();
+        assert_eq!(nonfinite, 0);
+        mean.add(&image);
+    }
+    mean.mean()
+}
+
+fn path_tracing(scene: &Scene, spp: u32, seed: u64) -> Image {
+    path::render(scene, &path::PathSettings { spp, seed, ..Default::default() }, &Silent).0
+}
+
+/// (reference, the variance of its own noise relative to its mean²).
+fn reference(scene: &Scene, spp: u32) -> (Image, f64) {
+    let (a, b) = (path_tracing(scene, spp, 99), path_tracing(scene, spp, 98));
+    let noise = compare_where(&a, &b, &without_lights(&a, &b)).unwrap().relative_to_mean;
+    let mut mean = ImageMean::new(a.width, a.height);
+    mean.add(&a);
+    mean.add(&b);
+    // The mean of two references carries a quarter of their difference's variance.
+    (mean.mean(), noise * noise / 4.0)
+}
+
+/// The error of `image` against the reference, its noise removed, and the
+/// mean ratio, the lights' own pixels left out (their edges' sub-pixel
+/// noise would drown the rest).
+fn error(image: &Image, (reference, variance): &(Image, f64)) -> (f64, f64) {
+    let e = compare_where(image, reference, &without_lights(image, reference)).unwrap();
+    ((e.relative_to_mean.powi(2) - variance).max(0.0).sqrt(), e.mean_ratio)
+}
+
+/// VCM with `strategies` after 4 and 32 passes against a long path-traced
+/// reference: the mean within 2% and the error falling; after 32 passes at
+/// most `factor` times the path tracer's at 32 samples per pixel (the same
+/// number of camera paths).
+fn converges(name: &str, scene: &Scene, settings: VcmSettings, factor: f64) {
+    converges_with(name, scene, settings, factor, 2048);
+}
+
+fn converges_with(name: &str, scene: &Scene, settings: VcmSettings, factor: f64, reference_spp: u32) {
+    let reference = reference(scene, reference_spp);
+    let strategies = settings.strategies;
+    let errors: Vec<(f64, f64)> = [4u32, 32].iter().map(|&n| error(&vcm(scene, &settings, n), &reference)).collect();
+    let (path_error, path_ratio) = error(&path_tracing(scene, 32, 5), &reference);
+    eprintln!(
+        "{name} {strategies:?}: (error, mean ratio) after 4 and 32 passes: {errors:?}; path at 32 spp: {path_error:.4}, {path_ratio:.4}; reference noise {:.4}",
+        reference.1.sqrt()
+    );
+    let ((first, _), (last, ratio)) = (errors[0], errors[1]);
+    assert!((ratio - 1.0).abs() < 0.02, "{name} {strategies:?}: mean ratio {ratio}");
+    assert!(last < 0.6 * first, "{name} {strategies:?}: {errors:?}");
+    assert!(last < factor * path_error, "{name} {strategies:?}: error {last} after 32 passes, path's {path_error}");
+}
+
+fn with(strategies: Strategies) -> VcmSettings {
+    VcmSettings { strategies, seed: 7, ..Default::default() }
+}
+
+#[test]
+fn bidirectional_converges_to_path_on_the_cornell_box() {
+    converges("cornell-box", &small("cornell-box", 48), with(Strategies::Connections), 1.2);
+}
+
+#[test]
+fn light_tracing_converges_to_path_on_the_cornell_box() {
+    converges("cornell-box", &small("cornell-box", 48), with(Strategies::LightTracing), 2.0);
+}
+
+#[test]
+fn vcm_converges_to_path_on_the_cornell_box() {
+    converges("cornell-box", &small("cornell-box", 48), with(Strategies::All), 1.2);
+}
+
+/// Through glass, merging carries the caustic: VCM beats the path tracer.
+#[test]
+fn vcm_converges_to_path_through_glass() {
+    converges_with("cornell-caustic", &small("cornell-caustic", 32), with(Strategies::All), 1.0, 16384);
+}
+
+/// Merging alone (progressive photon mapping at every eye vertex), at the
+/// photon maps' first radius, 3% of the diagonal.
+#[test]
+fn merging_alone_converges_to_path_on_the_cornell_box() {
+    let scene = small("cornell-box", 48);
+    let radius = Some(0.03 * scene.diagonal());
+    converges("cornell-box", &scene, VcmSettings { radius, ..with(Strategies::Merging) }, 3.0);
+}
