@@ -194,3 +194,6 @@ pub fn merge(
     let w_camera = camera.d_vcm * f.vc_weight + camera.d_vm * mis(camera_rev_pdf_w);
     1.0 / (w_light + 1.0 + w_camera)
 }
+
+#[cfg(test)]
+mod tests;
