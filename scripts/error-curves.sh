@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Error against time (docs/progressive.md): the relative RMSE of progressive
-# photon-cpu, the GPU renderer and the path tracer against a long
+# Error against time (docs/progressive.md): the error (relRMSE, relative to
+# the reference's mean, as shared/relerr.py) of progressive photon-cpu, the
+# GPU renderer, vertex connection and merging and the path tracer against a long
 # path-traced reference, printed at every checkpoint, for each scene. The
 # references are made once (kept in $OUT, out of the repository).
 #
@@ -24,11 +25,12 @@ for scene in ${SCENES:-cornell-box cornell-caustic fog-stage}; do
         "$H" render "$scene" --resolution "$SIZE" --renderer path --spp "$REF_SPP" --seed 12345 -q -o "$ref"
         echo "$scene: reference, $REF_SPP spp path tracing, $(( $(date +%s) - start )) s"
     fi
-    for renderer in photon-cpu gpu path; do
+    for renderer in ${RENDERERS:-photon-cpu gpu vcm path}; do
         extra=()
         [ "$renderer" = path ] && extra=(--spp 16)
         "$H" render "$scene" --resolution "$SIZE" --renderer "$renderer" --photons "$PHOTONS" \
             --time "$TIME" --checkpoint "$CHECK" --reference "$ref" -q -o "$OUT/$scene-$renderer.exr" "${extra[@]}" \
-            2> "$OUT/$scene-$renderer.log" | sed "s/^/$scene $renderer: /"
+            2> "$OUT/$scene-$renderer.log" | sed "s/^/$scene $renderer: /" \
+            || echo "$scene $renderer: did not render ($(tail -1 "$OUT/$scene-$renderer.log"))"
     done
 done

@@ -56,10 +56,10 @@ fn error(image: &Image, (reference, variance): &(Image, f64)) -> (f64, f64) {
 /// most `factor` times the path tracer's at 32 samples per pixel (the same
 /// number of camera paths).
 fn converges(name: &str, scene: &Scene, settings: VcmSettings, factor: f64) {
-    converges_with(name, scene, settings, factor, 2048);
+    converges_with(name, scene, settings, factor, 2048, 0.02);
 }
 
-fn converges_with(name: &str, scene: &Scene, settings: VcmSettings, factor: f64, reference_spp: u32) {
+fn converges_with(name: &str, scene: &Scene, settings: VcmSettings, factor: f64, reference_spp: u32, bias: f64) {
     let reference = reference(scene, reference_spp);
     let strategies = settings.strategies;
     let errors: Vec<(f64, f64)> = [4u32, 32].iter().map(|&n| error(&vcm(scene, &settings, n), &reference)).collect();
@@ -69,7 +69,7 @@ fn converges_with(name: &str, scene: &Scene, settings: VcmSettings, factor: f64,
         reference.1.sqrt()
     );
     let ((first, _), (last, ratio)) = (errors[0], errors[1]);
-    assert!((ratio - 1.0).abs() < 0.02, "{name} {strategies:?}: mean ratio {ratio}");
+    assert!((ratio - 1.0).abs() < bias, "{name} {strategies:?}: mean ratio {ratio}");
     assert!(last < 0.6 * first, "{name} {strategies:?}: {errors:?}");
     assert!(last < factor * path_error, "{name} {strategies:?}: error {last} after 32 passes, path's {path_error}");
 }
@@ -96,14 +96,15 @@ fn vcm_converges_to_path_on_the_cornell_box() {
 /// Through glass, merging carries the caustic: VCM beats the path tracer.
 #[test]
 fn vcm_converges_to_path_through_glass() {
-    converges_with("cornell-caustic", &small("cornell-caustic", 32), with(Strategies::All), 1.0, 16384);
+    converges_with("cornell-caustic", &small("cornell-caustic", 32), with(Strategies::All), 1.0, 16384, 0.02);
 }
 
 /// Merging alone (progressive photon mapping at every eye vertex), at the
-/// photon maps' first radius, 3% of the diagonal.
+/// photon maps' first radius, 3% of the diagonal: its bias (light spread
+/// across corners) is still 2% of the mean after 32 passes.
 #[test]
 fn merging_alone_converges_to_path_on_the_cornell_box() {
     let scene = small("cornell-box", 48);
-    let radius = Some(0.03 * scene.diagonal());
-    converges("cornell-box", &scene, VcmSettings { radius, ..with(Strategies::Merging) }, 3.0);
+    let settings = VcmSettings { radius: Some(0.03 * scene.diagonal()), ..with(Strategies::Merging) };
+    converges_with("cornell-box", &scene, settings, 3.0, 2048, 0.035);
 }

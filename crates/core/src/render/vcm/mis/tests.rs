@@ -3,8 +3,8 @@
 //! with Russian roulette, a pinhole camera), every strategy that makes the
 //! path (the camera hitting the light, next-event estimation, every
 //! connection, light tracing, a merge at every inner vertex) gets the weight
-//! p / Σ p computed from the vertices' densities directly, and the weights
-//! sum to one. The renderer (vcm/mod.rs) builds its subpath sums with the
+//! p^β / Σ p^β computed from the vertices' densities directly, and the
+//! weights sum to one. The renderer (vcm/mod.rs) builds its subpath sums with the
 //! same calls as `subpaths` below.
 
 use super::*;
@@ -166,9 +166,11 @@ fn weights(p: &Path, f: &Factors, connect: bool, merge: bool) -> Vec<(String, f6
             explicit.push((format!("merge at {i}"), w, eta * fwd[i] as f64 * vc(i)));
         }
     }
-    let total: f64 = explicit.iter().map(|(_, _, p)| p).sum();
+    // Veach's heuristic of power β over the counts × densities.
+    let power = |p: f64| p.powi(super::HEURISTIC_POWER);
+    let total: f64 = explicit.iter().map(|(_, _, p)| power(*p)).sum();
     for (name, w, density) in explicit {
-        out.push((name, w, density / total));
+        out.push((name, w, power(density) / total));
     }
     out
 }
@@ -193,7 +195,7 @@ fn check(connect: bool, merge: bool) {
 }
 
 #[test]
-fn weights_are_the_balance_heuristic_and_sum_to_one() {
+fn weights_are_veachs_heuristic_and_sum_to_one() {
     check(true, true);
 }
 
