@@ -1,6 +1,6 @@
 //! The same seed gives the same image whatever the thread count: photon
-//! tracing, the photon-map indexes (kd-trees, the volume map's BVH) and both
-//! CPU renderers, bit for bit.
+//! tracing, the photon-map indexes (kd-trees, the volume map's BVH), both
+//! CPU renderers and VCM, bit for bit.
 
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
@@ -48,4 +48,17 @@ fn path_traced_images_do_not_depend_on_thread_count() {
     let (one, two) = (with_threads(1, render), with_threads(2, render));
     assert!(one.mean() > 0.0);
     assert!(bits(&one) == bits(&two), "images differ between 1 and 2 threads");
+}
+
+/// VCM's light subpaths are traced in chunks joined in order and its
+/// splats added in that order: the same bits on 1 and 3 threads.
+#[test]
+fn vcm_images_do_not_depend_on_thread_count() {
+    use hikari_core::render::vcm::{VcmSettings, render_pass};
+    let scene = small("cornell-caustic", 24);
+    let settings = VcmSettings { seed: 3, ..Default::default() };
+    let render = || render_pass(&scene, &settings, 2).unwrap().0;
+    let (one, three) = (with_threads(1, render), with_threads(3, render));
+    assert!(one.mean() > 0.0);
+    assert!(bits(&one) == bits(&three), "images differ between 1 and 3 threads");
 }
