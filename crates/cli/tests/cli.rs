@@ -504,3 +504,42 @@ fn vertex_connection_and_merging_renders_and_refuses_fog() {
         &["fog-stage", "participating media"],
     );
 }
+
+/// `--target-error` renders passes until the noise the passes estimate
+/// falls to it, showing the estimate; a fraction outside (0, 1) is refused.
+#[test]
+fn renders_until_the_target_error() {
+    let dir = scratch_dir("target");
+    let out = hikari(
+        &[
+            "render",
+            "cornell-box",
+            "--renderer",
+            "path",
+            "--spp",
+            "1",
+            "--resolution",
+            "16x16",
+            "--target-error",
+            "0.2",
+            "-o",
+            "t.exr",
+        ],
+        &dir,
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && err.contains("stopped by the target error"), "{err}");
+    let noise: f64 = err
+        .split("estimated noise ")
+        .nth(1)
+        .and_then(|t| t.split('%').next())
+        .and_then(|v| v.parse().ok())
+        .expect("the estimate");
+    assert!(noise <= 20.0, "{err}");
+    let bad = scratch_dir("target-bad");
+    assert_fails_with(
+        &hikari(&["render", "cornell-box", "--target-error", "1.5", "-o", "t.png"], &bad),
+        &bad,
+        &["--target-error"],
+    );
+}

@@ -69,3 +69,38 @@ fn fog_converges_toward_the_path_tracer() {
     eprintln!("fog-stage relative RMSE after 1, 4, 16 passes: {errors:?}");
     assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
 }
+
+/// The noise estimate of item 4 (#19) against the measured error of real
+/// renders against a long reference (relative to its mean, the lights'
+/// pixels left out, the reference's own noise removed): the path tracer
+/// and VCM, which are unbiased or nearly, within a factor of 1.5.
+#[test]
+fn the_noise_estimate_agrees_with_the_measured_error() {
+    use hikari_core::progressive::{compare_where, without_lights};
+    use hikari_core::render::vcm;
+    let scene = scene_at("cornell-box", 32);
+    let (a, b) = (path_reference(&scene, 1024), {
+        let settings = path::PathSettings { spp: 1024, seed: 77, ..Default::default() };
+        path::render(&scene, &settings, &Silent).0
+    });
+    let mut reference = ImageMean::new(32, 32);
+    reference.add(&a);
+    reference.add(&b);
+    let reference = reference.mean();
+    let reference_noise = compare_where(&a, &b, &without_lights(&a, &b)).unwrap().relative_to_mean / 2.0;
+    let mut path_mean = ImageMean::new(32, 32);
+    let mut vcm_mean = ImageMean::new(32, 32);
+    for pass in 1..=16u32 {
+        let settings = path::PathSettings { spp: 4, seed: 1000 + pass as u64, ..Default::default() };
+        path_mean.add(&path::render(&scene, &settings, &Silent).0);
+        vcm_mean.add(&vcm::render_pass(&scene, &vcm::VcmSettings::default(), pass).unwrap().0);
+    }
+    for (name, mean) in [("path", &path_mean), ("vcm", &vcm_mean)] {
+        let image = mean.mean();
+        let e = compare_where(&image, &reference, &without_lights(&image, &reference)).unwrap();
+        let measured = (e.relative_to_mean.powi(2) - reference_noise.powi(2)).max(0.0).sqrt();
+        let estimate = mean.noise_estimate().unwrap();
+        eprintln!("{name}: estimated {estimate:.4}, measured {measured:.4}");
+        assert!(estimate / measured < 1.5 && measured / estimate < 1.5, "{name}: {estimate} against {measured}");
+    }
+}

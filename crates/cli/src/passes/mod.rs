@@ -24,6 +24,12 @@ pub trait PassRenderer {
     fn mean(&mut self) -> Result<Image>;
     /// The global map's radius in pass `pass`, for the progress bar (None: no radius).
     fn radius(&self, pass: u32) -> Option<f32>;
+    /// The mean's relative error as its passes estimate it
+    /// (`ImageMean::noise_estimate`); None where the passes are not kept
+    /// apart (the GPU's mean lives on the GPU) or before the second pass.
+    fn noise(&self) -> Option<f64> {
+        None
+    }
 }
 
 /// When to stop and what to report.
@@ -36,6 +42,9 @@ pub struct PassPlan {
     pub checkpoint: Option<Duration>,
     /// A reference image to compare with, and its path.
     pub reference: Option<(PathBuf, Image)>,
+    /// Stop once the estimated noise (relative to the mean) is this low,
+    /// from the fourth pass on.
+    pub target_error: Option<f64>,
     pub output: PathBuf,
     pub exposure: f32,
     pub quiet: bool,
@@ -82,7 +91,7 @@ pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u
         ProgressBar::new(plan.passes as u64)
     };
     bar.set_style(
-        ProgressStyle::with_template("{msg:>28} [{bar:30}] {pos}/{len} passes {elapsed_precise} eta {eta}")
+        ProgressStyle::with_template("{msg:>40} [{bar:30}] {pos}/{len} passes {elapsed_precise} eta {eta}")
             .expect("valid template")
             .progress_chars("=> "),
     );
@@ -93,11 +102,18 @@ pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u
         pass += 1;
         renderer.render_pass(pass)?;
         bar.inc(1);
-        let next = renderer.radius(pass + 1).map_or(String::new(), |r| format!("next radius {r:.5}"));
-        bar.set_message(next);
+        let noise = renderer.noise();
+        let mut message = noise.map_or(String::new(), |e| format!("noise ≈ {:.2}%", 100.0 * e));
+        if let Some(r) = renderer.radius(pass + 1) {
+            message = format!("{message}{}next radius {r:.5}", if message.is_empty() { "" } else { ", " });
+        }
+        bar.set_message(message);
         let elapsed = start.elapsed();
         if pass >= plan.passes {
             break "the pass count";
+        }
+        if pass >= 4 && plan.target_error.zip(noise).is_some_and(|(target, e)| e <= target) {
+            break "the target error";
         }
         if plan.time.is_some_and(|t| elapsed >= t) {
             break "the time limit";
@@ -115,7 +131,8 @@ pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u
     bar.finish_and_clear();
     let image = renderer.mean()?;
     let seconds = start.elapsed().as_secs_f64();
-    eprintln!("{pass} passes in {seconds:.2} s (stopped by {why})");
+    let noise = renderer.noise().map_or(String::new(), |e| format!("; estimated noise {:.2}%", 100.0 * e));
+    eprintln!("{pass} passes in {seconds:.2} s (stopped by {why}){noise}");
     report(plan, &image, pass, seconds)?;
     Ok((image, pass))
 }
@@ -154,6 +171,7 @@ mod tests {
             time,
             checkpoint: None,
             reference: None,
+            target_error: None,
             output: std::env::temp_dir().join("hikari-passes-test.exr"),
             exposure: 0.0,
             quiet: true,
@@ -166,5 +184,32 @@ mod tests {
         assert_eq!((passes, image.pixels[0].x), (5, 3.0));
         let (_, passes) = run(&mut Counting(0), &plan(u32::MAX, Some(Duration::ZERO))).unwrap();
         assert_eq!(passes, 1, "a time limit still renders one pass");
+    }
+
+    /// Passes whose noise estimate is 1/n: a target of 0.1 stops at pass
+    /// 10; a target met at once still renders 4 passes.
+    struct Quieting(Counting);
+
+    impl PassRenderer for Quieting {
+        fn render_pass(&mut self, pass: u32) -> Result<()> {
+            self.0.render_pass(pass)
+        }
+        fn mean(&mut self) -> Result<Image> {
+            self.0.mean()
+        }
+        fn radius(&self, _: u32) -> Option<f32> {
+            None
+        }
+        fn noise(&self) -> Option<f64> {
+            Some(1.0 / self.0.0 as f64)
+        }
+    }
+
+    #[test]
+    fn stops_at_the_target_error() {
+        let target = |t| PassPlan { target_error: Some(t), ..plan(u32::MAX, None) };
+        assert_eq!(run(&mut Quieting(Counting(0)), &target(0.1)).unwrap().1, 10);
+        assert_eq!(run(&mut Quieting(Counting(0)), &target(0.9)).unwrap().1, 4);
+        assert_eq!(run(&mut Counting(0), &PassPlan { target_error: Some(0.5), ..plan(7, None) }).unwrap().1, 7);
     }
 }

@@ -41,6 +41,10 @@ impl PassRenderer for CpuPasses<'_> {
         Ok(self.mean.mean())
     }
 
+    fn noise(&self) -> Option<f64> {
+        self.mean.noise_estimate()
+    }
+
     fn radius(&self, pass: u32) -> Option<f32> {
         Some(self.schedules.global.radius(pass))
     }
@@ -67,6 +71,10 @@ impl PassRenderer for PathPasses<'_> {
         Ok(self.mean.mean())
     }
 
+    fn noise(&self) -> Option<f64> {
+        self.mean.noise_estimate()
+    }
+
     fn radius(&self, _: u32) -> Option<f32> {
         None
     }
@@ -91,6 +99,10 @@ impl PassRenderer for VcmPasses<'_> {
 
     fn mean(&mut self) -> Result<Image> {
         Ok(self.mean.mean())
+    }
+
+    fn noise(&self) -> Option<f64> {
+        self.mean.noise_estimate()
     }
 
     fn radius(&self, pass: u32) -> Option<f32> {

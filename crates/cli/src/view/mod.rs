@@ -462,10 +462,12 @@ impl Viewer {
         Ok(())
     }
 
-    /// Moves the eye for the fly keys held since the last frame.
+    /// Moves the eye for the fly keys held since the last call (each frame
+    /// and each fly key's press and release). At most a second counts, so
+    /// that a stall (a scene reload) does not throw the eye across the scene.
     fn fly(&mut self) {
         let now = Instant::now();
-        let dt = self.last_fly.map_or(0.0, |t| (now - t).as_secs_f32().min(0.25));
+        let dt = self.last_fly.map_or(0.0, |t| (now - t).as_secs_f32().min(1.0));
         self.last_fly = Some(now);
         let [w, s, d, a, e, q] = self.flying.map(|held| held as i32 as f32);
         if w + s + d + a + e + q == 0.0 {
@@ -910,6 +912,10 @@ impl ApplicationHandler for Viewer {
                 let pressed = event.state == ElementState::Pressed;
                 if let Key::Character(c) = &event.logical_key {
                     if let Some(i) = "wsdaeq".find(c.to_ascii_lowercase().as_str()).filter(|_| c.len() == 1) {
+                        // Fly up to this moment with the keys held until
+                        // now: a key held between two slow frames still
+                        // moves the eye for as long as it was held.
+                        self.fly();
                         self.flying[i] = pressed;
                     }
                 }

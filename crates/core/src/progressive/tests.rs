@@ -124,3 +124,36 @@ fn pass_jitters_cover_the_pixel_evenly() {
         }
     }
 }
+
+/// Passes of known noise around a known image: the half-image estimate
+/// matches the mean's true relative error within 15%, for even and odd
+/// pass counts; a single pass gives none.
+#[test]
+fn the_noise_estimate_matches_the_true_error() {
+    let (w, h) = (64, 64);
+    let truth: Vec<f32> = (0..w * h).map(|i| 0.5 + (i % 7) as f32 * 0.3).collect();
+    let mut rng = Rng::for_item(21, 0);
+    let mut mean = ImageMean::new(w, h);
+    assert_eq!(mean.noise_estimate(), None);
+    for pass in 1..=33u32 {
+        let mut image = crate::render::Image::new(w, h);
+        for (p, &t) in image.pixels.iter_mut().zip(&truth) {
+            // Uniform noise of the value's size: an unbiased pass.
+            *p = glam::Vec3::new(t, 2.0 * t, 0.5 * t) * (0.5 + rng.next_f32());
+        }
+        mean.add(&image);
+        if [2, 8, 9, 33].contains(&pass) {
+            let m = mean.mean();
+            let (mut squares, mut total) = (0.0f64, 0.0f64);
+            for (p, &t) in m.pixels.iter().zip(&truth) {
+                let t = glam::Vec3::new(t, 2.0 * t, 0.5 * t);
+                squares += (*p - t).length_squared() as f64;
+                total += t.element_sum() as f64;
+            }
+            let values = 3.0 * truth.len() as f64;
+            let actual = (squares / values).sqrt() / (total / values);
+            let estimate = mean.noise_estimate().unwrap();
+            assert!((estimate / actual - 1.0).abs() < 0.15, "pass {pass}: estimate {estimate}, actual {actual}");
+        }
+    }
+}
