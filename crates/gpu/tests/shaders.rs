@@ -131,7 +131,9 @@ fn shared_structs_match_wgsl_layouts() {
             falloff_start,
             sample_area,
             two_sided,
-            mapped
+            mapped,
+            first_triangle,
+            triangle_count
         ]
     );
     assert_layout!(direct, "LightSample", GpuLightSample, [position, first_view, direction, view_count, weight, _pad]);
