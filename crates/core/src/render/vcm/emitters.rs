@@ -13,7 +13,7 @@
 
 use crate::geometry::Hit;
 use crate::light::{Light, cone_pdf, spot_falloff, spot_solid_angle};
-use crate::material::{Rgb, mean};
+use crate::material::Rgb;
 use crate::sampling::{Rng, UNIFORM_SPHERE_PDF};
 use crate::scene::Scene;
 use glam::Vec3;
@@ -245,11 +245,6 @@ impl<'a> Emitters<'a> {
             let pdf = sky_pdf(light, dir);
             Some(Found { radiance, direct_pdf: pdf * pick, emission_pdf_w: pdf / disc.area() * pick })
         })
-    }
-
-    /// Whether any light carries power.
-    pub fn any(&self) -> bool {
-        self.probabilities.iter().any(|&p| p > 0.0) && self.scene.lights.iter().any(|l| mean(l.power()) > 0.0)
     }
 }
 
