@@ -539,15 +539,19 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             seed: args.seed,
             strategies: args.vcm_strategies.into(),
             radius: args.radius,
+            volume_radius: args.volume_radius,
             alpha: args.alpha,
             ..Default::default()
         };
-        if let Some(why) = vcm::unsupported(scene) {
-            usage!("{}: {why}", args.scene);
-        }
         let radius = settings.radius.unwrap_or_else(|| vcm::default_radius(scene));
+        let in_media = if scene.media.is_empty() {
+            String::new()
+        } else {
+            let volume = settings.volume_radius.unwrap_or_else(|| vcm::default_volume_radius(scene));
+            format!(" ({volume:.4} in media)")
+        };
         eprintln!(
-            "vcm ({:?}): one light and one camera subpath per pixel a pass, first merging radius {radius:.4}, α = {}",
+            "vcm ({:?}): one light and one camera subpath per pixel a pass, first merging radius {radius:.4}{in_media}, α = {}",
             settings.strategies, args.alpha
         );
         let mut passes = VcmPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };

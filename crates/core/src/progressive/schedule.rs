@@ -27,7 +27,7 @@ pub struct RadiusSchedule {
     /// r_1: the first pass's radius (the single-pass method's).
     pub initial: f32,
     pub alpha: f32,
-    /// d: the kernel's dimension (2 for every map of hikari; see above).
+    /// d: the kernel's dimension (2 for every photon map of hikari; see above).
     pub dimension: u32,
 }
 
@@ -35,6 +35,12 @@ impl RadiusSchedule {
     /// The schedule of a disc kernel (surfaces, and the volume's chord estimate).
     pub fn disc(initial: f32, alpha: f32) -> Self {
         RadiusSchedule { initial, alpha, dimension: 2 }
+    }
+
+    /// The schedule of a ball kernel: a density at a point in a medium
+    /// (vertex merging's volume vertices).
+    pub fn ball(initial: f32, alpha: f32) -> Self {
+        RadiusSchedule { initial, alpha, dimension: 3 }
     }
 
     /// r_i / r_1 for pass `pass` (from 1): the product, in f64 (a million

@@ -16,16 +16,25 @@
 //! progressive photon mapping of every bounce, and `LightTracing` the
 //! light-tracing strategy alone (plus the lights the eye sees directly).
 //!
-//! Not yet handled: participating media (the renderer refuses scenes with
-//! fog, saying so) and normal textures (shading uses interpolated normals,
-//! as the photon mappers do).
+//! In participating media both subpaths sample free flights ([`flight`]):
+//! a flight that ends in a medium makes a volume vertex, scattering by the
+//! phase functions there; connections and next-event estimation carry the
+//! transmittance between their ends; volume vertices merge with the light
+//! subpaths' volume vertices within a ball (surface vertices with surface
+//! vertices within a disc), and the weights count the flights' densities
+//! (σ̄ e^−τ̄ to stop at a point, e^−τ̄ to pass).
+//!
+//! Not yet handled: normal textures (shading uses interpolated normals, as
+//! the photon mappers do).
 
 pub mod emitters;
+mod flight;
 mod grid;
 pub mod mis;
 mod scatter;
 
 use self::emitters::Emitters;
+use self::flight::Event;
 use self::grid::HashGrid;
 use self::mis::{Factors, SubpathMis};
 use self::scatter::Scatter;
@@ -69,8 +78,10 @@ pub struct VcmSettings {
     pub strategies: Strategies,
     /// Longest path, in segments from the eye to the light.
     pub max_path_length: u32,
-    /// The first pass's merging radius (default [`default_radius`]).
+    /// The first pass's merging radius on surfaces (default [`default_radius`]).
     pub radius: Option<f32>,
+    /// The first pass's merging radius in media (default [`default_volume_radius`]).
+    pub volume_radius: Option<f32>,
     /// The radius schedule's α (as the photon maps').
     pub alpha: f32,
 }
@@ -82,6 +93,7 @@ impl Default for VcmSettings {
             strategies: Strategies::All,
             max_path_length: 32,
             radius: None,
+            volume_radius: None,
             alpha: crate::progressive::DEFAULT_ALPHA,
         }
     }
@@ -98,10 +110,18 @@ pub fn default_radius(scene: &Scene) -> f32 {
     0.001 * scene.diagonal()
 }
 
+/// The first pass's merging radius in media: 1% of the scene's diagonal.
+pub fn default_volume_radius(scene: &Scene) -> f32 {
+    0.01 * scene.diagonal()
+}
+
 /// A stored light-subpath vertex.
 struct LightVertex {
     position: Vec3,
     throughput: Rgb,
+    /// What a merge multiplies: the throughput, without σ_s in a medium
+    /// (the camera vertex's throughput carries the σ_s of the merged point).
+    merge_throughput: Rgb,
     /// Segments from the light.
     length: u32,
     scatter: Scatter,
@@ -127,25 +147,18 @@ struct LightChunk {
     splats: Vec<(u32, Rgb)>,
 }
 
-/// Why a scene cannot be rendered with VCM yet.
-pub fn unsupported(scene: &Scene) -> Option<String> {
-    (!scene.media.is_empty()).then(|| {
-        "the vcm renderer does not handle participating media yet (use --renderer path or photon-cpu)".to_string()
-    })
-}
-
 /// Pass `pass` (from 1): one light subpath and one camera subpath per
 /// pixel. Returns the pass's image and the number of non-finite
 /// contributions dropped.
 pub fn render_pass(scene: &Scene, settings: &VcmSettings, pass: u32) -> Result<(Image, u64), String> {
-    if let Some(why) = unsupported(scene) {
-        return Err(why);
-    }
     let camera = &scene.camera;
     let (width, height) = (camera.width, camera.height);
     let pixels = (width * height) as usize;
     let radius =
         RadiusSchedule::disc(settings.radius.unwrap_or_else(|| default_radius(scene)), settings.alpha).radius(pass);
+    let volume_radius =
+        RadiusSchedule::ball(settings.volume_radius.unwrap_or_else(|| default_volume_radius(scene)), settings.alpha)
+            .radius(pass);
     let strategies = settings.strategies;
     // One light subpath per pixel: more a pass (2, 4, 8 per pixel) left
     // more error after 20 s on the Cornell box (13%, 20%, 27% against 8%):
@@ -154,7 +167,7 @@ pub fn render_pass(scene: &Scene, settings: &VcmSettings, pass: u32) -> Result<(
     let p = Pass {
         scene,
         emitters: Emitters::new(scene),
-        factors: Factors::new(radius, light_paths as f32, strategies.connect(), strategies.merge()),
+        factors: Factors::new(radius, volume_radius, light_paths as f32, strategies.connect(), strategies.merge()),
         strategies,
         max_length: settings.max_path_length.max(1),
         image_plane: camera.image_plane_distance(),
@@ -185,9 +198,10 @@ pub fn render_pass(scene: &Scene, settings: &VcmSettings, pass: u32) -> Result<(
         vertices.extend(chunk.vertices);
         splats.extend(chunk.splats);
     }
-    let positions: Vec<Vec3> = vertices.iter().map(|v| v.position).collect();
-    let grid = strategies.merge().then(|| HashGrid::new(&positions, radius));
-    let light = Subpaths { vertices: &vertices, positions: &positions, ends: &ends, grid: grid.as_ref() };
+    let surface = strategies.merge().then(|| MergeGrid::new(&vertices, false, radius));
+    let volume =
+        (strategies.merge() && !scene.media.is_empty()).then(|| MergeGrid::new(&vertices, true, volume_radius));
+    let light = Subpaths { vertices: &vertices, ends: &ends, surface: surface.as_ref(), volume: volume.as_ref() };
 
     // Camera subpaths, pixel by pixel.
     let mut image = Image::new(width, height);
@@ -224,9 +238,35 @@ pub fn render_pass(scene: &Scene, settings: &VcmSettings, pass: u32) -> Result<(
 /// The pass's light subpaths as camera subpaths read them.
 struct Subpaths<'a> {
     vertices: &'a [LightVertex],
-    positions: &'a [Vec3],
     ends: &'a [u32],
-    grid: Option<&'a HashGrid>,
+    /// The surface vertices and the volume vertices, for merging.
+    surface: Option<&'a MergeGrid>,
+    volume: Option<&'a MergeGrid>,
+}
+
+/// The light vertices of one kind (surface or volume) in a hash grid.
+struct MergeGrid {
+    positions: Vec<Vec3>,
+    /// Index in the pass's vertices of each position.
+    indices: Vec<u32>,
+    grid: HashGrid,
+}
+
+impl MergeGrid {
+    fn new(vertices: &[LightVertex], medium: bool, radius: f32) -> Self {
+        let (positions, indices): (Vec<Vec3>, Vec<u32>) = vertices
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.scatter.in_medium() == medium)
+            .map(|(i, v)| (v.position, i as u32))
+            .unzip();
+        let grid = HashGrid::new(&positions, radius);
+        MergeGrid { positions, indices, grid }
+    }
+
+    fn query(&self, p: Vec3, mut visit: impl FnMut(usize)) {
+        self.grid.query(&self.positions, p, |i| visit(self.indices[i] as usize));
+    }
 }
 
 impl Pass<'_> {
@@ -245,28 +285,53 @@ impl Pass<'_> {
         let mut throughput = e.throughput;
         let mut ray = Ray::new(e.origin, e.dir);
         let mut length = 1;
-        while let Some(hit) = self.scene.accel.intersect(&ray) {
+        // σ̄ at the vertex the ray left (1: a light or a surface).
+        let mut departure_density = 1.0;
+        loop {
+            let step = flight::step(self.scene, &ray, rng);
+            let (point, scatter) = match step.event {
+                Event::Escaped => break,
+                Event::Surface(hit) => (hit.point, Scatter::at(self.scene.material_at(&hit), &hit, ray.dir)),
+                Event::Medium { point, mask } => (point, Scatter::medium(&self.scene.media, mask, ray.dir)),
+            };
             if length == 1 && sphere {
-                state.direct_pdf_known(self.emitters.sphere_direct_pdf_a(e.light, hit.point, e.origin, e.normal));
+                state.direct_pdf_known(self.emitters.sphere_direct_pdf_a(e.light, point, e.origin, e.normal));
             }
-            let Some(scatter) = Scatter::at(self.scene.material_at(&hit), &hit, ray.dir) else { break };
-            state.arrive(hit.t * hit.t, scatter.cos_in(), length > 1 || e.finite);
+            let Some(scatter) = scatter else { break };
+            throughput *= step.weight;
+            let arrival = scatter.cos_in() * scatter.flight_density() * step.passes;
+            let distance2 = step.distance * step.distance;
+            state.arrive(distance2, arrival, departure_density * step.passes, length > 1 || e.finite);
             if !scatter.is_delta() {
                 let to_eye = self.strategies.connect() || self.strategies == Strategies::LightTracing;
-                if let Some(splat) =
-                    to_eye.then(|| self.connect_to_eye(hit.point, &scatter, throughput, &state)).flatten()
+                if let Some(splat) = to_eye.then(|| self.connect_to_eye(point, &scatter, throughput, &state)).flatten()
                 {
                     out.splats.push(splat);
                 }
                 if self.strategies != Strategies::LightTracing {
-                    out.vertices.push(LightVertex { position: hit.point, throughput, length, scatter, mis: state });
+                    let merge_throughput = match step.event {
+                        Event::Medium { mask, .. } => {
+                            let sigma_s = self.scene.media.sigma_s(mask);
+                            Rgb::select(sigma_s.cmpgt(Rgb::ZERO), throughput / sigma_s, Rgb::ZERO)
+                        }
+                        _ => throughput,
+                    };
+                    out.vertices.push(LightVertex {
+                        position: point,
+                        throughput,
+                        merge_throughput,
+                        length,
+                        scatter,
+                        mis: state,
+                    });
                 }
             }
             if length + 2 > self.max_length {
                 break;
             }
             let Some((next, _)) = self.continue_subpath(&scatter, &mut state, &mut throughput, rng) else { break };
-            ray = Ray::new(hit.point, next);
+            departure_density = scatter.flight_density();
+            ray = Ray::new(point, next);
             length += 1;
         }
     }
@@ -289,7 +354,8 @@ impl Pass<'_> {
         if s.delta {
             state.scatter_delta(s.cos);
         } else {
-            state.scatter(s.cos, s.pdf_dir * continuation, s.pdf_rev * continuation, &self.factors);
+            let eta = self.factors.eta(scatter.in_medium());
+            state.scatter(s.cos, s.pdf_dir * continuation, s.pdf_rev * continuation, eta, &self.factors);
         }
         *throughput *= s.weight / continuation;
         Some((s.wi, s.delta))
@@ -306,16 +372,21 @@ impl Pass<'_> {
         let dir = to_eye / distance;
         let eval = scatter.evaluate(dir)?;
         let cos_at_camera = camera.forward().dot(-dir);
-        // Per unit area at x, the density of the camera's ray choosing x
-        // (one unit of image-plane area per pixel sample).
+        let (transmittance, passes) = flight::between(&self.scene.media, x, dir, distance);
+        // The camera's importance times the geometry term (one unit of
+        // image-plane area per pixel sample), and the density, per unit
+        // area (volume) at x, of the camera's ray choosing x: the same
+        // with the free flight's density for the cosine's transmittance.
         let to_plane = self.image_plane / cos_at_camera;
-        let camera_pdf_a = to_plane * to_plane / cos_at_camera * eval.cos / distance2;
+        let importance = to_plane * to_plane / cos_at_camera * eval.cos / distance2;
+        let camera_pdf_a = importance * scatter.flight_density() * passes;
         let weight = if self.strategies == Strategies::LightTracing {
             1.0
         } else {
-            mis::light_tracing(state, camera_pdf_a, eval.pdf_rev * scatter.continuation(), &self.factors)
+            let eta = self.factors.eta(scatter.in_medium());
+            mis::light_tracing(state, camera_pdf_a, eval.pdf_rev * scatter.continuation(), eta, &self.factors)
         };
-        let value = throughput * eval.f * (weight * camera_pdf_a / self.factors.light_paths);
+        let value = throughput * eval.f * transmittance * (weight * importance / self.factors.light_paths);
         if value.max_element() <= 0.0 || self.occluded(x, dir, distance) {
             return None;
         }
@@ -336,25 +407,42 @@ impl Pass<'_> {
         let mut length = 1;
         let mut specular_path = true;
         let mut from = camera.position;
+        let mut departure_density = 1.0;
         loop {
-            let Some(hit) = self.scene.accel.intersect(&ray) else {
-                for found in self.emitters.escaped(ray.dir) {
-                    let weight =
-                        self.emitter_weight(&state, length, specular_path, found.direct_pdf, found.emission_pdf_w);
-                    color += throughput * found.radiance * weight;
+            let step = flight::step(self.scene, &ray, rng);
+            throughput *= step.weight;
+            let departure = departure_density * step.passes;
+            let (x, scatter) = match step.event {
+                Event::Escaped => {
+                    state.arrive(1.0, step.passes, departure, false);
+                    for found in self.emitters.escaped(ray.dir) {
+                        let weight =
+                            self.emitter_weight(&state, length, specular_path, found.direct_pdf, found.emission_pdf_w);
+                        color += throughput * found.radiance * weight;
+                    }
+                    break;
                 }
-                break;
+                Event::Surface(hit) => {
+                    let cos = ray.dir.dot(hit.shading_normal);
+                    state.arrive(step.distance * step.distance, cos * step.passes, departure, true);
+                    if let Some(found) = self.emitters.at_surface(&hit, from, ray.dir) {
+                        let weight =
+                            self.emitter_weight(&state, length, specular_path, found.direct_pdf, found.emission_pdf_w);
+                        color += throughput * found.radiance * weight;
+                    }
+                    (hit.point, Scatter::at(self.scene.material_at(&hit), &hit, ray.dir))
+                }
+                Event::Medium { point, mask } => {
+                    let scatter = Scatter::medium(&self.scene.media, mask, ray.dir);
+                    let density = scatter.as_ref().map_or(1.0, |s| s.flight_density());
+                    state.arrive(step.distance * step.distance, density * step.passes, departure, true);
+                    (point, scatter)
+                }
             };
-            state.arrive(hit.t * hit.t, ray.dir.dot(hit.shading_normal), true);
-            if let Some(found) = self.emitters.at_surface(&hit, from, ray.dir) {
-                let weight = self.emitter_weight(&state, length, specular_path, found.direct_pdf, found.emission_pdf_w);
-                color += throughput * found.radiance * weight;
-            }
             if self.strategies == Strategies::LightTracing || length >= self.max_length {
                 break;
             }
-            let Some(scatter) = Scatter::at(self.scene.material_at(&hit), &hit, ray.dir) else { break };
-            let x = hit.point;
+            let Some(scatter) = scatter else { break };
             if !scatter.is_delta() {
                 if self.strategies.connect() {
                     color += throughput * self.next_event(x, &scatter, &state, rng);
@@ -366,16 +454,16 @@ impl Pass<'_> {
                         color += throughput * vertex.throughput * self.connect(x, &scatter, &state, vertex);
                     }
                 }
-                if let Some(grid) = light.grid {
+                let medium = scatter.in_medium();
+                if let Some(grid) = if medium { light.volume } else { light.surface } {
                     let mut sum = Rgb::ZERO;
-                    grid.query(light.positions, x, |i| {
-                        sum += self.merge(&scatter, &state, length, &light.vertices[i]);
-                    });
-                    color += throughput * sum * f.vm_normalization;
+                    grid.query(x, |i| sum += self.merge(&scatter, &state, length, &light.vertices[i]));
+                    color += throughput * sum * f.normalization(medium);
                 }
             }
             let Some((next, delta)) = self.continue_subpath(&scatter, &mut state, &mut throughput, rng) else { break };
             specular_path &= delta;
+            departure_density = scatter.flight_density();
             from = x;
             ray = Ray::new(x, next);
             length += 1;
@@ -400,16 +488,18 @@ impl Pass<'_> {
         let Some(light) = self.emitters.illuminate(x, rng) else { return Rgb::ZERO };
         let Some(eval) = scatter.evaluate(light.wi) else { return Rgb::ZERO };
         let continuation = scatter.continuation();
+        let (transmittance, passes) = flight::between(&self.scene.media, x, light.wi, light.distance);
         let densities = mis::NextEvent {
             bsdf_dir_pdf_w: if light.delta { 0.0 } else { eval.pdf_dir * continuation },
             bsdf_rev_pdf_w: eval.pdf_rev * continuation,
             direct_pdf_w: light.direct_pdf_w,
             emission_pdf_w: light.emission_pdf_w,
-            cos_at_vertex: eval.cos,
+            vertex_arrival: eval.cos * scatter.flight_density() * passes,
+            passes,
             cos_at_light: light.cos_at_light,
         };
-        let weight = mis::next_event(state, &densities, &self.factors);
-        let value = light.radiance * eval.f * (weight * eval.cos / light.direct_pdf_w);
+        let weight = mis::next_event(state, &densities, self.factors.eta(scatter.in_medium()));
+        let value = light.radiance * eval.f * transmittance * (weight * eval.cos / light.direct_pdf_w);
         if value.max_element() <= 0.0 || self.occluded(x, light.wi, light.distance) {
             return Rgb::ZERO;
         }
@@ -425,14 +515,20 @@ impl Pass<'_> {
         let Some(camera_eval) = scatter.evaluate(dir) else { return Rgb::ZERO };
         let Some(light_eval) = vertex.scatter.evaluate(-dir) else { return Rgb::ZERO };
         let (camera_continuation, light_continuation) = (scatter.continuation(), vertex.scatter.continuation());
+        let (transmittance, passes) = flight::between(&self.scene.media, x, dir, distance);
+        let at_light = light_eval.cos * vertex.scatter.flight_density() * passes;
+        let at_camera = camera_eval.cos * scatter.flight_density() * passes;
         let densities = mis::Connection {
-            camera_dir_pdf_a: camera_eval.pdf_dir * camera_continuation * light_eval.cos / distance2,
+            camera_dir_pdf_a: camera_eval.pdf_dir * camera_continuation * at_light / distance2,
             camera_rev_pdf_w: camera_eval.pdf_rev * camera_continuation,
-            light_dir_pdf_a: light_eval.pdf_dir * light_continuation * camera_eval.cos / distance2,
+            light_dir_pdf_a: light_eval.pdf_dir * light_continuation * at_camera / distance2,
             light_rev_pdf_w: light_eval.pdf_rev * light_continuation,
+            camera_eta: self.factors.eta(scatter.in_medium()),
+            light_eta: self.factors.eta(vertex.scatter.in_medium()),
         };
-        let weight = mis::connection(state, &vertex.mis, &densities, &self.factors);
-        let value = camera_eval.f * light_eval.f * (weight * camera_eval.cos * light_eval.cos / distance2);
+        let weight = mis::connection(state, &vertex.mis, &densities);
+        let value =
+            camera_eval.f * light_eval.f * transmittance * (weight * camera_eval.cos * light_eval.cos / distance2);
         if value.max_element() <= 0.0 || self.occluded(x, dir, distance) {
             return Rgb::ZERO;
         }
@@ -451,8 +547,9 @@ impl Pass<'_> {
             &vertex.mis,
             eval.pdf_dir * scatter.continuation(),
             eval.pdf_rev * vertex.scatter.continuation(),
+            self.factors.eta(scatter.in_medium()),
             &self.factors,
         );
-        eval.f * vertex.throughput * weight
+        eval.f * vertex.merge_throughput * weight
     }
 }

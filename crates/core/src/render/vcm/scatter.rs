@@ -1,8 +1,9 @@
-//! A surface vertex as vertex connection and merging sees it: its material
-//! at the point, the direction its subpath arrived from, and what the
-//! strategies ask of it: f and both sampling densities toward any
-//! direction (connections, merges), a sampled continuation, and the
-//! Russian-roulette probability of going on, which every density includes.
+//! A vertex as vertex connection and merging sees it: its material at the
+//! point (or, in a medium, the phase functions there), the direction its
+//! subpath arrived from, and what the strategies ask of it: f and both
+//! sampling densities toward any direction (connections, merges), a sampled
+//! continuation, and the Russian-roulette probability of going on, which
+//! every density includes (in a medium, the albedo Λ).
 //!
 //! Shading uses the interpolated normal, as the photon mappers do (normal
 //! textures are the path tracer's alone); f is symmetric, so light and
@@ -11,6 +12,7 @@
 use crate::bsdf::{Bsdf, ShadingFrame};
 use crate::geometry::Hit;
 use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
+use crate::medium::{MAX_PHASES, Media, Phase};
 use crate::sampling::{Rng, cosine_hemisphere};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -24,6 +26,73 @@ enum Lobes {
     Lambert { albedo: Rgb, mirror: Rgb, p_diffuse: f32 },
     /// Smooth glass: Fresnel reflection or refraction, both deltas.
     Glass { ior: f32 },
+    /// A point in a medium.
+    Medium(PhaseMix),
+}
+
+/// The phase functions of the media overlapping at a point: per channel,
+/// f = Σᵢ σ_s,i pᵢ / Σᵢ σ_s,i (the vertex's throughput already carries
+/// σ_s), sampled by choosing a medium ∝ its mean σ_s, so the density is
+/// the same mixture with those probabilities. One medium: f = pdf = p.
+#[derive(Clone, Copy, Debug)]
+struct PhaseMix {
+    phases: [Phase; MAX_PHASES],
+    weights: [Rgb; MAX_PHASES],
+    probabilities: [f32; MAX_PHASES],
+    count: usize,
+    /// σ̄ = mean(σ_t) there: the free flight's density per unit length
+    /// (with the transmittance before it).
+    sigma_bar: f32,
+}
+
+impl PhaseMix {
+    fn new(media: &Media, mask: u32) -> Option<PhaseMix> {
+        let phases_in_scene = media.phases();
+        let mut mix = PhaseMix {
+            phases: [Phase::Schlick { k: 0.0 }; MAX_PHASES],
+            weights: [Rgb::ZERO; MAX_PHASES],
+            probabilities: [0.0; MAX_PHASES],
+            count: phases_in_scene.len().min(MAX_PHASES),
+            sigma_bar: mean(media.sigma_t(mask)),
+        };
+        mix.phases[..mix.count].copy_from_slice(&phases_in_scene[..mix.count]);
+        let sigma_s = media.sigma_s(mask);
+        let total = mean(sigma_s);
+        if total <= 0.0 {
+            return None;
+        }
+        let mut bits = mask;
+        while bits != 0 {
+            let entry = &media.entries()[bits.trailing_zeros() as usize];
+            bits &= bits - 1;
+            let slot = entry.phase_slot as usize;
+            mix.weights[slot] += Rgb::select(sigma_s.cmpgt(Rgb::ZERO), entry.medium.sigma_s / sigma_s, Rgb::ZERO);
+            mix.probabilities[slot] += mean(entry.medium.sigma_s) / total;
+        }
+        Some(mix)
+    }
+
+    /// f (per channel) and density of scattering by angle acos(`mu`).
+    fn eval(&self, mu: f32) -> (Rgb, f32) {
+        let (mut f, mut pdf) = (Rgb::ZERO, 0.0);
+        for slot in 0..self.count {
+            let p = self.phases[slot].eval(mu);
+            f += self.weights[slot] * p;
+            pdf += self.probabilities[slot] * p;
+        }
+        (f, pdf)
+    }
+
+    fn choose(&self, u: f32) -> Phase {
+        let mut acc = 0.0;
+        for slot in 0..self.count {
+            acc += self.probabilities[slot];
+            if u < acc {
+                return self.phases[slot];
+            }
+        }
+        self.phases[self.count.saturating_sub(1)]
+    }
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -102,18 +171,53 @@ impl Scatter {
         })
     }
 
+    /// The vertex in the media of `mask`, reached along `dir`; None where
+    /// nothing there scatters.
+    pub fn medium(media: &Media, mask: u32, dir: Vec3) -> Option<Scatter> {
+        let mix = PhaseMix::new(media, mask)?;
+        let (lambda, _) = media.scattering(mask);
+        let frame = ShadingFrame::new(dir);
+        Some(Scatter {
+            lobes: Lobes::Medium(mix),
+            frame,
+            normal: dir,
+            geometric: dir,
+            outward: dir,
+            wo: -dir,
+            wo_local: frame.to_local(-dir),
+            continuation: lambda.min(1.0),
+        })
+    }
+
+    /// Whether the vertex lies in a medium (merges there use the ball kernel).
+    pub fn in_medium(&self) -> bool {
+        matches!(self.lobes, Lobes::Medium(_))
+    }
+
+    /// What turns a density per unit area on a surface into one per unit
+    /// volume in a medium: σ̄ there (the free flight's density, with the
+    /// transmittance before it); 1 on a surface, whose cosine
+    /// [`Evaluation::cos`] carries instead.
+    pub fn flight_density(&self) -> f32 {
+        match self.lobes {
+            Lobes::Medium(mix) => mix.sigma_bar,
+            _ => 1.0,
+        }
+    }
+
     /// Every lobe is a delta: no connection or merge can use this vertex.
     pub fn is_delta(&self) -> bool {
         match self.lobes {
             Lobes::Pbr(bsdf) => bsdf.is_delta() && !bsdf.has_diffuse(),
             Lobes::Lambert { p_diffuse, .. } => p_diffuse == 0.0,
             Lobes::Glass { .. } => true,
+            Lobes::Medium(_) => false,
         }
     }
 
-    /// |n · wo|: the cosine the subpath arrived with.
+    /// |n · wo|: the cosine the subpath arrived with (1 in a medium).
     pub fn cos_in(&self) -> f32 {
-        self.wo_local.z.abs()
+        if self.in_medium() { 1.0 } else { self.wo_local.z.abs() }
     }
 
     /// The probability that a subpath goes on from here.
@@ -129,6 +233,16 @@ impl Scatter {
     /// f and densities toward world direction `wi` (non-delta lobes);
     /// None where they carry nothing.
     pub fn evaluate(&self, wi: Vec3) -> Option<Evaluation> {
+        if let Lobes::Medium(mix) = self.lobes {
+            // μ between the directions of travel before (−wo) and after (wi).
+            let (f, pdf) = mix.eval(-self.wo.dot(wi));
+            return (f.max_element() > 0.0 && pdf > 0.0).then_some(Evaluation {
+                f,
+                cos: 1.0,
+                pdf_dir: pdf,
+                pdf_rev: pdf,
+            });
+        }
         // Reflection only, on the side the subpath arrived from.
         if wi.dot(self.geometric) <= 0.0 {
             return None;
@@ -144,7 +258,7 @@ impl Scatter {
             Lobes::Lambert { albedo, p_diffuse, .. } => {
                 (albedo / PI, p_diffuse * wi_local.z / PI, p_diffuse * self.wo_local.z / PI)
             }
-            Lobes::Glass { .. } => return None,
+            Lobes::Glass { .. } | Lobes::Medium(_) => return None,
         };
         (f.max_element() > 0.0 && pdf_dir > 0.0).then_some(Evaluation { f, cos: wi_local.z, pdf_dir, pdf_rev })
     }
@@ -190,6 +304,18 @@ impl Scatter {
                 };
                 Sampled { wi, weight: Rgb::ONE, pdf_dir: p, pdf_rev: p, cos: wi.dot(self.normal).abs(), delta: true }
             }
+            Lobes::Medium(mix) => {
+                let wi = mix.choose(u_lobe).sample(-self.wo, u);
+                let (f, pdf) = mix.eval(-self.wo.dot(wi));
+                Sampled {
+                    wi,
+                    weight: f / pdf.max(f32::MIN_POSITIVE),
+                    pdf_dir: pdf,
+                    pdf_rev: pdf,
+                    cos: 1.0,
+                    delta: false,
+                }
+            }
         };
         if sampled.pdf_dir.is_nan() || sampled.pdf_dir <= 0.0 || sampled.weight.max_element() <= 0.0 {
             return None;
@@ -197,7 +323,7 @@ impl Scatter {
         // A reflection must leave on the side it arrived from (a shading
         // normal can point a sample through the surface); glass may cross it.
         let crosses = sampled.wi.dot(self.geometric) <= 0.0;
-        if crosses && !matches!(self.lobes, Lobes::Glass { .. }) {
+        if crosses && !matches!(self.lobes, Lobes::Glass { .. } | Lobes::Medium(_)) {
             return None;
         }
         Some(sampled)

@@ -1,6 +1,7 @@
 //! The recursive weights against Veach's explicit balance heuristic: on
 //! random paths of 2 to 5 segments (an area light, Lambertian vertices
-//! with Russian roulette, a pinhole camera), every strategy that makes the
+//! with Russian roulette, a pinhole camera; with media, some vertices in a
+//! medium and every segment attenuated), every strategy that makes the
 //! path (the camera hitting the light, next-event estimation, every
 //! connection, light tracing, a merge at every inner vertex) gets the weight
 //! p^β / Σ p^β computed from the vertices' densities directly, and the
@@ -16,6 +17,11 @@ struct Path {
     x: Vec<Vec3>,
     /// Normals of x_0..x_{k−1}.
     n: Vec<Vec3>,
+    /// σ̄ of the inner vertices that lie in a medium (isotropic phase
+    /// function there), None on surfaces (index by vertex; x_0 never).
+    medium: Vec<Option<f32>>,
+    /// e^−τ̄ of segment x_j x_{j+1} (index j).
+    passes: Vec<f32>,
     /// Russian-roulette continuation of x_1..x_{k−1} (index by vertex).
     continuation: Vec<f32>,
     area: f32,
@@ -25,13 +31,17 @@ struct Path {
 }
 
 impl Path {
-    fn random(k: usize, rng: &mut Rng) -> Path {
+    fn random(k: usize, media: bool, rng: &mut Rng) -> Path {
         let mut point = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
         let x: Vec<Vec3> = (0..=k).map(|_| point()).collect();
         let n: Vec<Vec3> = (0..k).map(|_| point().normalize()).collect();
+        let medium =
+            (0..k).map(|j| (media && j > 0 && rng.next_f32() < 0.4).then(|| 0.3 + 3.0 * rng.next_f32())).collect();
+        let passes = (0..k).map(|_| if media { 0.2 + 0.8 * rng.next_f32() } else { 1.0 }).collect();
         let continuation = (0..k).map(|_| 0.2 + 0.8 * rng.next_f32()).collect();
         let forward = (x[k - 1] - x[k]).normalize();
-        Path { x, n, continuation, area: 0.3, pick: 0.7, forward, image_plane: 40.0 + 100.0 * rng.next_f32() }
+        let image_plane = 40.0 + 100.0 * rng.next_f32();
+        Path { x, n, medium, passes, continuation, area: 0.3, pick: 0.7, forward, image_plane }
     }
 
     fn k(&self) -> usize {
@@ -46,14 +56,34 @@ impl Path {
         (self.x[a] - self.x[b]).length_squared()
     }
 
-    /// |cos| at vertex `at` toward vertex `to`.
-    fn cos(&self, at: usize, to: usize) -> f32 {
-        self.n[at].dot(self.dir(at, to)).abs()
+    fn in_medium(&self, at: usize) -> bool {
+        self.medium.get(at).is_some_and(|m| m.is_some())
     }
 
-    /// Lambertian sampling density at `at` of leaving toward `to`, roulette included.
+    fn pass(&self, a: usize, b: usize) -> f32 {
+        self.passes[a.min(b)]
+    }
+
+    /// |cos| at vertex `at` toward vertex `to` (1 in a medium).
+    fn cos(&self, at: usize, to: usize) -> f32 {
+        if self.in_medium(at) { 1.0 } else { self.n[at].dot(self.dir(at, to)).abs() }
+    }
+
+    /// [`SubpathMis::arrive`]'s `arrival` at `at` on a ray from `from`.
+    fn arrival(&self, at: usize, from: usize) -> f32 {
+        self.medium.get(at).copied().flatten().unwrap_or_else(|| self.cos(at, from)) * self.pass(at, from)
+    }
+
+    /// Its `departure` for a ray that left `from` toward `to`.
+    fn departure(&self, from: usize, to: usize) -> f32 {
+        self.medium.get(from).copied().flatten().unwrap_or(1.0) * self.pass(from, to)
+    }
+
+    /// Sampling density at `at` of leaving toward `to` (Lambertian, or
+    /// isotropic in a medium), roulette included.
     fn pdf(&self, at: usize, to: usize) -> f32 {
-        self.cos(at, to) / PI * self.continuation[at]
+        let lobe = if self.in_medium(at) { 0.25 } else { self.cos(at, to) };
+        lobe / PI * self.continuation[at]
     }
 
     fn camera_pdf_w(&self) -> f32 {
@@ -64,23 +94,27 @@ impl Path {
 
     fn camera_pdf_a(&self) -> f32 {
         let k = self.k();
-        self.camera_pdf_w() * self.cos(k - 1, k) / self.d2(k - 1, k)
+        self.camera_pdf_w() * self.arrival(k - 1, k) / self.d2(k - 1, k)
     }
 
-    /// Per unit area, the light side choosing x_j and the eye side choosing x_j.
+    /// Per unit area (volume), the light side choosing x_j and the eye side choosing x_j.
     fn densities(&self) -> (Vec<f32>, Vec<f32>) {
         let k = self.k();
         let mut forward = vec![self.pick / self.area];
         for j in 1..k {
             let pdf_w = if j == 1 { self.cos(0, 1) / PI } else { self.pdf(j - 1, j) };
-            forward.push(pdf_w * self.cos(j, j - 1) / self.d2(j - 1, j));
+            forward.push(pdf_w * self.arrival(j, j - 1) / self.d2(j - 1, j));
         }
         let mut reverse = vec![0.0; k];
         reverse[k - 1] = self.camera_pdf_a();
         for j in (0..k - 1).rev() {
-            reverse[j] = self.pdf(j + 1, j) * self.cos(j, j + 1) / self.d2(j, j + 1);
+            reverse[j] = self.pdf(j + 1, j) * self.arrival(j, j + 1) / self.d2(j, j + 1);
         }
         (forward, reverse)
+    }
+
+    fn eta(&self, f: &Factors, at: usize) -> f32 {
+        f.eta(self.in_medium(at))
     }
 }
 
@@ -92,9 +126,9 @@ fn subpaths(p: &Path, f: &Factors) -> (Vec<SubpathMis>, Vec<SubpathMis>) {
     for j in 1..k {
         let mut s = *light.last().unwrap();
         if j > 1 {
-            s.scatter(p.cos(j - 1, j), p.pdf(j - 1, j), p.pdf(j - 1, j - 2), f);
+            s.scatter(p.cos(j - 1, j), p.pdf(j - 1, j), p.pdf(j - 1, j - 2), p.eta(f, j - 1), f);
         }
-        s.arrive(p.d2(j - 1, j), p.cos(j, j - 1), true);
+        s.arrive(p.d2(j - 1, j), p.arrival(j, j - 1), p.departure(j - 1, j), true);
         light.push(s);
     }
     let mut camera = vec![SubpathMis::camera_start(p.camera_pdf_w(), f); k];
@@ -103,18 +137,12 @@ fn subpaths(p: &Path, f: &Factors) -> (Vec<SubpathMis>, Vec<SubpathMis>) {
         if j < k - 1 {
             let from = if j + 2 == k { k } else { j + 2 };
             // The eye's vertex x_{j+1} scatters toward x_j, having come from `from`.
-            let rev = if from == k { p.cos(j + 1, k) / PI * p.continuation[j + 1] } else { p.pdf(j + 1, from) };
-            s.scatter(p.cos(j + 1, j), p.pdf(j + 1, j), rev, f);
+            s.scatter(p.cos(j + 1, j), p.pdf(j + 1, j), p.pdf(j + 1, from), p.eta(f, j + 1), f);
         }
-        s.arrive(p.d2(j, j + 1), p.cos(j, j + 1), true);
+        s.arrive(p.d2(j, j + 1), p.arrival(j, j + 1), p.departure(j + 1, j), true);
         camera[j] = s;
     }
     (light, camera)
-}
-
-/// Density at eye vertex x_i of leaving toward the eye side's next vertex.
-fn toward_eye(p: &Path, i: usize) -> f32 {
-    if i + 1 == p.k() { p.cos(i, p.k()) / PI * p.continuation[i] } else { p.pdf(i, i + 1) }
 }
 
 /// (name, recursive weight, explicit weight) of every strategy.
@@ -122,7 +150,6 @@ fn weights(p: &Path, f: &Factors, connect: bool, merge: bool) -> Vec<(String, f6
     let k = p.k();
     let (fwd, rev) = p.densities();
     let (light, camera) = subpaths(p, f);
-    let eta = (f.vm_normalization as f64).recip();
     // Count × density of every strategy, as Veach's formula has them.
     let vc = |s: usize| -> f64 {
         (0..s).map(|j| fwd[j] as f64).product::<f64>() * (s..k).map(|j| rev[j] as f64).product::<f64>()
@@ -135,35 +162,37 @@ fn weights(p: &Path, f: &Factors, connect: bool, merge: bool) -> Vec<(String, f6
         explicit.push(("hit".into(), emitter_hit(&camera[0], direct, emission) as f64, vc(0)));
         let nee = NextEvent {
             bsdf_dir_pdf_w: p.pdf(1, 0),
-            bsdf_rev_pdf_w: toward_eye(p, 1),
+            bsdf_rev_pdf_w: p.pdf(1, 2),
             direct_pdf_w: direct * p.d2(0, 1) / p.cos(0, 1),
             emission_pdf_w: emission,
-            cos_at_vertex: p.cos(1, 0),
+            vertex_arrival: p.arrival(1, 0),
+            passes: p.pass(0, 1),
             cos_at_light: p.cos(0, 1),
         };
-        explicit.push(("next event".into(), next_event(&camera[1], &nee, f) as f64, vc(1)));
+        explicit.push(("next event".into(), next_event(&camera[1], &nee, p.eta(f, 1)) as f64, vc(1)));
         for s in 2..k {
             // Light vertex x_{s−1}, eye vertex x_s.
             let (l, c) = (s - 1, s);
             let d2 = p.d2(l, c);
             let densities = Connection {
-                camera_dir_pdf_a: p.pdf(c, l) * p.cos(l, c) / d2,
-                camera_rev_pdf_w: toward_eye(p, c),
-                light_dir_pdf_a: p.pdf(l, c) * p.cos(c, l) / d2,
-                light_rev_pdf_w: if l == 1 { p.cos(1, 0) / PI * p.continuation[1] } else { p.pdf(l, l - 1) },
+                camera_dir_pdf_a: p.pdf(c, l) * p.arrival(l, c) / d2,
+                camera_rev_pdf_w: p.pdf(c, c + 1),
+                light_dir_pdf_a: p.pdf(l, c) * p.arrival(c, l) / d2,
+                light_rev_pdf_w: p.pdf(l, l - 1),
+                camera_eta: p.eta(f, c),
+                light_eta: p.eta(f, l),
             };
-            explicit.push((format!("connect {s}"), connection(&camera[c], &light[l], &densities, f) as f64, vc(s)));
+            explicit.push((format!("connect {s}"), connection(&camera[c], &light[l], &densities) as f64, vc(s)));
         }
-        let lt_rev = if k == 2 { p.cos(1, 0) / PI * p.continuation[1] } else { p.pdf(k - 1, k - 2) };
-        let lt = light_tracing(&light[k - 1], p.camera_pdf_a(), lt_rev, f) as f64;
+        let lt = light_tracing(&light[k - 1], p.camera_pdf_a(), p.pdf(k - 1, k - 2), p.eta(f, k - 1), f) as f64;
         explicit.push(("light tracing".into(), lt, f.light_paths as f64 * vc(k)));
     }
     if merge {
         for i in 1..k {
-            let dir = p.pdf(i, i - 1);
-            let rev_w = toward_eye(p, i);
-            let w = super::merge(&camera[i], &light[i], dir, rev_w, f) as f64;
-            explicit.push((format!("merge at {i}"), w, eta * fwd[i] as f64 * vc(i)));
+            let eta = p.eta(f, i);
+            let w = super::merge(&camera[i], &light[i], p.pdf(i, i - 1), p.pdf(i, i + 1), eta, f) as f64;
+            let raw_eta = (f.normalization(p.in_medium(i)) as f64).recip();
+            explicit.push((format!("merge at {i}"), w, raw_eta * fwd[i] as f64 * vc(i)));
         }
     }
     // Veach's heuristic of power β over the counts × densities.
@@ -175,12 +204,14 @@ fn weights(p: &Path, f: &Factors, connect: bool, merge: bool) -> Vec<(String, f6
     out
 }
 
-fn check(connect: bool, merge: bool) {
-    let mut rng = Rng::for_item(11, connect as u64 * 2 + merge as u64);
+fn check(connect: bool, merge: bool, media: bool) {
+    let mut rng = Rng::for_item(11, connect as u64 * 4 + merge as u64 * 2 + media as u64);
     for k in 2..=5 {
         for trial in 0..200 {
-            let p = Path::random(k, &mut rng);
-            let f = Factors::new(0.01 + 0.2 * rng.next_f32(), 1000.0 + 60_000.0 * rng.next_f32(), connect, merge);
+            let p = Path::random(k, media, &mut rng);
+            let (radius, volume_radius) = (0.01 + 0.2 * rng.next_f32(), 0.01 + 0.2 * rng.next_f32());
+            let light_paths = 1000.0 + 60_000.0 * rng.next_f32();
+            let f = Factors::new(radius, volume_radius, light_paths, connect, merge);
             let w = weights(&p, &f, connect, merge);
             let sum: f64 = w.iter().map(|(_, w, _)| w).sum();
             assert!((sum - 1.0).abs() < 1e-3, "k = {k}, trial {trial}: weights sum to {sum}: {w:?}");
@@ -196,15 +227,24 @@ fn check(connect: bool, merge: bool) {
 
 #[test]
 fn weights_are_veachs_heuristic_and_sum_to_one() {
-    check(true, true);
+    check(true, true, false);
 }
 
 #[test]
 fn without_merging_the_connections_sum_to_one() {
-    check(true, false);
+    check(true, false, false);
 }
 
 #[test]
 fn without_connections_the_merges_sum_to_one() {
-    check(false, true);
+    check(false, true, false);
+}
+
+/// Paths with vertices in media (flight densities σ̄ e^−τ̄, a ball kernel
+/// there, a disc on surfaces) and transmittance on every segment.
+#[test]
+fn with_medium_vertices_the_weights_are_veachs_heuristic() {
+    check(true, true, true);
+    check(true, false, true);
+    check(false, true, true);
 }
