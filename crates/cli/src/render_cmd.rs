@@ -14,8 +14,13 @@ use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_trace_settings};
 use hikari_core::render::{Image, path, photon_cpu, vcm};
 
-/// Passes `--renderer vcm` renders without --passes or --time.
-const VCM_DEFAULT_PASSES: u32 = 16;
+/// A render without --passes, --time or --target-error (nor --spp with the
+/// path tracer) renders passes until the noise they estimate falls to this
+/// fraction of the image's mean, or for this many seconds, whichever first.
+pub const DEFAULT_TARGET_ERROR: f64 = 0.02;
+pub const DEFAULT_TIME_LIMIT: f64 = 60.0;
+/// Samples per pixel of the path tracer's open-ended passes (without --spp).
+const PATH_PASS_SPP: u32 = 4;
 use hikari_core::scene::{Scene, builtin};
 use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
@@ -164,7 +169,9 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub area_light_samples: u32,
     /// Volume-map radius in scene units, between 1e-5 and 0.5 scene
-    /// diagonals [default: 3% of the scene diagonal].
+    /// diagonals [default: 3% of the scene diagonal for one pass, 0.8% for
+    /// the first of progressive passes; vcm: its merging radius in media,
+    /// 0.3%].
     #[arg(long, allow_negative_numbers = true)]
     pub volume_radius: Option<f32>,
     /// Optical-depth slices along each view ray through region media, 1 to 64 (gpu).
@@ -189,8 +196,10 @@ pub struct RenderArgs {
     pub lod_groups: u32,
     /// Progressive photon mapping (docs/progressive.md): render up to this
     /// many passes, each with a fresh photon set and smaller radii, and
-    /// average them, 1 to 1,000,000 [default: 1, the seed's method; no
-    /// limit with --time]. With --renderer path, passes of --spp samples.
+    /// average them, 1 to 1,000,000; `--passes 1` is the seed's single
+    /// pass [default: until the estimated noise is 2% or 60 s have passed;
+    /// no limit with --time or --target-error]. With --renderer path, passes
+    /// of --spp samples (a single pass where --spp alone is given).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
     pub passes: Option<u32>,
     /// Stop the passes after the first that ends past this many seconds.
@@ -202,9 +211,9 @@ pub struct RenderArgs {
     pub alpha: f32,
     /// Render passes until the noise the passes themselves estimate (two
     /// interleaved half-images; relative to the image's mean, as --reference
-    /// reports) falls to this fraction, e.g. 0.02 (photon-cpu, path and vcm;
-    /// the GPU renderer does not estimate it yet). With --time, whichever
-    /// comes first. Noise only: photon mapping's blur is not in it.
+    /// reports) falls to this fraction, e.g. 0.02. With --time, whichever
+    /// comes first. Noise only: photon mapping's blur is not in it. The GPU
+    /// reads its estimate back after passes 2, 3, 4, 6, 8, 12, 16, ….
     #[arg(long, value_parser = parse_fraction)]
     pub target_error: Option<f64>,
     /// With passes: write the image so far every this many seconds.
@@ -468,13 +477,25 @@ fn render_photons(
 }
 
 /// Whether to render in progressive passes: more than one pass, a time
-/// limit, checkpoints or a reference to compare with.
+/// limit, checkpoints or a reference to compare with, or nothing said
+/// ([`by_default`]).
 fn progressive(args: &RenderArgs) -> bool {
     args.passes.is_some_and(|n| n > 1)
         || args.time.is_some()
         || args.reference.is_some()
         || args.checkpoint.is_some()
         || args.target_error.is_some()
+        || by_default(args)
+}
+
+/// Whether nothing says when to stop, so the render stops at
+/// [`DEFAULT_TARGET_ERROR`] or [`DEFAULT_TIME_LIMIT`]: no --passes,
+/// --time or --target-error, and for the path tracer no --spp.
+fn by_default(args: &RenderArgs) -> bool {
+    args.passes.is_none()
+        && args.time.is_none()
+        && args.target_error.is_none()
+        && !(args.renderer == RendererKind::Path && args.spp.is_some())
 }
 
 /// A fraction in (0, 1).
@@ -499,27 +520,23 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             Some((path.clone(), image))
         }
     };
-    if args.checkpoint.is_some()
-        && args.passes.is_none_or(|n| n == 1)
-        && args.time.is_none()
-        && args.target_error.is_none()
-    {
+    let defaults = by_default(args);
+    let target_error = args.target_error.or(defaults.then_some(DEFAULT_TARGET_ERROR));
+    let time = args.time.or(defaults.then_some(DEFAULT_TIME_LIMIT));
+    if args.checkpoint.is_some() && args.passes.is_none_or(|n| n == 1) && time.is_none() && target_error.is_none() {
         usage!("--checkpoint needs --passes (more than 1), --time or --target-error");
     }
-    let single = if kind == RendererKind::Vcm { VCM_DEFAULT_PASSES } else { 1 };
-    let open_ended = args.time.is_some() || args.target_error.is_some();
-    if args.target_error.is_some() && kind == RendererKind::Gpu {
+    if defaults && !args.quiet {
         eprintln!(
-            "note: --target-error: the gpu renderer does not estimate its noise yet; it stops at --passes or --time only"
+            "rendering passes until the estimated noise is {}% or {DEFAULT_TIME_LIMIT} s have passed (--passes 1: the seed's single pass)",
+            100.0 * DEFAULT_TARGET_ERROR
         );
     }
-    if args.target_error.is_some() && kind == RendererKind::Gpu && args.passes.is_none() && args.time.is_none() {
-        usage!("--target-error with the gpu renderer needs --passes or --time (or use photon-cpu, path or vcm)");
-    }
+    let open_ended = time.is_some() || target_error.is_some();
     let plan = PassPlan {
-        passes: args.passes.unwrap_or(if open_ended { u32::MAX } else { single }),
-        target_error: args.target_error,
-        time: args.time.map(Duration::from_secs_f64),
+        passes: args.passes.unwrap_or(if open_ended { u32::MAX } else { 1 }),
+        target_error,
+        time: time.map(Duration::from_secs_f64),
         checkpoint: args.checkpoint.map(Duration::from_secs_f64),
         reference,
         output: args.output.clone(),
@@ -528,7 +545,8 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
     };
     let (w, h) = (scene.camera.width, scene.camera.height);
     if kind == RendererKind::Path {
-        let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
+        let spp = args.spp.unwrap_or(if open_ended { PATH_PASS_SPP } else { 64 });
+        let settings = path::PathSettings { spp, seed: args.seed, ..Default::default() };
         eprintln!("path tracing in passes of {} spp", settings.spp);
         let mut passes = PathPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
         let (image, _) = passes::run(&mut passes, &plan)?;
@@ -560,7 +578,7 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
     }
     let settings = cpu_settings(args);
     let (global, caustic) = settings.estimate_params(scene);
-    let volume = args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene));
+    let volume = args.volume_radius.unwrap_or_else(|| hikari_core::progressive::default_volume_radius(scene));
     let schedules = Schedules::new([global.radius, caustic.radius, volume], args.alpha);
     eprintln!(
         "progressive: {} photon paths per pass, α = {}; first radii {:.4} (global), {:.4} (caustic){}",

@@ -9,7 +9,19 @@ use std::process::Command;
 fn renders_a_builtin_scene_and_reports() {
     let dir = scratch_dir("ok");
     let out = hikari(
-        &["render", "cornell-caustic", "--resolution", "24x16", "--photons", "3000", "-o", "out.png", "-q"],
+        &[
+            "render",
+            "cornell-caustic",
+            "--resolution",
+            "24x16",
+            "--photons",
+            "3000",
+            "--passes",
+            "1",
+            "-o",
+            "out.png",
+            "-q",
+        ],
         &dir,
     );
     let err = stderr(&out);
@@ -77,7 +89,7 @@ fn bad_scene_files_are_reported_with_file_and_line() {
 fn media_are_rendered() {
     let dir = scratch_dir("fog");
     std::fs::write(dir.join("fog.toml"), format!("{SCENE}\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n")).unwrap();
-    let out = hikari(&["render", "fog.toml", "--photons", "2000", "-o", "fog.png", "-q"], &dir);
+    let out = hikari(&["render", "fog.toml", "--photons", "2000", "--passes", "1", "-o", "fog.png", "-q"], &dir);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     assert!(err.contains("gpu:"), "{err}");
@@ -92,7 +104,7 @@ fn media_are_rendered() {
     }
     let glass = SCENE.replace("type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", "type = \"glass\"");
     std::fs::write(dir.join("glass.toml"), format!("{glass}\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\n")).unwrap();
-    let out = hikari(&["render", "glass.toml", "--photons", "2000", "-o", "g.png", "-q"], &dir);
+    let out = hikari(&["render", "glass.toml", "--photons", "2000", "--passes", "1", "-o", "g.png", "-q"], &dir);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
     // Drawn on the GPU (lavapipe included: its gathers are split to fit
@@ -115,7 +127,8 @@ fn bad_options_are_rejected() {
         &dir,
         &["no-such-scene", "cornell-box"],
     );
-    assert_fails_with(&hikari(&["render", "ok.toml", "-o", "no/such/dir/out.png", "-q"], &dir), &dir, &["out.png"]);
+    let no_dir = hikari(&["render", "ok.toml", "--passes", "1", "-o", "no/such/dir/out.png", "-q"], &dir);
+    assert_fails_with(&no_dir, &dir, &["out.png"]);
 }
 
 /// Out-of-range flags and scene files are input errors: exit code 2, the
@@ -167,6 +180,8 @@ fn settings_too_large_for_the_gpu_fall_back_with_the_reason() {
             "8192",
             "--area-light-samples",
             "256",
+            "--passes",
+            "1",
             "-o",
             "out.png",
             "-q",
@@ -191,7 +206,7 @@ fn settings_too_large_for_the_gpu_fall_back_with_the_reason() {
 fn the_gl_backend_renders_or_falls_back_with_the_reason() {
     let dir = scratch_dir("gl");
     let out = Command::new(env!("CARGO_BIN_EXE_hikari"))
-        .args(["render", "--resolution", "16x16", "--photons", "2000", "-o", "out.png", "-q"])
+        .args(["render", "--resolution", "16x16", "--photons", "2000", "--passes", "1", "-o", "out.png", "-q"])
         .env("WGPU_BACKEND", "gl")
         .current_dir(&dir)
         .output()
@@ -249,7 +264,19 @@ fn renders_in_passes_and_compares_with_a_reference() {
     // Bad input: exit 2, nothing written (in a folder of its own, holding the reference).
     let bad = scratch_dir("passes-bad");
     let out = hikari(
-        &["render", "cornell-box", "--resolution", "16x16", "--renderer", "path", "-q", "-o", "ref16.exr"],
+        &[
+            "render",
+            "cornell-box",
+            "--resolution",
+            "16x16",
+            "--renderer",
+            "path",
+            "--spp",
+            "64",
+            "-q",
+            "-o",
+            "ref16.exr",
+        ],
         &bad,
     );
     assert!(out.status.success(), "{}", stderr(&out));
@@ -260,7 +287,7 @@ fn renders_in_passes_and_compares_with_a_reference() {
         (&["--passes", "2", "--reference", "missing.exr"], &["missing.exr"]),
         (&["--passes", "2", "--reference", "ref16.exr"], &["ref16.exr", "16x16", "32x32"]),
         (&["--passes", "2", "--reference", "shown.png"], &["shown.png", "exr"]),
-        (&["--checkpoint", "1"], &["--checkpoint"]),
+        (&["--passes", "1", "--checkpoint", "1"], &["--checkpoint"]),
     ] {
         let out = hikari(&[&["render"], &small[..], args, &["-o", "bad.png"]].concat(), &bad);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
@@ -297,7 +324,21 @@ fn ctrl_c_writes_the_passes_so_far() {
 fn traces_photons_on_the_gpu_or_the_cpu() {
     let dir = scratch_dir("trace");
     let render = |trace: &str, scene: &str, out: &str| {
-        let args = ["render", scene, "--trace", trace, "--resolution", "24x24", "--photons", "4000", "-o", out, "-q"];
+        let args = [
+            "render",
+            scene,
+            "--trace",
+            trace,
+            "--resolution",
+            "24x24",
+            "--photons",
+            "4000",
+            "--passes",
+            "1",
+            "-o",
+            out,
+            "-q",
+        ];
         let out = hikari(&args, &dir);
         assert!(out.status.success(), "{}", stderr(&out));
         stderr(&out)
@@ -332,6 +373,8 @@ fn tiled_estimator_renders_the_splat_image() {
             "32x32",
             "--photons",
             "5000",
+            "--passes",
+            "1",
             "-o",
             out,
         ];
@@ -370,6 +413,8 @@ fn gltf_files_render_and_broken_ones_are_located_errors() {
             "x10",
             "--photons",
             "2000",
+            "--passes",
+            "1",
             "-o",
             "g.png",
             "-q",
@@ -439,7 +484,8 @@ fn suns_skies_and_emissive_surfaces_render_on_the_gpu() {
     std::fs::write(dir.join("mesh-light.glb"), mesh_light).unwrap();
     std::fs::write(dir.join("unlit.glb"), unlit_glb()).unwrap();
     for file in ["sun-and-sky.toml", "mesh-light.glb", "unlit.glb"] {
-        let out = hikari(&["render", file, "--resolution", "32", "--photons", "5000", "-o", "g.exr"], &dir);
+        let out =
+            hikari(&["render", file, "--resolution", "32", "--photons", "5000", "--passes", "1", "-o", "g.exr"], &dir);
         let err = stderr(&out);
         assert!(out.status.success(), "{file}: {err}");
         let fell_back = err.lines().find(|l| l.contains("rendering with photon-cpu instead"));
@@ -463,7 +509,8 @@ fn an_environment_map_lights_a_gltf_file() {
     let data: Vec<f32> = (0..w * h).flat_map(|i| if i / w < h / 2 { [2.0, 1.5, 1.0] } else { [0.1; 3] }).collect();
     let sky = image::Rgb32FImage::from_raw(w, h, data).unwrap();
     image::DynamicImage::ImageRgb32F(sky).save(dir.join("sky.exr")).unwrap();
-    let args = ["render", "unlit.glb", "--environment", "sky.exr", "--resolution", "24", "--photons", "5000"];
+    let args =
+        ["render", "unlit.glb", "--environment", "sky.exr", "--resolution", "24", "--photons", "5000", "--passes", "1"];
     let out = hikari(&[&args[..], &["-o", "env.exr"]].concat(), &dir);
     let err = stderr(&out);
     assert!(out.status.success(), "{err}");
@@ -488,7 +535,7 @@ fn vertex_connection_and_merging_renders_every_strategy_and_fog() {
     let dir = scratch_dir("vcm");
     let run =
         |args: &[&str]| hikari(&[&["render", "cornell-caustic", "--resolution", "16x16", "-q"], args].concat(), &dir);
-    let out = run(&["--renderer", "vcm", "-o", "v.exr"]);
+    let out = run(&["--renderer", "vcm", "--passes", "16", "-o", "v.exr"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(String::from_utf8_lossy(&out.stderr).contains("16 passes"), "{}", String::from_utf8_lossy(&out.stderr));
     for strategies in ["connections", "merging", "light-tracing"] {
@@ -497,8 +544,10 @@ fn vertex_connection_and_merging_renders_every_strategy_and_fog() {
     }
     let image = hikari_core::output::read_exr(&dir.join("v.exr")).unwrap();
     assert!(image.pixels.iter().all(|p| p.is_finite()) && image.mean() > 0.0);
-    let out =
-        hikari(&["render", "fog-stage", "--resolution", "16x16", "-q", "--renderer", "vcm", "-o", "fog.exr"], &dir);
+    let out = hikari(
+        &["render", "fog-stage", "--resolution", "16x16", "-q", "--renderer", "vcm", "--passes", "8", "-o", "fog.exr"],
+        &dir,
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let fog = hikari_core::output::read_exr(&dir.join("fog.exr")).unwrap();
     assert!(fog.pixels.iter().all(|p| p.is_finite()) && fog.mean() > 0.0);
@@ -541,4 +590,29 @@ fn renders_until_the_target_error() {
         &bad,
         &["--target-error"],
     );
+}
+
+/// With nothing said about when to stop, a render is progressive: passes
+/// until the noise they estimate is 2% (or a minute), on the GPU (which
+/// reads its two half-means back) or on the CPU after a line saying why.
+/// (A floor and a box under a sun and a sky: about 64 passes; small shadow
+/// maps, which lavapipe redraws each pass.)
+#[test]
+fn the_default_render_stops_when_the_noise_is_two_percent() {
+    let dir = scratch_dir("default-stop");
+    std::fs::write(dir.join("sun-and-sky.toml"), SUN_AND_SKY).unwrap();
+    let args = ["sun-and-sky.toml", "--resolution", "16x16", "--photons", "50000", "--shadow-map-size", "128"];
+    let out = hikari(&[&["render"], &args[..], &["-o", "d.exr"]].concat(), &dir);
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("until the estimated noise is 2%") && err.contains("--passes 1"), "{err}");
+    assert!(err.contains("stopped by the target error"), "{err}");
+    let noise: f64 = err
+        .split("estimated noise ")
+        .last()
+        .and_then(|t| t.split('%').next())
+        .and_then(|v| v.parse().ok())
+        .expect("the estimate");
+    assert!(noise <= 2.0, "{err}");
+    assert!(dir.join("d.exr").is_file());
 }

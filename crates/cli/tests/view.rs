@@ -275,7 +275,21 @@ fn view_matches_the_headless_render() {
     view(&dir, &["cornell-box", "--size", "48x36", "--photons", "3000", "--frames", "1", "--screenshot", "v1.exr"]);
     view(&dir, &["cornell-box", "--size", "48x36", "--photons", "3000", "--frames", "30", "--screenshot", "v30.exr"]);
     // The viewer's converging frames use the normal test, as passes do.
-    render(&dir, &["cornell-box", "--resolution", "48x36", "--photons", "3000", "--normal-test", "-o", "r1.exr"]);
+    render(
+        &dir,
+        &[
+            "cornell-box",
+            "--resolution",
+            "48x36",
+            "--photons",
+            "3000",
+            "--normal-test",
+            "--passes",
+            "1",
+            "-o",
+            "r1.exr",
+        ],
+    );
     render(&dir, &["cornell-box", "--resolution", "48x36", "--renderer", "path", "--spp", "1024", "-o", "path.exr"]);
     render(&dir, &["cornell-box", "--resolution", "48x36", "--photons", "3000", "--passes", "30", "-o", "r30.exr"]);
     let (v1, v30, r1, path) = (exr(&dir, "v1.exr"), exr(&dir, "v30.exr"), exr(&dir, "r1.exr"), exr(&dir, "path.exr"));
@@ -314,7 +328,22 @@ fn view_retraces_a_moving_light() {
     assert!(passes < 1e-4, "the still run differs from render --passes 6 by {passes}");
     for at in ["0", "2"] {
         let file = format!("at{at}.exr");
-        render(&dir, &["cornell-orbit", "--resolution", "40x40", "--photons", "100000", "--at", at, "-o", &file]);
+        render(
+            &dir,
+            &[
+                "cornell-orbit",
+                "--resolution",
+                "40x40",
+                "--photons",
+                "100000",
+                "--passes",
+                "1",
+                "--at",
+                at,
+                "-o",
+                &file,
+            ],
+        );
     }
     let (moving, still) = (exr(&dir, "moving.exr"), exr(&dir, "still.exr"));
     let (at0, at2) = (exr(&dir, "at0.exr"), exr(&dir, "at2.exr"));

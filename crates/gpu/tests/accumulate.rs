@@ -89,3 +89,39 @@ fn the_mean_of_k_frames_has_a_kth_of_the_variance() {
         assert!((2.5..6.4).contains(&ratio), "variance fell by {ratio} from K = {what}");
     }
 }
+
+/// The odd frames' mean, kept beside the mean, gives the noise estimate
+/// the CPU renderers give (`ImageMean::noise_estimate`, from the same
+/// frames read back), after 2 to 5 frames, and none after a reset.
+#[test]
+fn the_noise_estimate_is_the_cpu_twins() {
+    use hikari_core::progressive::ImageMean;
+    let ctx = test_context("accumulate noise");
+    let mut scene = Scene::load("cornell-box").unwrap();
+    scene.camera = scene.camera.with_resolution(24, 20).unwrap();
+    let trace = |seed| trace_photons(&scene, &TraceSettings { photons: 2_000, seed, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &trace(1), GpuSettings::new(global, caustic)).unwrap();
+    let mut mean = AccumulatePass::new(&ctx.device, gpu.resolved());
+    let mut cpu = ImageMean::new(24, 20);
+    for seed in 1..=5 {
+        gpu.set_photons(&scene, &trace(seed)).unwrap();
+        gpu.render().unwrap();
+        cpu.add(&gpu.read_image().unwrap().0);
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        mean.record(&ctx.queue, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        let (got, want) = (mean.read_noise(&ctx).unwrap(), cpu.noise_estimate());
+        match (got, want) {
+            (None, None) => assert_eq!(seed, 1),
+            (Some(g), Some(w)) => assert!((g - w).abs() < 1e-4 * w, "after {seed} frames: {g} against {w}"),
+            _ => panic!("after {seed} frames: {got:?} against {want:?}"),
+        }
+    }
+    assert!(cpu.noise_estimate().unwrap() > 0.01, "the frames differ");
+    mean.reset();
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    mean.record(&ctx.queue, &mut encoder);
+    ctx.queue.submit([encoder.finish()]);
+    assert_eq!(mean.read_noise(&ctx).unwrap(), None);
+}

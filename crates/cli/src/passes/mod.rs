@@ -25,9 +25,8 @@ pub trait PassRenderer {
     /// The global map's radius in pass `pass`, for the progress bar (None: no radius).
     fn radius(&self, pass: u32) -> Option<f32>;
     /// The mean's relative error as its passes estimate it
-    /// (`ImageMean::noise_estimate`); None where the passes are not kept
-    /// apart (the GPU's mean lives on the GPU) or before the second pass.
-    fn noise(&self) -> Option<f64> {
+    /// (`ImageMean::noise_estimate`); None before the second pass.
+    fn noise(&mut self) -> Option<f64> {
         None
     }
 }
@@ -200,7 +199,7 @@ mod tests {
         fn radius(&self, _: u32) -> Option<f32> {
             None
         }
-        fn noise(&self) -> Option<f64> {
+        fn noise(&mut self) -> Option<f64> {
             Some(1.0 / self.0.0 as f64)
         }
     }

@@ -41,7 +41,7 @@ impl PassRenderer for CpuPasses<'_> {
         Ok(self.mean.mean())
     }
 
-    fn noise(&self) -> Option<f64> {
+    fn noise(&mut self) -> Option<f64> {
         self.mean.noise_estimate()
     }
 
@@ -71,7 +71,7 @@ impl PassRenderer for PathPasses<'_> {
         Ok(self.mean.mean())
     }
 
-    fn noise(&self) -> Option<f64> {
+    fn noise(&mut self) -> Option<f64> {
         self.mean.noise_estimate()
     }
 
@@ -101,7 +101,7 @@ impl PassRenderer for VcmPasses<'_> {
         Ok(self.mean.mean())
     }
 
-    fn noise(&self) -> Option<f64> {
+    fn noise(&mut self) -> Option<f64> {
         self.mean.noise_estimate()
     }
 
@@ -127,6 +127,9 @@ pub struct GpuPasses<'a> {
     first_built: bool,
     tracer: PhotonTracer,
     pub nonfinite: u64,
+    /// The last noise estimate (`AccumulatePass::noise_due`: reading the
+    /// means back each pass would cost more than the pass at large sizes).
+    noise: Option<f64>,
 }
 
 impl<'a> GpuPasses<'a> {
@@ -146,7 +149,18 @@ impl<'a> GpuPasses<'a> {
         [settings.global.radius, settings.caustic.radius, settings.volume_radius] = schedules.radii(1);
         let renderer = GpuRenderer::new(ctx, scene, first, settings)?;
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        Ok(GpuPasses { scene, renderer, mean, photons, seed, schedules, first_built: true, tracer, nonfinite: 0 })
+        Ok(GpuPasses {
+            scene,
+            renderer,
+            mean,
+            photons,
+            seed,
+            schedules,
+            first_built: true,
+            tracer,
+            nonfinite: 0,
+            noise: None,
+        })
     }
 }
 
@@ -170,7 +184,14 @@ impl PassRenderer for GpuPasses<'_> {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         self.mean.record(&ctx.queue, &mut encoder);
         ctx.queue.submit([encoder.finish()]);
+        if self.mean.noise_due() {
+            self.noise = self.mean.read_noise(&self.renderer.ctx)?;
+        }
         Ok(())
+    }
+
+    fn noise(&mut self) -> Option<f64> {
+        self.noise
     }
 
     fn mean(&mut self) -> Result<Image> {

@@ -637,6 +637,11 @@ impl Viewer {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             session.mean.record(&ctx.queue, &mut encoder);
             ctx.queue.submit([encoder.finish()]);
+            if session.mean.count() == 1 {
+                self.readouts.noise = None;
+            } else if session.mean.noise_due() {
+                self.readouts.noise = session.mean.read_noise(ctx)?;
+            }
         }
         let ctx = &session.renderer.ctx;
         let texture = match session.surface.get_current_texture() {

@@ -42,6 +42,8 @@ pub struct Readouts {
     pub adapter: String,
     pub fps: f64,
     pub frames_in_mean: u32,
+    /// The mean's noise as its frames estimate it (relative to its mean).
+    pub noise: Option<f64>,
     pub photon_sets: u64,
     pub photons_per_set: u64,
     pub stored: [usize; 3],
@@ -148,6 +150,9 @@ impl Panel {
 fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
     ui.label(&r.adapter);
     ui.label(format!("{:.1} fps; mean of {} frames ({} photon sets)", r.fps, r.frames_in_mean, r.photon_sets));
+    if let Some(noise) = r.noise {
+        ui.label(format!("noise ≈ {:.1}% (of the mean, from odd and even frames)", 100.0 * noise));
+    }
     ui.label(format!(
         "photons: {} per set; stored {} global, {} caustic, {} volume",
         r.photons_per_set, r.stored[0], r.stored[1], r.stored[2]

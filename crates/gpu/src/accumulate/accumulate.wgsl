@@ -1,6 +1,8 @@
-// The running mean of frames (the viewer's still camera: each frame comes
-// from a fresh photon set): the sum of the frames since the last reset is
-// kept in f32 per pixel, and the output is sum / count.
+// The running mean of frames (the viewer's still camera, the progressive
+// render's passes: each frame comes from a fresh photon set): the sum of the
+// frames since the last reset is kept in f32 per pixel, and the output is
+// sum / count; the odd frames' sum and mean likewise (the noise estimate's
+// half-images).
 
 struct AccumulateParams {
     width: u32,
@@ -12,8 +14,10 @@ struct AccumulateParams {
 
 @group(0) @binding(0) var<uniform> params: AccumulateParams;
 @group(0) @binding(1) var frame: texture_2d<f32>;
+// All frames' sums (first width × height entries), then the odd frames'.
 @group(0) @binding(2) var<storage, read_write> sum: array<vec4<f32>>;
 @group(0) @binding(3) var mean: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(4) var odd_mean: texture_storage_2d<rgba32float, write>;
 
 // Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
 override WORKGROUP: u32;
@@ -31,4 +35,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     sum[index] = total;
     textureStore(mean, vec2<i32>(id.xy), total / f32(params.count));
+    if (params.count % 2u == 1u) {
+        let odd_index = params.width * params.height + index;
+        var odd_total = value;
+        if (params.count > 1u) {
+            odd_total += sum[odd_index];
+        }
+        sum[odd_index] = odd_total;
+        textureStore(odd_mean, vec2<i32>(id.xy), odd_total / f32((params.count + 1u) / 2u));
+    }
 }

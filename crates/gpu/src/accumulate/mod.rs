@@ -1,6 +1,9 @@
 //! The running mean of frames from independent photon sets: what the
 //! viewer shows while the camera stands still, so the noise of the photon
-//! maps falls as it looks (`count` frames: variance / count).
+//! maps falls as it looks (`count` frames: variance / count), and the
+//! progressive GPU render's mean. The odd frames' mean is kept apart too:
+//! the two interleaved half-images from which the mean's remaining noise
+//! is estimated (`hikari_core::progressive::noise_from_sums`).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -28,6 +31,8 @@ pub struct AccumulatePass {
     count: u32,
     /// The mean so far (`Rgba32Float`).
     pub mean: wgpu::Texture,
+    /// The mean of the odd frames (1st, 3rd, …) alone.
+    pub odd_mean: wgpu::Texture,
 }
 
 impl AccumulatePass {
@@ -48,6 +53,7 @@ impl AccumulatePass {
                 entry(1, stage, texture(wgpu::TextureViewDimension::D2)),
                 entry(2, stage, storage(false)),
                 entry(3, stage, storage_texture_rgba32f()),
+                entry(4, stage, storage_texture_rgba32f()),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "accumulate", &layout);
@@ -60,14 +66,17 @@ impl AccumulatePass {
             mapped_at_creation: false,
         });
         let sum = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accumulated sum"),
-            size: width as u64 * height as u64 * 16,
+            label: Some("accumulated sums"),
+            // All frames' sum, then the odd frames'.
+            size: 2 * width as u64 * height as u64 * 16,
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
         let mean = crate::binding::storage_output_texture(device, "accumulated mean", width, height);
         let frame_view = frame.create_view(&Default::default());
         let mean_view = mean.create_view(&Default::default());
+        let odd_mean = crate::binding::storage_output_texture(device, "accumulated odd mean", width, height);
+        let odd_mean_view = odd_mean.create_view(&Default::default());
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("accumulate"),
             layout: &layout,
@@ -76,14 +85,41 @@ impl AccumulatePass {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&frame_view) },
                 wgpu::BindGroupEntry { binding: 2, resource: sum.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&mean_view) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&odd_mean_view) },
             ],
         });
-        AccumulatePass { pipeline, bind_group, params, width, height, count: 0, mean }
+        AccumulatePass { pipeline, bind_group, params, width, height, count: 0, mean, odd_mean }
     }
 
     /// Frames in the mean.
     pub fn count(&self) -> u32 {
         self.count
+    }
+
+    /// Whether the noise estimate is worth reading back now: after frames
+    /// 2, 3, 4, 6, 8, 12, 16, 24, … (2^k and 3·2^k), so a render that stops
+    /// at a target error renders at most half again as many passes as it
+    /// needed, and the readbacks (two images) cost a logarithm's worth.
+    pub fn noise_due(&self) -> bool {
+        let n = self.count;
+        n >= 2 && (n.is_power_of_two() || (n.is_multiple_of(3) && (n / 3).is_power_of_two()))
+    }
+
+    /// The noise of the mean as its frames estimate it, relative to the
+    /// mean (None before two frames): the means read back.
+    pub fn read_noise(&self, ctx: &crate::GpuContext) -> Result<Option<f64>, crate::GpuError> {
+        let mean = crate::readback::read_rgba(ctx, &self.mean)?;
+        let odd_mean = crate::readback::read_rgba(ctx, &self.odd_mean)?;
+        Ok(self.noise_from(&mean, &odd_mean))
+    }
+
+    /// The estimate from `mean` and `odd_mean` as read back.
+    fn noise_from(&self, mean: &[glam::Vec4], odd_mean: &[glam::Vec4]) -> Option<f64> {
+        let (n, odd) = (self.count as f64, self.count.div_ceil(2) as f64);
+        let sums = |m: &[glam::Vec4], k: f64| -> Vec<[f64; 3]> {
+            m.iter().map(|v| [v.x as f64 * k, v.y as f64 * k, v.z as f64 * k]).collect()
+        };
+        hikari_core::progressive::noise_from_sums(self.width as usize, self.count, &sums(mean, n), &sums(odd_mean, odd))
     }
 
     /// Starts a new mean with the next frame (the camera or scene changed).

@@ -110,9 +110,13 @@ pub fn default_radius(scene: &Scene) -> f32 {
     0.001 * scene.diagonal()
 }
 
-/// The first pass's merging radius in media: 1% of the scene's diagonal.
+/// The first pass's merging radius in media: 0.3% of the scene's
+/// diagonal. In thin fog merges carry little weight, and a larger ball
+/// reaches through the surfaces that bound a medium: at 1% the layered fog
+/// stage (128², 20 s) read 0.7% too dark and 10.7% error, at 0.3% 0.07% and
+/// 9.6% (0.1%: the same).
 pub fn default_volume_radius(scene: &Scene) -> f32 {
-    0.01 * scene.diagonal()
+    0.003 * scene.diagonal()
 }
 
 /// A stored light-subpath vertex.
