@@ -2,7 +2,8 @@
 # Error against time (docs/progressive.md): the error (relRMSE, relative to
 # the reference's mean, as shared/relerr.py) of progressive photon-cpu, the
 # GPU renderer, vertex connection and merging and the path tracer against a long
-# path-traced reference, printed at every checkpoint, for each scene. The
+# path-traced reference, printed at every checkpoint, for each scene, and
+# drawn as one chart per scene ($OUT/SCENE-error.png, `hikari plot`). The
 # references are made once (kept in $OUT, out of the repository).
 #
 #   bash scripts/error-curves.sh            # defaults below
@@ -25,12 +26,15 @@ for scene in ${SCENES:-cornell-box cornell-caustic fog-stage}; do
         "$H" render "$scene" --resolution "$SIZE" --renderer path --spp "$REF_SPP" --seed 12345 -q -o "$ref"
         echo "$scene: reference, $REF_SPP spp path tracing, $(( $(date +%s) - start )) s"
     fi
+    curves="$OUT/$scene-$SIZE-curves.txt"
+    : > "$curves"
     for renderer in ${RENDERERS:-photon-cpu gpu vcm path}; do
         extra=()
         [ "$renderer" = path ] && extra=(--spp 16)
         "$H" render "$scene" --resolution "$SIZE" --renderer "$renderer" --photons "$PHOTONS" \
             --time "$TIME" --checkpoint "$CHECK" --reference "$ref" -q -o "$OUT/$scene-$renderer.exr" "${extra[@]}" \
-            2> "$OUT/$scene-$renderer.log" | sed "s/^/$scene $renderer: /" \
+            2> "$OUT/$scene-$renderer.log" | sed "s/^/$renderer: /" | tee -a "$curves" | sed "s/^/$scene /" \
             || echo "$scene $renderer: did not render ($(tail -1 "$OUT/$scene-$renderer.log"))"
     done
+    "$H" plot "$curves" --title "$scene, $SIZE, $(nproc) cores" -o "$OUT/$scene-error.png" || true
 done

@@ -2,6 +2,7 @@
 
 mod bench_cmd;
 mod passes;
+mod plot_cmd;
 mod progress_bar;
 mod render_cmd;
 mod tracing;
@@ -39,6 +40,8 @@ converges as you look. Saving the scene file reloads it.")]
     Scenes,
     /// Measure the GPU renderer: the seed's chapter-6 table for surfaces.
     Bench(bench_cmd::BenchArgs),
+    /// Draw error against time (what `render --reference` prints) as a chart.
+    Plot(plot_cmd::PlotArgs),
 }
 
 fn main() -> ExitCode {
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
+        Command::Plot(args) => plot_cmd::run(&args),
         Command::View(args) => view::run(args),
         Command::Scenes => {
             for name in hikari_core::scene::builtin::NAMES {

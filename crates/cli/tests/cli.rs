@@ -616,3 +616,29 @@ fn the_default_render_stops_when_the_noise_is_two_percent() {
     assert!(noise <= 2.0, "{err}");
     assert!(dir.join("d.exr").is_file());
 }
+
+/// `hikari plot` draws what `render --reference` prints as a PNG chart;
+/// a missing file, one without curves or another image type is exit 2 and
+/// no file.
+#[test]
+fn plots_error_curves() {
+    let dir = scratch_dir("plot");
+    let text = "vcm: pass 4, 1.02 s: relRMSE 0.21 meanratio 1.0\nvcm: pass 16, 4.1 s: relRMSE 0.11 meanratio 1.0\n\
+                path: pass 2, 1.1 s: relRMSE 0.4 meanratio 1.0\npath: pass 8, 4.3 s: relRMSE 0.2 meanratio 1.0\n";
+    std::fs::write(dir.join("curves.txt"), text).unwrap();
+    let out = hikari(&["plot", "curves.txt", "--title", "test", "-o", "c.png"], &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let chart = image::open(dir.join("c.png")).unwrap();
+    assert_eq!((chart.width(), chart.height()), (800, 560));
+    std::fs::remove_file(dir.join("c.png")).unwrap();
+    std::fs::write(dir.join("empty.txt"), "no curves\n").unwrap();
+    for (args, words) in [
+        (&["plot", "missing.txt", "-o", "bad.png"][..], &["missing.txt"][..]),
+        (&["plot", "empty.txt", "-o", "bad.png"], &["empty.txt", "no error curves"]),
+        (&["plot", "curves.txt", "-o", "bad.jpg"], &["bad.jpg", ".png"]),
+    ] {
+        let out = hikari(args, &dir);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert_fails_with(&out, &dir, words);
+    }
+}

@@ -40,21 +40,34 @@ pub fn write_image(path: &Path, image: &Image, exposure: f32) -> Result<(), Outp
         Some("exr") => ::image::ImageFormat::OpenExr,
         _ => return Err(OutputError::UnsupportedExtension { path: shown }),
     };
-    let wrap = |e: Box<dyn std::error::Error + Send + Sync>| OutputError::Write { path: shown.clone(), source: e };
-    let tmp = temporary_name(path);
-    let result = match format {
+    save_atomically(path, |tmp| match format {
         ::image::ImageFormat::Png => ::image::RgbImage::from_raw(image.width, image.height, tone_map(image, exposure))
             .expect("buffer size matches the image")
-            .save_with_format(&tmp, format),
+            .save_with_format(tmp, format),
         _ => {
             let data: Vec<f32> =
                 image.pixels.iter().flat_map(|p| p.to_array()).map(|c| if c.is_finite() { c } else { 0.0 }).collect();
             ::image::Rgb32FImage::from_raw(image.width, image.height, data)
                 .expect("buffer size matches the image")
-                .save_with_format(&tmp, format)
+                .save_with_format(tmp, format)
         }
-    };
-    if let Err(e) = result {
+    })
+}
+
+/// Writes an 8-bit sRGB image (`data`: RGB rows, `width` × `height`) as
+/// PNG, atomically, as [`write_image`] does (a chart, a screenshot).
+pub fn write_rgb8_png(path: &Path, width: u32, height: u32, data: Vec<u8>) -> Result<(), OutputError> {
+    let image = ::image::RgbImage::from_raw(width, height, data).expect("buffer size matches the image");
+    save_atomically(path, |tmp| image.save_with_format(tmp, ::image::ImageFormat::Png))
+}
+
+/// Saves by `save` to a temporary name beside `path`, then renames it, so
+/// no half-written file ever has the name asked for.
+fn save_atomically(path: &Path, save: impl FnOnce(&Path) -> ::image::ImageResult<()>) -> Result<(), OutputError> {
+    let shown = path.display().to_string();
+    let wrap = |e: Box<dyn std::error::Error + Send + Sync>| OutputError::Write { path: shown.clone(), source: e };
+    let tmp = temporary_name(path);
+    if let Err(e) = save(&tmp) {
         let _ = std::fs::remove_file(&tmp);
         return Err(wrap(Box::new(e)));
     }
