@@ -46,7 +46,7 @@ pub enum RendererKind {
     Path,
     /// Vertex connection and merging: light tracing, bidirectional
     /// connections and photon merging weighted by MIS, in progressive
-    /// passes (16 unless --passes or --time says otherwise). No fog yet.
+    /// passes, fog included (points in media merge within a ball).
     Vcm,
 }
 
