@@ -171,9 +171,12 @@ win=$(xdotool search --sync --name "hikari view")
 xdotool windowfocus --sync "$win"
 sleep 0.6
 cp broken.toml scene.toml
-sleep 1.0
+# Wait for the viewer to see each save (it looks between frames, which a
+# loaded machine makes slow), at most 30 s.
+for i in $(seq 150); do grep -q "last good scene" err.txt && break; sleep 0.2; done
 cp brighter.toml scene.toml
-sleep 1.5
+for i in $(seq 150); do grep -q "reloaded" err.txt && break; sleep 0.2; done
+sleep 0.3
 xdotool key Escape
 wait $pid
 "#;

@@ -140,8 +140,8 @@ pub fn noise_from_sums(width: usize, passes: u32, sums: &[[f64; 3]], odd_sums: &
     let n = passes as f64;
     let (k_a, k_b) = ((n / 2.0).ceil(), (n / 2.0).floor());
     let mut values: Vec<f64> = sums.iter().flatten().copied().collect();
-    values.sort_by(f64::total_cmp);
-    let median = values[values.len() / 2];
+    let middle = values.len() / 2;
+    let median = *values.select_nth_unstable_by(middle, f64::total_cmp).1;
     let lit: Vec<bool> = sums.iter().map(|s| s.iter().copied().fold(0.0, f64::max) >= 50.0 * median).collect();
     let height = sums.len() / width.max(1);
     let near_light = |i: usize| {

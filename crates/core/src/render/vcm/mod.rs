@@ -250,8 +250,7 @@ struct Subpaths<'a> {
 
 /// The light vertices of one kind (surface or volume) in a hash grid.
 struct MergeGrid {
-    positions: Vec<Vec3>,
-    /// Index in the pass's vertices of each position.
+    /// Index in the pass's vertices of each of the grid's points.
     indices: Vec<u32>,
     grid: HashGrid,
 }
@@ -264,12 +263,11 @@ impl MergeGrid {
             .filter(|(_, v)| v.scatter.in_medium() == medium)
             .map(|(i, v)| (v.position, i as u32))
             .unzip();
-        let grid = HashGrid::new(&positions, radius);
-        MergeGrid { positions, indices, grid }
+        MergeGrid { indices, grid: HashGrid::new(&positions, radius) }
     }
 
     fn query(&self, p: Vec3, mut visit: impl FnMut(usize)) {
-        self.grid.query(&self.positions, p, |i| visit(self.indices[i] as usize));
+        self.grid.query(p, |i| visit(self.indices[i] as usize));
     }
 }
 
