@@ -18,7 +18,7 @@ use hikari_core::render::{Image, path, photon_cpu, vcm};
 /// path tracer) renders passes until the noise they estimate falls to this
 /// fraction of the image's mean, or for this many seconds, whichever first.
 pub const DEFAULT_TARGET_ERROR: f64 = 0.02;
-pub const DEFAULT_TIME_LIMIT: f64 = 60.0;
+pub const DEFAULT_TIME_LIMIT: f64 = 20.0;
 /// Samples per pixel of the path tracer's open-ended passes (without --spp).
 const PATH_PASS_SPP: u32 = 4;
 use hikari_core::scene::{Scene, builtin};
@@ -197,7 +197,7 @@ pub struct RenderArgs {
     /// Progressive photon mapping (docs/progressive.md): render up to this
     /// many passes, each with a fresh photon set and smaller radii, and
     /// average them, 1 to 1,000,000; `--passes 1` is the seed's single
-    /// pass [default: until the estimated noise is 2% or 60 s have passed;
+    /// pass [default: until the estimated noise is 2% or 20 s have passed;
     /// no limit with --time or --target-error]. With --renderer path, passes
     /// of --spp samples (a single pass where --spp alone is given).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]

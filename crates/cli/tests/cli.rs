@@ -593,7 +593,7 @@ fn renders_until_the_target_error() {
 }
 
 /// With nothing said about when to stop, a render is progressive: passes
-/// until the noise they estimate is 2% (or a minute), on the GPU (which
+/// until the noise they estimate is 2% (or 20 s), on the GPU (which
 /// reads its two half-means back) or on the CPU after a line saying why.
 /// (A floor and a box under a sun and a sky: about 64 passes; small shadow
 /// maps, which lavapipe redraws each pass.)
