@@ -137,3 +137,50 @@ fn vcm_converges_to_path_in_layered_fog() {
     let settings = VcmSettings { volume_radius: Some(0.02 * scene.diagonal()), ..with(Strategies::All) };
     converges_to("fog-stage-layered", &scene, settings, 1.2, &reference, 0.02);
 }
+
+/// Without connections VCM is progressive photon mapping: its passes and
+/// progressive `photon-cpu`'s (as many light paths a pass, the same first
+/// radius and schedule) make the same image up to the noise of each and
+/// the difference of their blurs (photon-cpu takes direct light by shadow
+/// rays, merging blurs it too): the means within 2%, the difference at most
+/// 1.3 times what the two noise estimates add up to (measured: 1.14, at
+/// 3% of the diagonal and 64 passes).
+#[test]
+fn merging_alone_agrees_with_progressive_photon_mapping() {
+    use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, photon_cpu_pass};
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    let scene = small("cornell-box", 48);
+    let radius = 0.03 * scene.diagonal();
+    let passes = 64;
+    let settings = VcmSettings { radius: Some(radius), ..with(Strategies::Merging) };
+    let mut merging = ImageMean::new(48, 48);
+    for pass in 1..=passes {
+        merging.add(&render_pass(&scene, &settings, pass).unwrap().0);
+    }
+    let photon_settings =
+        PhotonCpuSettings { radius: Some(radius), caustic_radius: Some(radius), spp: 1, seed: 7, ..Default::default() };
+    let schedules = Schedules::new([radius, radius, radius], DEFAULT_ALPHA);
+    let mut photon = ImageMean::new(48, 48);
+    for pass in 1..=passes {
+        photon.add(&photon_cpu_pass(&scene, &photon_settings, 48 * 48, &schedules, pass).0);
+    }
+    let (a, b) = (merging.mean(), photon.mean());
+    let e = compare_where(&a, &b, &without_lights(&a, &b)).unwrap();
+    let (na, nb) = (merging.noise_estimate().unwrap(), photon.noise_estimate().unwrap());
+    let expected = (na * na + nb * nb).sqrt();
+    eprintln!(
+        "merging alone against photon-cpu, {passes} passes: relRMSE {:.4}, mean ratio {:.4}; their noise {na:.4} and {nb:.4} (together {expected:.4})",
+        e.relative_to_mean, e.mean_ratio
+    );
+    assert!((e.mean_ratio - 1.0).abs() < 0.02, "mean ratio {}", e.mean_ratio);
+    assert!(e.relative_to_mean < 1.3 * expected, "difference {} against noise {expected}", e.relative_to_mean);
+}
+
+/// Without merging VCM is unbiased on every built-in scene (those the tests
+/// above leave out here, small).
+#[test]
+fn bidirectional_converges_to_path_on_the_other_built_in_scenes() {
+    for name in ["cornell-caustic", "cornell-orbit", "fog-stage-layered"] {
+        converges_with(name, &small(name, 24), with(Strategies::Connections), 1.2, 1024, 0.02);
+    }
+}
