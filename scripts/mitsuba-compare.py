@@ -11,12 +11,14 @@ that the reference's own noise can be subtracted:
     E|a - ref|^2 = E|a - truth|^2 + E|ref - truth|^2,
     E|ref - truth|^2 ~ |half1 - half2|^2 / 4 (per pixel, summed),
 
-and the error is the project's relative RMSE, sqrt(sum|a - b|^2 / sum|b|^2).
+and the error is the project's metric (shared/relerr.py --halves): the
+per-pixel RMS error over the reference's mean.
 The two references are also compared with each other: two independent
 renderers agreeing on the same scene.
 
 Mitsuba is not a dependency of hikari; this is a benchmark script:
 
+    apt-get install libllvm19   # for the llvm_* variants
     python3 -m venv /tmp/mts && /tmp/mts/bin/pip install mitsuba numpy
     cargo build --release
     /tmp/mts/bin/python scripts/mitsuba-compare.py --time 80 --size 256
@@ -32,7 +34,10 @@ import tomllib
 import mitsuba as mi
 import numpy as np
 
-mi.set_variant("scalar_rgb")
+# MITSUBA_VARIANT=scalar_rgb for the one-sample-at-a-time CPU variant;
+# llvm_ad_rgb (the default here) is Mitsuba's fastest on a CPU: wavefront,
+# JIT-compiled to vector code by LLVM (Debian's libllvm19).
+mi.set_variant(os.environ.get("MITSUBA_VARIANT", "llvm_ad_rgb"))
 T = mi.ScalarTransform4f
 
 
@@ -102,7 +107,7 @@ def mitsuba_scene(toml_path, size, rfilter):
 class Mitsuba:
     def __init__(self, toml_path, size, rfilter):
         self.scene = mitsuba_scene(toml_path, size, rfilter)
-        self.name = f"Mitsuba 3 {mi.__version__} path ({rfilter} filter)"
+        self.name = f"Mitsuba 3 {mi.__version__} {mi.variant()} path ({rfilter} filter)"
 
     def render(self, spp, seed):
         start = time.perf_counter()
@@ -143,13 +148,13 @@ class Reference:
         self.seconds = ta + tb
 
     def relative_rmse(self, image):
-        """Relative RMSE of `image` against the truth: measured against the
-        reference, minus the reference's own noise."""
+        """The project's metric (shared/relerr.py --halves): per-pixel RMS
+        error over the reference's mean, the reference's own noise removed."""
         measured = squared_norm(image - self.image)
-        return math.sqrt(max(measured - self.noise, 0.0) / squared_norm(self.image))
+        return math.sqrt(max(measured - self.noise, 0.0) / image.size) / self.image.mean()
 
     def raw_relative_rmse(self, image):
-        return math.sqrt(squared_norm(image - self.image) / squared_norm(self.image))
+        return math.sqrt(squared_norm(image - self.image) / image.size) / self.image.mean()
 
 
 def main():
@@ -176,7 +181,7 @@ def main():
         ref = Reference(r, args.ref_spp, (1001, 2002))
         references[r.name] = ref
         print(f"# {r.name}: reference {args.ref_spp} spp in {ref.seconds:.1f} s, "
-              f"its own relative RMSE {math.sqrt(ref.noise / squared_norm(ref.image)):.4f}", file=sys.stderr)
+              f"its own relative RMSE {math.sqrt(ref.noise / ref.image.size) / ref.image.mean():.4f}", file=sys.stderr)
         # Samples per second from the reference, then one run sized to the
         # budget; its error is also scaled to the budget exactly (variance
         # falls as 1/time for an unbiased renderer).

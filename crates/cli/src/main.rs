@@ -1,6 +1,7 @@
 //! `hikari`: the command-line renderer.
 
 mod bench_cmd;
+mod merge_cmd;
 mod passes;
 mod plot_cmd;
 mod progress_bar;
@@ -42,6 +43,8 @@ converges as you look. Saving the scene file reloads it.")]
     Bench(bench_cmd::BenchArgs),
     /// Draw error against time (what `render --reference` prints) as a chart.
     Plot(plot_cmd::PlotArgs),
+    /// Add up the parts of a render split by `render --shard K/M` into its image.
+    Merge(merge_cmd::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +53,7 @@ fn main() -> ExitCode {
         Command::Render(args) => render_cmd::run(&args),
         Command::Bench(args) => bench_cmd::run(&args),
         Command::Plot(args) => plot_cmd::run(&args),
+        Command::Merge(args) => merge_cmd::run(&args),
         Command::View(args) => view::run(args),
         Command::Scenes => {
             for name in hikari_core::scene::builtin::NAMES {

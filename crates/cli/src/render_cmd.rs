@@ -11,6 +11,7 @@ use hikari_core::output::write_image;
 use hikari_core::photon::TracedPhotons;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
+use hikari_core::progressive::shard::{Part, PartHeader, Shard, fingerprint};
 use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_trace_settings};
 use hikari_core::render::{Image, path, photon_cpu, vcm};
 
@@ -225,6 +226,12 @@ pub struct RenderArgs {
     /// the same error on 16×16 blocks, and the older RMS-relative figure.
     #[arg(long)]
     pub reference: Option<PathBuf>,
+    /// Render only shard K of M: passes K, K + M, K + 2M, … of --passes
+    /// N (or as many as --time allows), the same passes, seeds and radii
+    /// one run of all N renders, into an .exr part that `hikari merge`
+    /// adds up with the other shards' into that run's image (docs/cluster.md).
+    #[arg(long, value_parser = Shard::parse, value_name = "K/M")]
+    pub shard: Option<Shard>,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
@@ -506,9 +513,46 @@ fn parse_fraction(text: &str) -> Result<f64, String> {
     }
 }
 
-/// Renders in passes (`--passes`, `--time`, `--reference`) with `kind`; the
-/// GPU falls back to photon-cpu as the single pass does.
-fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Result<(Image, u64)> {
+/// What a render in passes made: the image, the non-finite samples
+/// dropped and, for a shard, what its part keeps.
+struct Passes {
+    image: Image,
+    nonfinite: u64,
+    part: Option<PartBody>,
+}
+
+/// A shard's passes: its sums, which passes, and who rendered them.
+struct PartBody {
+    sums: Vec<[f64; 3]>,
+    passes: Vec<u32>,
+    stopped_early: bool,
+    /// The renderer that ran (after any fallback), with how (gpu: where photons were traced, the estimator).
+    renderer: String,
+}
+
+/// What `renderer` made of `plan` (`done`): a shard keeps its sums.
+fn finish<R: passes::PassRenderer>(
+    done: passes::Outcome,
+    renderer: &mut R,
+    plan: &PassPlan,
+    name: &str,
+    nonfinite: impl Fn(&R) -> u64,
+) -> Result<Passes> {
+    let part = match plan.shard {
+        None => None,
+        Some(_) => Some(PartBody {
+            sums: renderer.sums()?,
+            passes: done.passes,
+            stopped_early: done.stopped_early,
+            renderer: name.to_string(),
+        }),
+    };
+    Ok(Passes { image: done.image, nonfinite: nonfinite(renderer), part })
+}
+
+/// Renders in passes (`--passes`, `--time`, `--reference`, `--shard`) with
+/// `kind`; the GPU falls back to photon-cpu as the single pass does.
+fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Result<Passes> {
     let reference = match &args.reference {
         None => None,
         Some(path) => {
@@ -535,6 +579,7 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
     let open_ended = time.is_some() || target_error.is_some();
     let plan = PassPlan {
         passes: args.passes.unwrap_or(if open_ended { u32::MAX } else { 1 }),
+        shard: args.shard,
         target_error,
         time: time.map(Duration::from_secs_f64),
         checkpoint: args.checkpoint.map(Duration::from_secs_f64),
@@ -549,8 +594,8 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
         let settings = path::PathSettings { spp, seed: args.seed, ..Default::default() };
         eprintln!("path tracing in passes of {} spp", settings.spp);
         let mut passes = PathPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
-        let (image, _) = passes::run(&mut passes, &plan)?;
-        return Ok((image, passes.nonfinite));
+        let done = passes::run(&mut passes, &plan)?;
+        return finish(done, &mut passes, &plan, "path", |p| p.nonfinite);
     }
     if kind == RendererKind::Vcm {
         let settings = vcm::VcmSettings {
@@ -573,8 +618,8 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             settings.strategies, args.alpha
         );
         let mut passes = VcmPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
-        let (image, _) = passes::run(&mut passes, &plan)?;
-        return Ok((image, passes.nonfinite));
+        let done = passes::run(&mut passes, &plan)?;
+        return finish(done, &mut passes, &plan, "vcm", |p| p.nonfinite);
     }
     let settings = cpu_settings(args);
     let (global, caustic) = settings.estimate_params(scene);
@@ -595,11 +640,26 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             let adapter = ctx.describe();
             let mut tracer = PhotonTracer::choose(args.trace, Some(&ctx), scene);
             let device = tracer.device();
-            let first = tracer.trace(scene, &pass_trace_settings(args.photons, args.seed, 1), &Silent);
+            // A shard's first pass builds the renderer (a shard with no passes: pass 1).
+            let first_pass = plan.shard.map_or(1, |s| s.index);
+            let first = tracer.trace(scene, &pass_trace_settings(args.photons, args.seed, first_pass), &Silent);
             let gpu_settings = GpuSettings { estimator: args.estimator.on(&ctx), ..gpu_settings };
             let estimator = gpu_settings.estimator;
-            let run = GpuPasses::new(ctx, scene, &first, gpu_settings, args.photons, args.seed, schedules, tracer)
-                .and_then(|mut passes| passes::run(&mut passes, &plan).map(|(image, _)| (image, passes.nonfinite)));
+            let name = format!("gpu ({estimator:?} estimator, photons traced on the {device})");
+            let run = GpuPasses::new(
+                ctx,
+                scene,
+                (first_pass, &first),
+                gpu_settings,
+                args.photons,
+                args.seed,
+                schedules,
+                tracer,
+            )
+            .and_then(|mut passes| {
+                let done = passes::run(&mut passes, &plan)?;
+                finish(done, &mut passes, &plan, &name, |p| p.nonfinite)
+            });
             match run {
                 Ok(result) => {
                     eprintln!(
@@ -621,8 +681,46 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
         nonfinite: 0,
         tracer,
     };
-    let (image, _) = passes::run(&mut passes, &plan)?;
-    Ok((image, passes.nonfinite))
+    let done = passes::run(&mut passes, &plan)?;
+    finish(done, &mut passes, &plan, "photon-cpu", |p| p.nonfinite)
+}
+
+/// The fingerprint of the scene's content: the built-in scene's text or
+/// the file's bytes (not the meshes and textures it names).
+fn scene_fingerprint(spec: &str) -> Result<String> {
+    match builtin::source(spec) {
+        Some(text) => Ok(fingerprint(text.as_bytes())),
+        None => Ok(fingerprint(&std::fs::read(spec).with_context(|| format!("reading {spec} again"))?)),
+    }
+}
+
+/// Every flag that changes a pass's image, by name, as a shard's part
+/// records them for the merge to compare (not --passes, --time, --shard,
+/// the output, --threads: the same image whatever the thread count).
+fn image_settings(args: &RenderArgs) -> std::collections::BTreeMap<String, String> {
+    let mut map = std::collections::BTreeMap::new();
+    let mut set = |key: &str, value: String| map.insert(key.to_string(), value);
+    set("renderer", format!("{:?}", args.renderer));
+    set("trace", format!("{:?}", args.trace));
+    set("estimator", format!("{:?}", args.estimator));
+    set("photons", args.photons.to_string());
+    set("radius", format!("{:?}", args.radius));
+    set("caustic-radius", format!("{:?}", args.caustic_radius));
+    set("volume-radius", format!("{:?}", args.volume_radius));
+    set("spp", format!("{:?}", args.spp));
+    set("resolution", format!("{:?}", args.resolution.map(|r| (r.width, r.height))));
+    set("camera", format!("{:?}", args.camera));
+    set("environment", format!("{:?}", args.environment));
+    set("vcm-strategies", format!("{:?}", args.vcm_strategies));
+    set("seed", args.seed.to_string());
+    set("at", format!("{:?}", args.at));
+    set("shadow-map-size", args.shadow_map_size.to_string());
+    set("area-light-samples", args.area_light_samples.to_string());
+    set("volume-slices", args.volume_slices.to_string());
+    set("normal-test", format!("{:?}", args.normal_test));
+    set("lod", format!("{:?} {:?} {}", args.lod_near, args.lod_far, args.lod_groups));
+    set("alpha", format!("{:?}", args.alpha));
+    map
 }
 
 /// A bad flag or scene: the CLI exits with code 2 (as clap does for its own
@@ -682,6 +780,29 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !matches!(ext.as_deref(), Some("png" | "exr")) {
         usage!("{}: unsupported image type (use .png or .exr)", args.output.display());
     }
+    if let Some(shard) = args.shard {
+        if ext.as_deref() != Some("exr") {
+            usage!(
+                "--shard: {} must be an .exr file (a part keeps sums; `hikari merge` writes the PNG)",
+                args.output.display()
+            );
+        }
+        if args.passes.is_none() && args.time.is_none() {
+            usage!(
+                "--shard {}/{} needs --passes N (the whole render's pass count) or --time",
+                shard.index,
+                shard.count
+            );
+        }
+        if args.target_error.is_some() || args.checkpoint.is_some() {
+            usage!(
+                "--shard: --target-error and --checkpoint judge one image; a shard is a share of one (merge the parts)"
+            );
+        }
+        if let Some(n) = args.passes.filter(|&n| shard.count > n) {
+            usage!("--shard {}/{}: more shards than --passes {n} (some would have no pass)", shard.index, shard.count);
+        }
+    }
     if let Some(threads) = args.threads {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads as usize)
@@ -704,22 +825,44 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
-    let progressive = progressive(args);
-    let (image, nonfinite) = match renderer {
-        _ if progressive => render_in_passes(args, renderer, &scene)?,
+    let progressive = progressive(args) || args.shard.is_some();
+    let in_passes = |kind| render_in_passes(args, kind, &scene);
+    let Passes { image, nonfinite, part } = match renderer {
+        _ if progressive => in_passes(renderer)?,
         RendererKind::Path => {
             let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
-            let result = path::render(&scene, &settings, &progress);
+            let (image, nonfinite) = path::render(&scene, &settings, &progress);
             eprintln!("path tracing: {} spp", settings.spp);
-            result
+            Passes { image, nonfinite, part: None }
         }
-        RendererKind::Gpu | RendererKind::PhotonCpu => render_photons(args, renderer, &scene, &progress)?,
-        RendererKind::Vcm => render_in_passes(args, renderer, &scene)?,
+        RendererKind::Gpu | RendererKind::PhotonCpu => {
+            let (image, nonfinite) = render_photons(args, renderer, &scene, &progress)?;
+            Passes { image, nonfinite, part: None }
+        }
+        RendererKind::Vcm => in_passes(renderer)?,
     };
     if nonfinite > 0 {
         eprintln!("warning: {nonfinite} non-finite samples were dropped");
     }
-    write_image(&args.output, &image, args.exposure)?;
+    match (part, args.shard) {
+        (Some(body), Some(shard)) => {
+            let header = PartHeader {
+                renderer: body.renderer,
+                scene: args.scene.clone(),
+                scene_hash: scene_fingerprint(&args.scene)?,
+                settings: image_settings(args),
+                width: image.width,
+                height: image.height,
+                total_passes: args.passes,
+                shard: shard.index,
+                shards: shard.count,
+                passes: body.passes,
+                stopped_early: body.stopped_early,
+            };
+            Part { header, sums: body.sums }.write(&args.output).map_err(anyhow::Error::msg)?;
+        }
+        _ => write_image(&args.output, &image, args.exposure)?,
+    }
     eprintln!(
         "wrote {} ({}x{}) in {:.2} s total",
         args.output.display(),

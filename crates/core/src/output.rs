@@ -61,6 +61,20 @@ pub fn write_rgb8_png(path: &Path, width: u32, height: u32, data: Vec<u8>) -> Re
     save_atomically(path, |tmp| image.save_with_format(tmp, ::image::ImageFormat::Png))
 }
 
+/// Writes by `write` to a temporary name beside `path`, then renames it,
+/// so no half-written file ever has the name asked for. Errors name `path`.
+pub fn atomically(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+    let tmp = temporary_name(path);
+    if let Err(e) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(format!("{}: {e}", path.display()));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: {e}", path.display())
+    })
+}
+
 /// Saves by `save` to a temporary name beside `path`, then renames it, so
 /// no half-written file ever has the name asked for.
 fn save_atomically(path: &Path, save: impl FnOnce(&Path) -> ::image::ImageResult<()>) -> Result<(), OutputError> {

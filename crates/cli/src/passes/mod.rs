@@ -9,6 +9,7 @@ pub mod renderers;
 use anyhow::{Result, anyhow};
 use hikari_core::output::write_image;
 use hikari_core::progressive::compare;
+use hikari_core::progressive::shard::Shard;
 use hikari_core::render::Image;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -29,12 +30,17 @@ pub trait PassRenderer {
     fn noise(&mut self) -> Option<f64> {
         None
     }
+    /// The per-pixel sums of the passes so far (row-major), what a shard
+    /// of the render keeps for the merge.
+    fn sums(&mut self) -> Result<Vec<[f64; 3]>>;
 }
 
 /// When to stop and what to report.
 pub struct PassPlan {
-    /// At most this many passes.
+    /// At most this many passes: passes 1..=passes, or a shard's share of them.
     pub passes: u32,
+    /// Which of the passes to render (`--shard K/M`: K, K + M, …; None: all).
+    pub shard: Option<Shard>,
     /// Stop after the first pass that ends past this.
     pub time: Option<Duration>,
     /// Write the image so far (and compare it) this often.
@@ -79,15 +85,24 @@ fn report(plan: &PassPlan, image: &Image, pass: u32, seconds: f64) -> Result<()>
     Ok(())
 }
 
-/// Runs the passes; returns the mean and the number of passes rendered.
-pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u32)> {
+/// What a run of passes made.
+pub struct Outcome {
+    pub image: Image,
+    /// The passes rendered, in order.
+    pub passes: Vec<u32>,
+    /// Whether it stopped before its last pass (time, target error, Ctrl-C).
+    pub stopped_early: bool,
+}
+
+/// Runs the plan's passes (its shard's share of 1..=passes) in order.
+pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<Outcome> {
     let stop = interrupted();
     let bar = if plan.quiet {
         ProgressBar::with_draw_target(Some(plan.passes as u64), ProgressDrawTarget::hidden())
     } else if plan.passes == u32::MAX {
         ProgressBar::new_spinner()
     } else {
-        ProgressBar::new(plan.passes as u64)
+        ProgressBar::new(plan.shard.unwrap_or(Shard::WHOLE).len(plan.passes) as u64)
     };
     bar.set_style(
         ProgressStyle::with_template("{msg:>40} [{bar:30}] {pos}/{len} passes {elapsed_precise} eta {eta}")
@@ -96,22 +111,24 @@ pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u
     );
     let start = Instant::now();
     let mut last_checkpoint = start;
-    let mut pass = 0;
+    let mut rendered = Vec::new();
+    let mut upcoming = plan.shard.unwrap_or(Shard::WHOLE).passes(plan.passes).peekable();
     let why = loop {
-        pass += 1;
+        let Some(pass) = upcoming.next() else { break "the pass count" };
         renderer.render_pass(pass)?;
+        rendered.push(pass);
         bar.inc(1);
         let noise = renderer.noise();
         let mut message = noise.map_or(String::new(), |e| format!("noise ≈ {:.2}%", 100.0 * e));
-        if let Some(r) = renderer.radius(pass + 1) {
+        if let Some(r) = upcoming.peek().and_then(|&next| renderer.radius(next)) {
             message = format!("{message}{}next radius {r:.5}", if message.is_empty() { "" } else { ", " });
         }
         bar.set_message(message);
         let elapsed = start.elapsed();
-        if pass >= plan.passes {
+        if upcoming.peek().is_none() {
             break "the pass count";
         }
-        if pass >= 4 && plan.target_error.zip(noise).is_some_and(|(target, e)| e <= target) {
+        if rendered.len() >= 4 && plan.target_error.zip(noise).is_some_and(|(target, e)| e <= target) {
             break "the target error";
         }
         if plan.time.is_some_and(|t| elapsed >= t) {
@@ -124,16 +141,26 @@ pub fn run(renderer: &mut dyn PassRenderer, plan: &PassPlan) -> Result<(Image, u
             last_checkpoint = Instant::now();
             let image = renderer.mean()?;
             write_image(&plan.output, &image, plan.exposure)?;
-            bar.suspend(|| report(plan, &image, pass, elapsed.as_secs_f64()))?;
+            bar.suspend(|| report(plan, &image, rendered.len() as u32, elapsed.as_secs_f64()))?;
         }
     };
+    let count = rendered.len() as u32;
     bar.finish_and_clear();
     let image = renderer.mean()?;
     let seconds = start.elapsed().as_secs_f64();
     let noise = renderer.noise().map_or(String::new(), |e| format!("; estimated noise {:.2}%", 100.0 * e));
-    eprintln!("{pass} passes in {seconds:.2} s (stopped by {why}){noise}");
-    report(plan, &image, pass, seconds)?;
-    Ok((image, pass))
+    let shard =
+        plan.shard.map_or(String::new(), |s| format!(" of shard {}/{} ({})", s.index, s.count, list(&rendered)));
+    eprintln!("{count} passes{shard} in {seconds:.2} s (stopped by {why}){noise}");
+    report(plan, &image, count, seconds)?;
+    let stopped_early = upcoming.peek().is_some();
+    Ok(Outcome { image, passes: rendered, stopped_early })
+}
+
+/// "1, 4, 7" (at most a few, then "…").
+fn list(passes: &[u32]) -> String {
+    let shown: Vec<String> = passes.iter().take(6).map(u32::to_string).collect();
+    format!("passes {}{}", shown.join(", "), if passes.len() > 6 { ", …" } else { "" })
 }
 
 /// Reads a reference image: linear float RGB from an EXR file.
@@ -154,6 +181,9 @@ mod tests {
             self.0 = pass;
             Ok(())
         }
+        fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+            unreachable!()
+        }
         fn mean(&mut self) -> Result<Image> {
             let mut image = Image::new(1, 1);
             image.pixels[0] = glam::Vec3::splat((self.0 + 1) as f32 / 2.0);
@@ -167,6 +197,7 @@ mod tests {
     fn plan(passes: u32, time: Option<Duration>) -> PassPlan {
         PassPlan {
             passes,
+            shard: None,
             time,
             checkpoint: None,
             reference: None,
@@ -179,10 +210,42 @@ mod tests {
 
     #[test]
     fn stops_at_the_pass_count_or_the_time_limit() {
-        let (image, passes) = run(&mut Counting(0), &plan(5, None)).unwrap();
-        assert_eq!((passes, image.pixels[0].x), (5, 3.0));
-        let (_, passes) = run(&mut Counting(0), &plan(u32::MAX, Some(Duration::ZERO))).unwrap();
-        assert_eq!(passes, 1, "a time limit still renders one pass");
+        let done = run(&mut Counting(0), &plan(5, None)).unwrap();
+        assert_eq!((done.passes.len(), done.image.pixels[0].x, done.stopped_early), (5, 3.0, false));
+        let done = run(&mut Counting(0), &plan(u32::MAX, Some(Duration::ZERO))).unwrap();
+        assert_eq!((done.passes.len(), done.stopped_early), (1, true), "a time limit still renders one pass");
+    }
+
+    /// Records the passes it is asked for.
+    struct Recording(Vec<u32>);
+
+    impl PassRenderer for Recording {
+        fn render_pass(&mut self, pass: u32) -> Result<()> {
+            self.0.push(pass);
+            Ok(())
+        }
+        fn mean(&mut self) -> Result<Image> {
+            Ok(Image::new(1, 1))
+        }
+        fn radius(&self, _: u32) -> Option<f32> {
+            None
+        }
+        fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+            Ok(vec![[0.0; 3]])
+        }
+    }
+
+    #[test]
+    fn a_shard_renders_its_share_of_the_passes() {
+        let shard = |k, m| PassPlan { shard: Some(Shard { index: k, count: m }), ..plan(7, None) };
+        for (k, m, expected) in [(1, 3, vec![1, 4, 7]), (3, 3, vec![3, 6]), (7, 7, vec![7]), (2, 2, vec![2, 4, 6])] {
+            let mut recording = Recording(Vec::new());
+            let done = run(&mut recording, &shard(k, m)).unwrap();
+            assert_eq!((&recording.0, &done.passes, done.stopped_early), (&expected, &expected, false));
+        }
+        // More shards than passes: shard 9 of 9 has none of 7.
+        let mut recording = Recording(Vec::new());
+        assert!(run(&mut recording, &shard(9, 9)).unwrap().passes.is_empty());
     }
 
     /// Passes whose noise estimate is 1/n: a target of 0.1 stops at pass
@@ -202,13 +265,17 @@ mod tests {
         fn noise(&mut self) -> Option<f64> {
             Some(1.0 / self.0.0 as f64)
         }
+        fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+            self.0.sums()
+        }
     }
 
     #[test]
     fn stops_at_the_target_error() {
         let target = |t| PassPlan { target_error: Some(t), ..plan(u32::MAX, None) };
-        assert_eq!(run(&mut Quieting(Counting(0)), &target(0.1)).unwrap().1, 10);
-        assert_eq!(run(&mut Quieting(Counting(0)), &target(0.9)).unwrap().1, 4);
-        assert_eq!(run(&mut Counting(0), &PassPlan { target_error: Some(0.5), ..plan(7, None) }).unwrap().1, 7);
+        let passes = |done: Outcome| done.passes.len();
+        assert_eq!(passes(run(&mut Quieting(Counting(0)), &target(0.1)).unwrap()), 10);
+        assert_eq!(passes(run(&mut Quieting(Counting(0)), &target(0.9)).unwrap()), 4);
+        assert_eq!(passes(run(&mut Counting(0), &PassPlan { target_error: Some(0.5), ..plan(7, None) }).unwrap()), 7);
     }
 }

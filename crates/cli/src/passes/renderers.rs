@@ -45,6 +45,10 @@ impl PassRenderer for CpuPasses<'_> {
         self.mean.noise_estimate()
     }
 
+    fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+        Ok(self.mean.sums().to_vec())
+    }
+
     fn radius(&self, pass: u32) -> Option<f32> {
         Some(self.schedules.global.radius(pass))
     }
@@ -73,6 +77,10 @@ impl PassRenderer for PathPasses<'_> {
 
     fn noise(&mut self) -> Option<f64> {
         self.mean.noise_estimate()
+    }
+
+    fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+        Ok(self.mean.sums().to_vec())
     }
 
     fn radius(&self, _: u32) -> Option<f32> {
@@ -105,6 +113,10 @@ impl PassRenderer for VcmPasses<'_> {
         self.mean.noise_estimate()
     }
 
+    fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+        Ok(self.mean.sums().to_vec())
+    }
+
     fn radius(&self, pass: u32) -> Option<f32> {
         let first = self.settings.radius.unwrap_or_else(|| vcm::default_radius(self.scene));
         Some(hikari_core::progressive::RadiusSchedule::disc(first, self.settings.alpha).radius(pass))
@@ -123,8 +135,8 @@ pub struct GpuPasses<'a> {
     photons: u64,
     seed: u64,
     schedules: Schedules,
-    /// Pass 1's photons, which the renderer was built with.
-    first_built: bool,
+    /// The pass whose photons the renderer was built with, until it is rendered.
+    first_built: Option<u32>,
     tracer: PhotonTracer,
     pub nonfinite: u64,
     /// The last noise estimate (`AccumulatePass::noise_due`: reading the
@@ -133,21 +145,28 @@ pub struct GpuPasses<'a> {
 }
 
 impl<'a> GpuPasses<'a> {
-    /// A renderer of `scene` built with pass 1's photons `first` (traced
-    /// with `seed`) at the schedule's first radii; later passes trace with `tracer`.
+    /// A renderer of `scene` built with pass `first_pass`'s photons `first`
+    /// (traced with `pass_trace_settings`) at that pass's radii; other
+    /// passes trace with `tracer`.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         ctx: GpuContext,
         scene: &'a Scene,
-        first: &TracedPhotons,
+        (first_pass, first): (u32, &TracedPhotons),
         mut settings: GpuSettings,
         photons: u64,
         seed: u64,
         schedules: Schedules,
         tracer: PhotonTracer,
     ) -> Result<Self> {
-        [settings.global.radius, settings.caustic.radius, settings.volume_radius] = schedules.radii(1);
-        let renderer = GpuRenderer::new(ctx, scene, first, settings)?;
+        [settings.global.radius, settings.caustic.radius, settings.volume_radius] = schedules.radii(first_pass);
+        settings.pass = first_pass;
+        let mut renderer = GpuRenderer::new(ctx, scene, first, settings)?;
+        if first_pass != 1 {
+            let mut camera = renderer.camera().clone();
+            camera.jitter = pass_jitter(first_pass);
+            renderer.set_camera(&camera)?;
+        }
         let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
         Ok(GpuPasses {
             scene,
@@ -156,7 +175,7 @@ impl<'a> GpuPasses<'a> {
             photons,
             seed,
             schedules,
-            first_built: true,
+            first_built: Some(first_pass),
             tracer,
             nonfinite: 0,
             noise: None,
@@ -166,8 +185,7 @@ impl<'a> GpuPasses<'a> {
 
 impl PassRenderer for GpuPasses<'_> {
     fn render_pass(&mut self, pass: u32) -> Result<()> {
-        let built = std::mem::take(&mut self.first_built);
-        if !(built && pass == 1) {
+        if self.first_built.take() != Some(pass) {
             let traced = self.tracer.trace(self.scene, &pass_trace_settings(self.photons, self.seed, pass), &Silent);
             let s = &mut self.renderer.settings;
             [s.global.radius, s.caustic.radius, s.volume_radius] = self.schedules.radii(pass);
@@ -192,6 +210,13 @@ impl PassRenderer for GpuPasses<'_> {
 
     fn noise(&mut self) -> Option<f64> {
         self.noise
+    }
+
+    /// The mean (kept in f32 on the GPU) times the passes: the merge of GPU
+    /// shards matches a single GPU run to f32's precision, not bit for bit.
+    fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+        let n = self.mean.count() as f64;
+        Ok(self.mean()?.pixels.iter().map(|p| [p.x as f64 * n, p.y as f64 * n, p.z as f64 * n]).collect())
     }
 
     fn mean(&mut self) -> Result<Image> {

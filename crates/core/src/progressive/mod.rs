@@ -7,6 +7,7 @@
 
 pub mod metric;
 pub mod schedule;
+pub mod shard;
 
 use crate::render::Image;
 use glam::{Vec2, Vec3};
@@ -113,6 +114,18 @@ impl ImageMean {
 
     pub fn passes(&self) -> u32 {
         self.passes
+    }
+
+    /// The per-pixel sums of the passes so far (row-major).
+    pub fn sums(&self) -> &[[f64; 3]] {
+        &self.sums
+    }
+
+    /// A mean of `passes` passes whose sums are `sums` (a merge of
+    /// shards): its noise estimate is unknown (no odd half).
+    pub fn from_sums(width: u32, height: u32, sums: Vec<[f64; 3]>, passes: u32) -> Self {
+        assert_eq!(sums.len(), (width * height) as usize, "sums of another size");
+        ImageMean { width, height, odd_sums: vec![[0.0; 3]; sums.len()], sums, passes }
     }
 
     /// The mean so far (black before the first pass).
