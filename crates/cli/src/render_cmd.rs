@@ -98,7 +98,7 @@ impl EstimatorChoice {
     }
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
     /// A built-in scene name (see `hikari scenes`), a path to a .toml scene
     /// file, or a glTF 2.0 file (.glb, or .gltf with its buffers).
@@ -232,9 +232,46 @@ pub struct RenderArgs {
     /// adds up with the other shards' into that run's image (docs/cluster.md).
     #[arg(long, value_parser = Shard::parse, value_name = "K/M")]
     pub shard: Option<Shard>,
+    /// Render frames A to B (both included) of the scene's animation, frame
+    /// f at time f / --fps, each to the output named with its run of #
+    /// replaced by the zero-padded frame number (-o out-####.exr). Frames
+    /// whose file exists are skipped, so a re-run after a failure resumes.
+    #[arg(long, value_parser = parse_frames, value_name = "A..B", conflicts_with_all = ["shard", "at"])]
+    pub frames: Option<(u32, u32)>,
+    /// Frames per second of --frames (0.001 to 10,000).
+    #[arg(long, default_value_t = 24.0, value_parser = parse_fps, requires = "frames")]
+    pub fps: f64,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// "A..B" with A ≤ B ≤ 1,000,000.
+fn parse_frames(text: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("{text}: frames are A..B, both included, 0 ≤ A ≤ B ≤ 1000000 (e.g. 0..119)");
+    let (a, b) = text.split_once("..").ok_or_else(bad)?;
+    let (a, b) = (a.trim().parse::<u32>().map_err(|_| bad())?, b.trim().parse::<u32>().map_err(|_| bad())?);
+    if a > b || b > 1_000_000 {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+fn parse_fps(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(v) if (0.001..=10_000.0).contains(&v) => Ok(v),
+        _ => Err(format!("{text}: frames per second must be between 0.001 and 10000")),
+    }
+}
+
+/// `output` with its last run of # replaced by `frame`, zero-padded to
+/// the run's length (out-####.exr, 7 → out-0007.exr).
+pub fn frame_path(output: &std::path::Path, frame: u32) -> Option<PathBuf> {
+    let name = output.file_name()?.to_str()?;
+    let end = name.rfind('#')? + 1;
+    let start = name[..end].rfind(|c| c != '#').map_or(0, |i| i + 1);
+    let width = end - start;
+    Some(output.with_file_name(format!("{}{frame:0width$}{}", &name[..start], &name[end..])))
 }
 
 /// A duration in seconds: finite and positive, at most a year.
@@ -810,10 +847,49 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .context("setting the thread count")?;
     }
 
-    let mut scene = load_scene(&args.scene, args.camera.as_deref(), args.environment.as_deref(), args.quiet)?;
-    if scene.is_animated() {
-        scene = scene.at_time(args.at);
+    let scene = load_scene(&args.scene, args.camera.as_deref(), args.environment.as_deref(), args.quiet)?;
+    if let Some(frames) = args.frames {
+        return render_frames(args, &scene, frames);
     }
+    let scene = if scene.is_animated() { scene.at_time(args.at) } else { scene };
+    render_scene(args, scene)
+}
+
+/// `--frames A..B`: each frame not yet written, in order, from the scene
+/// as it stands at its time.
+fn render_frames(args: &RenderArgs, scene: &Scene, (first, last): (u32, u32)) -> Result<()> {
+    if frame_path(&args.output, 0).is_none() {
+        usage!("--frames: {} has no # for the frame number (e.g. -o out-####.exr)", args.output.display());
+    }
+    if !scene.is_animated() {
+        eprintln!("note: {} has no animation: every frame is the same image", args.scene);
+    }
+    let (mut rendered, mut skipped) = (0, 0);
+    for frame in first..=last {
+        let output = frame_path(&args.output, frame).expect("checked above");
+        if output.exists() {
+            skipped += 1;
+            continue;
+        }
+        let at = (frame as f64 / args.fps) as f32;
+        if !(at <= 1_000_000.0) {
+            usage!("--frames: frame {frame} at {} fps is past the last time --at allows (1,000,000 s)", args.fps);
+        }
+        eprintln!("frame {frame} (t = {at} s) → {}", output.display());
+        let frame_scene = if scene.is_animated() { scene.at_time(at) } else { scene.clone() };
+        let frame_args = RenderArgs { output: output.clone(), at, frames: None, ..args.clone() };
+        render_scene(&frame_args, frame_scene).with_context(|| format!("frame {frame} ({})", output.display()))?;
+        rendered += 1;
+    }
+    eprintln!(
+        "frames {first}..{last}: {rendered} rendered, {skipped} already written{}",
+        if skipped > 0 { " (skipped)" } else { "" }
+    );
+    Ok(())
+}
+
+/// Renders `scene` (at its time already) as the flags say and writes the image or part.
+fn render_scene(args: &RenderArgs, mut scene: Scene) -> Result<()> {
     let diagonal = scene.diagonal();
     radius_in_range("radius", args.radius, diagonal)?;
     radius_in_range("caustic-radius", args.caustic_radius, diagonal)?;

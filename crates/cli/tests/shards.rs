@@ -179,3 +179,36 @@ fn shards_with_a_time_limit_merge_what_they_rendered() {
     ok(hikari(&two, &dir));
     assert_eq!(pixels(&dir.join("merged.exr")), pixels(&dir.join("two.exr")));
 }
+
+/// `--frames 0..5` renders the six frames `--at f / fps` renders, one file
+/// each; a second run finds them written and renders nothing.
+#[test]
+fn frames_are_the_renders_at_their_times_and_a_rerun_skips_them() {
+    let dir = scratch_dir("frames");
+    let base = ["render", "cornell-orbit", "--renderer", "path", "--spp", "4", "--resolution", "12x12", "-q"];
+    let mut args = base.to_vec();
+    args.extend_from_slice(&["--frames", "0..5", "--fps", "4", "-o", "out-###.exr"]);
+    let err = ok(hikari(&args, &dir));
+    assert!(err.contains("6 rendered, 0 already written"), "{err}");
+    let frames: Vec<_> = (0..=5).map(|f| dir.join(format!("out-{f:03}.exr"))).collect();
+    let written: Vec<_> = frames.iter().map(|f| std::fs::metadata(f).unwrap().modified().unwrap()).collect();
+    for (f, frame) in frames.iter().enumerate() {
+        let at = (f as f64 / 4.0).to_string();
+        let mut single = base.to_vec();
+        single.extend_from_slice(&["--at", &at, "-o", "at.exr"]);
+        ok(hikari(&single, &dir));
+        assert_eq!(pixels(frame), pixels(&dir.join("at.exr")), "frame {f}");
+    }
+    assert_ne!(pixels(&frames[0]), pixels(&frames[3]), "the animation moves");
+    let err = ok(hikari(&args, &dir));
+    assert!(err.contains("0 rendered, 6 already written"), "{err}");
+    let again: Vec<_> = frames.iter().map(|f| std::fs::metadata(f).unwrap().modified().unwrap()).collect();
+    assert_eq!(written, again, "finished frames are not overwritten");
+    // Without a # in the name there is nowhere to put the frame number.
+    let out = hikari(&["render", "cornell-orbit", "--frames", "0..2", "-o", "still.exr"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert_fails_with(&out, &dir, &["still.exr", "#"]);
+    let out = hikari(&["render", "--frames", "5..2", "-o", "x-#.exr"], &dir);
+    assert_eq!(out.status.code(), Some(2));
+    assert_fails_with(&out, &dir, &["5..2"]);
+}
