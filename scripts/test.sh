@@ -47,5 +47,10 @@ for entry in "${gpu_tests[@]}"; do
     (cd "$dir" && WGPU_BACKEND=gl "$exe")
 done
 
+# One render split across a real one-node Slurm (#20): a job array of
+# shards and its dependent merge, compared with the single run. Installs
+# slurm-wlm and munge; skipped, loudly, only where Slurm cannot start.
+bash scripts/slurm/test.sh target/debug/hikari
+
 # A minute of the structured scene fuzzer (new mutants for every commit).
 bash scripts/fuzz-ci.sh "$@"
