@@ -934,6 +934,7 @@ fn render_scene(args: &RenderArgs, mut scene: Scene) -> Result<()> {
                 shards: shard.count,
                 passes: body.passes,
                 stopped_early: body.stopped_early,
+                time_limited: args.time.is_some(),
             };
             Part { header, sums: body.sums }.write(&args.output).map_err(anyhow::Error::msg)?;
         }

@@ -83,7 +83,7 @@ fn merged_gpu_shards_match_the_single_run() {
         let err = ok(command(&args, &dir, env));
         assert!(err.contains("averaged on the GPU"), "{backend}: {err}");
         let single = pixels(&dir.join("single.exr"));
-        for shards in [2, 3, 7] {
+        for shards in [1, 2, 3, 7] {
             let merged = shards_merged(&dir, "gpu", shards, env);
             let worst = merged
                 .iter()
@@ -211,4 +211,31 @@ fn frames_are_the_renders_at_their_times_and_a_rerun_skips_them() {
     let out = hikari(&["render", "--frames", "5..2", "-o", "x-#.exr"], &dir);
     assert_eq!(out.status.code(), Some(2));
     assert_fails_with(&out, &dir, &["5..2"]);
+}
+
+/// `HIKARI_GPU` picks the adapter (a cluster task's own GPU): by name or
+/// index it renders there; naming none, it falls back with the adapters seen.
+#[test]
+fn hikari_gpu_picks_the_adapter() {
+    let dir = scratch_dir("hikari-gpu");
+    let args = [
+        "render",
+        "--resolution",
+        "8x8",
+        "--photons",
+        "500",
+        "--shadow-map-size",
+        "32",
+        "--passes",
+        "1",
+        "-o",
+        "a.exr",
+    ];
+    for wanted in ["0", "llvmpipe"] {
+        let err = ok(command(&args, &dir, &[("HIKARI_GPU", wanted)]));
+        assert!(err.contains("gpu: llvmpipe"), "HIKARI_GPU={wanted}: {err}");
+    }
+    let err = ok(command(&args, &dir, &[("HIKARI_GPU", "no-such-gpu")]));
+    assert!(err.contains("HIKARI_GPU=no-such-gpu names none of the adapters: 0: llvmpipe"), "{err}");
+    assert!(err.contains("photon-cpu"), "{err}");
 }

@@ -212,9 +212,51 @@ pub fn preference(info: &wgpu::AdapterInfo) -> (u8, u8) {
     (kind, api)
 }
 
+/// The environment variable that picks the adapter (docs/cluster.md): a
+/// number is an index in the order of [`preference`] (0: the first), other
+/// text a part of the adapter's name or its PCI bus id (lspci's or
+/// nvidia-smi's form, "17:00.0" or "00000000:17:00.0"), case ignored.
+pub const ADAPTER_VARIABLE: &str = "HIKARI_GPU";
+
+/// Whether `info`, at `index` in the order of preference, is the adapter
+/// `wanted` (the value of [`ADAPTER_VARIABLE`]) names.
+pub fn is_wanted(wanted: &str, index: usize, info: &wgpu::AdapterInfo) -> bool {
+    let wanted = wanted.trim().to_ascii_lowercase();
+    if let Ok(i) = wanted.parse::<usize>() {
+        return i == index;
+    }
+    // A bus id's domain is written with 4 or 8 digits: compare bus:device.function.
+    let bus = |id: &str| {
+        let mut parts = id.rsplitn(3, ':');
+        let (function, bus) = (parts.next().unwrap_or(""), parts.next().unwrap_or(""));
+        format!("{bus}:{function}")
+    };
+    let bus_id = info.device_pci_bus_id.to_ascii_lowercase();
+    !wanted.is_empty()
+        && (info.name.to_ascii_lowercase().contains(&wanted)
+            || (!bus_id.is_empty() && wanted.contains(':') && bus(&bus_id) == bus(&wanted)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_variable_names_an_adapter_by_index_name_or_bus() {
+        let gpu = wgpu::AdapterInfo {
+            name: "NVIDIA H100 80GB HBM3".into(),
+            device_pci_bus_id: "0000:17:00.0".into(),
+            ..wgpu::AdapterInfo::new(wgpu::DeviceType::DiscreteGpu, wgpu::Backend::Vulkan)
+        };
+        for wanted in ["1", "h100", "NVIDIA", "17:00.0", "00000000:17:00.0", "0000:17:00.0"] {
+            assert!(is_wanted(wanted, 1, &gpu), "{wanted}");
+        }
+        for wanted in ["0", "llvmpipe", "18:00.0", "00000000:18:00.0", "", " "] {
+            assert!(!is_wanted(wanted, 1, &gpu), "{wanted}");
+        }
+        let no_bus = wgpu::AdapterInfo { device_pci_bus_id: String::new(), ..gpu };
+        assert!(!is_wanted("17:00.0", 1, &no_bus));
+    }
 
     fn info(device_type: wgpu::DeviceType, backend: wgpu::Backend) -> wgpu::AdapterInfo {
         wgpu::AdapterInfo {

@@ -61,6 +61,11 @@ pub struct GpuContext {
     fault: Fault,
 }
 
+/// ", bus 0000:17:00.0" where the adapter reports its PCI bus.
+fn bus_suffix(info: &wgpu::AdapterInfo) -> String {
+    if info.device_pci_bus_id.is_empty() { String::new() } else { format!(", bus {}", info.device_pci_bus_id) }
+}
+
 /// Default `wait_timeout`: a software adapter needs tens of seconds for a
 /// large frame; a hung driver should not hold the CLI for ever.
 pub const WAIT_TIMEOUT: Duration = Duration::from_secs(600);
@@ -86,6 +91,26 @@ impl GpuContext {
             return Err(GpuError::NoAdapter("wgpu enumerated none; WGPU_BACKEND may exclude them".into()));
         }
         adapters.sort_by_key(|a| preference(&a.get_info()));
+        // HIKARI_GPU picks one (a cluster task's own GPU, docs/cluster.md).
+        if let Ok(wanted) = std::env::var(crate::capabilities::ADAPTER_VARIABLE) {
+            let names: Vec<String> = adapters
+                .iter()
+                .enumerate()
+                .map(|(i, a)| {
+                    let info = a.get_info();
+                    format!("{i}: {} ({:?}{})", info.name, info.backend, bus_suffix(&info))
+                })
+                .collect();
+            let mut index = 0..;
+            adapters.retain(|a| crate::capabilities::is_wanted(&wanted, index.next().unwrap_or(0), &a.get_info()));
+            if adapters.is_empty() {
+                return Err(GpuError::NoAdapter(format!(
+                    "{}={wanted} names none of the adapters: {}",
+                    crate::capabilities::ADAPTER_VARIABLE,
+                    names.join(", ")
+                )));
+            }
+        }
         let mut refusals = Vec::new();
         for adapter in adapters {
             let info = adapter.get_info();
@@ -147,7 +172,7 @@ impl GpuContext {
     /// One line naming the adapter, for logs and summaries.
     pub fn describe(&self) -> String {
         let i = &self.adapter_info;
-        format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
+        format!("{} ({:?}, {:?}){}", i.name, i.backend, i.device_type, bus_suffix(i).replacen(",", "", 1))
     }
 
     /// Runs `f` under error scopes for validation, out-of-memory and internal

@@ -76,9 +76,12 @@ pub struct PartHeader {
     pub shards: u32,
     /// The passes this part rendered, in order.
     pub passes: Vec<u32>,
-    /// Whether the part stopped early (`--time`, Ctrl-C): its passes are a
-    /// prefix of its shard's.
+    /// Whether the part stopped before its last pass (`--time`, Ctrl-C):
+    /// its passes are a prefix of its shard's.
     pub stopped_early: bool,
+    /// Whether it had a time limit (`--time`): only then is stopping early
+    /// what was asked for; otherwise (Ctrl-C) the set is incomplete.
+    pub time_limited: bool,
 }
 
 /// A part: its header and its per-pixel sums over its passes.
@@ -160,7 +163,7 @@ impl Part {
             return Err(format!("its header says {}x{} but it is {}x{}", header.width, header.height, size.0, size.1));
         }
         let channel = |name: &str| -> std::result::Result<&Vec<u32>, String> {
-            let found = layer.channel_data.list.iter().find(|c| c.name == Text::from(name));
+            let found = layer.channel_data.list.iter().find(|c| c.name.eq(name));
             match found.map(|c| &c.sample_data) {
                 Some(FlatSamples::U32(v)) if v.len() == pixels => Ok(v),
                 _ => Err(format!("channel {name} is missing or not 32-bit integers")),
@@ -238,6 +241,12 @@ pub fn merge(parts: &[(String, Part)]) -> Result<Merged, String> {
             None => shard.passes(h.passes.last().copied().unwrap_or(0)).collect(),
         };
         let fits = if h.stopped_early { expected.starts_with(&h.passes) } else { expected == h.passes };
+        if h.stopped_early && !h.time_limited && fits {
+            return Err(format!(
+                "{name}: shard {}/{} stopped after passes {:?} of {:?} (interrupted): render it again",
+                h.shard, h.shards, h.passes, expected
+            ));
+        }
         if !fits {
             return Err(format!(
                 "{name}: holds passes {:?}, which are not shard {}/{}'s{}",

@@ -13,6 +13,7 @@ fn header(shard: u32, shards: u32, total: u32) -> PartHeader {
         shards,
         passes: Shard { index: shard, count: shards }.passes(total).collect(),
         stopped_early: false,
+        time_limited: false,
     }
 }
 
@@ -149,6 +150,10 @@ fn parts_stopped_early_merge_what_they_did() {
     early.header.passes = vec![2];
     early.header.stopped_early = true;
     early.sums = vec![pass_image(2)[0], pass_image(2)[1]];
+    // Interrupted (no time limit): the set lacks pass 5.
+    let e = merge_error(vec![part(1, 3, 7), early.clone(), part(3, 3, 7)]);
+    assert!(e.starts_with("part-2.exr: shard 2/3 stopped after passes [2] of [2, 5]"), "{e}");
+    early.header.time_limited = true;
     let merged = merge(&named(vec![part(1, 3, 7), early, part(3, 3, 7)])).unwrap();
     assert_eq!(merged.passes, 6);
     assert_eq!(merged.header.passes, [1, 2, 3, 4, 6, 7]);
