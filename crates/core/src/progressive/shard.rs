@@ -81,6 +81,7 @@ pub struct PartHeader {
     pub stopped_early: bool,
     /// Whether it had a time limit (`--time`): only then is stopping early
     /// what was asked for; otherwise (Ctrl-C) the set is incomplete.
+    #[serde(default)]
     pub time_limited: bool,
 }
 
@@ -156,7 +157,7 @@ impl Part {
                 );
             }
         };
-        let header: PartHeader = toml::from_str(&text).map_err(|e| format!("its part header is damaged: {e}"))?;
+        let header: PartHeader = toml::from_str(&text).map_err(|e| format!("its part header is damaged or from another version of hikari: {e}"))?;
         let pixels = (header.width as usize) * (header.height as usize);
         let size = layer.size;
         if (size.width(), size.height()) != (header.width as usize, header.height as usize) {
