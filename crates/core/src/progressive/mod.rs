@@ -121,22 +121,23 @@ impl ImageMean {
         &self.sums
     }
 
-    /// A mean of `passes` passes whose sums are `sums` (a merge of
-    /// shards): its noise estimate is unknown (no odd half).
-    pub fn from_sums(width: u32, height: u32, sums: Vec<[f64; 3]>, passes: u32) -> Self {
-        assert_eq!(sums.len(), (width * height) as usize, "sums of another size");
-        ImageMean { width, height, odd_sums: vec![[0.0; 3]; sums.len()], sums, passes }
-    }
-
     /// The mean so far (black before the first pass).
     pub fn mean(&self) -> Image {
-        let mut image = Image::new(self.width, self.height);
-        let n = self.passes.max(1) as f64;
-        for (p, s) in image.pixels.iter_mut().zip(&self.sums) {
-            *p = Vec3::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32);
-        }
-        image
+        mean_of_sums(self.width, self.height, &self.sums, self.passes)
     }
+}
+
+/// The mean image of `passes` passes whose per-pixel sums are `sums`
+/// (black for none): [`ImageMean::mean`], and a merge of shards, which
+/// must divide exactly as a single run does.
+pub fn mean_of_sums(width: u32, height: u32, sums: &[[f64; 3]], passes: u32) -> Image {
+    assert_eq!(sums.len(), (width * height) as usize, "sums of another size");
+    let mut image = Image::new(width, height);
+    let n = passes.max(1) as f64;
+    for (p, s) in image.pixels.iter_mut().zip(sums) {
+        *p = Vec3::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32);
+    }
+    image
 }
 
 /// [`ImageMean::noise_estimate`] from the sums of all `passes` passes and

@@ -16,7 +16,7 @@
 //! the additions does not change them: the merged image is then
 //! bit-identical to the single run's.
 
-use super::ImageMean;
+use super::mean_of_sums;
 use crate::render::Image;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -109,7 +109,7 @@ const CHANNELS: [&str; 3] = ["R", "G", "B"];
 impl Part {
     /// The part's own mean (black where it has no passes).
     pub fn mean(&self) -> Image {
-        mean_of(self.header.width, self.header.height, &self.sums, self.header.passes.len() as u32)
+        mean_of_sums(self.header.width, self.header.height, &self.sums, self.header.passes.len() as u32)
     }
 
     /// Writes the part to `path` (an `.exr`) atomically: a temporary
@@ -157,7 +157,8 @@ impl Part {
                 );
             }
         };
-        let header: PartHeader = toml::from_str(&text).map_err(|e| format!("its part header is damaged or from another version of hikari: {e}"))?;
+        let header: PartHeader = toml::from_str(&text)
+            .map_err(|e| format!("its part header is damaged or from another version of hikari: {e}"))?;
         let pixels = (header.width as usize) * (header.height as usize);
         let size = layer.size;
         if (size.width(), size.height()) != (header.width as usize, header.height as usize) {
@@ -182,10 +183,6 @@ impl Part {
         }
         Ok(Part { header, sums })
     }
-}
-
-fn mean_of(width: u32, height: u32, sums: &[[f64; 3]], passes: u32) -> Image {
-    ImageMean::from_sums(width, height, sums.to_vec(), passes).mean()
 }
 
 /// What a merge made: the image and how many passes it holds.
@@ -299,7 +296,7 @@ pub fn merge(parts: &[(String, Part)]) -> Result<Merged, String> {
     let mut header = f.clone();
     header.passes = parts.iter().flat_map(|(_, p)| p.header.passes.iter().copied()).collect();
     header.passes.sort_unstable();
-    Ok(Merged { image: mean_of(f.width, f.height, &sums, passes), passes, header })
+    Ok(Merged { image: mean_of_sums(f.width, f.height, &sums, passes), passes, header })
 }
 
 #[cfg(test)]

@@ -1,4 +1,5 @@
 use super::*;
+use crate::progressive::ImageMean;
 
 fn header(shard: u32, shards: u32, total: u32) -> PartHeader {
     PartHeader {
