@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Runs the whole hikari test suite on a fresh Debian 12 machine: installs what
 # the machine lacks (Mesa's software Vulkan driver for the GPU tests, Xvfb
-# for the viewer's window tests), then
-# runs every test of the workspace. GPU tests fail, not skip, without an
+# for the viewer's window tests, Chromium for the web page's browser tests),
+# builds the web page, then runs every test of the workspace. GPU tests fail, not skip, without an
 # adapter; the CLI tests also run the renderer on Mesa's OpenGL.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need=()
-for pkg in mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool; do
+for pkg in mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool chromium; do
     dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then
@@ -28,6 +28,11 @@ fi
 # A one-off build gains nothing from incremental compilation but a gigabyte
 # of disk.
 export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"
+
+# The web page (crates/web) and its browser tests' driver (web/test):
+# crates/cli/tests/web.rs opens the built page in Debian's headless Chromium.
+bash scripts/web.sh build
+npm ci --prefix web/test --no-audit --no-fund --silent
 
 cargo test --workspace --locked "$@"
 

@@ -250,18 +250,6 @@ fn exr(dir: &std::path::Path, file: &str) -> Vec<[f32; 3]> {
     image::open(dir.join(file)).unwrap().to_rgb32f().pixels().map(|p| p.0).collect()
 }
 
-/// Relative RMS difference of two images: √(Σ|a−b|²/Σ|b|²).
-fn relative_rms(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
-    let (mut num, mut den) = (0.0f64, 0.0f64);
-    for (p, q) in a.iter().zip(b) {
-        for c in 0..3 {
-            num += ((p[c] - q[c]) as f64).powi(2);
-            den += (q[c] as f64).powi(2);
-        }
-    }
-    (num / den).sqrt()
-}
-
 fn image_mean(a: &[[f32; 3]]) -> f64 {
     a.iter().flat_map(|p| p.iter()).map(|&x| x as f64).sum::<f64>() / (3 * a.len()) as f64
 }

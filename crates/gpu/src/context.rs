@@ -75,18 +75,28 @@ impl GpuContext {
     /// `capabilities::preference` order and opens a device on the first
     /// that has everything the renderer needs.
     pub fn new() -> Result<Self, GpuError> {
+        crate::block::wait_for(Self::new_async())
+    }
+
+    /// `new` without blocking (a browser's adapter and device are promises).
+    pub async fn new_async() -> Result<Self, GpuError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Self::choose(&instance, None)
+        Self::choose(&instance, None).await
     }
 
     /// As `new`, among the adapters of `instance` that can present to
     /// `surface` (the viewer's window).
     pub fn for_surface(instance: &wgpu::Instance, surface: &wgpu::Surface) -> Result<Self, GpuError> {
-        Self::choose(instance, Some(surface))
+        crate::block::wait_for(Self::for_surface_async(instance, surface))
     }
 
-    fn choose(instance: &wgpu::Instance, surface: Option<&wgpu::Surface>) -> Result<Self, GpuError> {
-        let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+    /// `for_surface` without blocking.
+    pub async fn for_surface_async(instance: &wgpu::Instance, surface: &wgpu::Surface<'_>) -> Result<Self, GpuError> {
+        Self::choose(instance, Some(surface)).await
+    }
+
+    async fn choose(instance: &wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, GpuError> {
+        let mut adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
         if adapters.is_empty() {
             return Err(GpuError::NoAdapter("wgpu enumerated none; WGPU_BACKEND may exclude them".into()));
         }
@@ -119,25 +129,27 @@ impl GpuContext {
                 continue;
             }
             match Capabilities::check(&adapter) {
-                Ok(caps) => return Self::open(adapter, caps),
+                Ok(caps) => return Self::open(adapter, caps).await,
                 Err(why) => refusals.push(format!("{} ({:?}) {why}", info.name, info.backend)),
             }
         }
         Err(GpuError::Unsupported(refusals.join(" | ")))
     }
 
-    fn open(adapter: wgpu::Adapter, caps: Capabilities) -> Result<Self, GpuError> {
+    async fn open(adapter: wgpu::Adapter, caps: Capabilities) -> Result<Self, GpuError> {
         let limits = adapter.limits();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("hikari"),
-            required_features: caps.features(),
-            // The adapter's own limits: the G-buffer needs 64 bytes per sample
-            // of colour attachments, and photon buffers want the largest
-            // bindings the adapter allows (sizes are checked against them).
-            required_limits: limits.clone(),
-            ..Default::default()
-        }))
-        .map_err(|e| GpuError::Device(e.to_string()))?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("hikari"),
+                required_features: caps.features(),
+                // The adapter's own limits: the G-buffer needs 64 bytes per sample
+                // of colour attachments, and photon buffers want the largest
+                // bindings the adapter allows (sizes are checked against them).
+                required_limits: limits.clone(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| GpuError::Device(e.to_string()))?;
         let fault: Fault = Arc::default();
         let record = |fault: &Fault, what: String| {
             let mut slot = fault.lock().unwrap_or_else(|e| e.into_inner());
@@ -191,6 +203,7 @@ impl GpuContext {
         ErrorScopes(
             [wgpu::ErrorFilter::Validation, wgpu::ErrorFilter::OutOfMemory, wgpu::ErrorFilter::Internal]
                 .map(|filter| self.device.push_error_scope(filter)),
+            self.fault.clone(),
         )
     }
 
@@ -203,6 +216,8 @@ impl GpuContext {
     }
 
     /// Blocks until the submitted work is done, at most `wait_timeout`.
+    /// In a browser the device runs by itself and this only checks for
+    /// faults: wait for a result with an `_async` readback instead.
     pub fn wait(&self) -> Result<(), GpuError> {
         self.device.poll(wgpu::PollType::Wait { submission_index: None, timeout: Some(self.wait_timeout) }).map_err(
             |e| match e {
@@ -216,21 +231,57 @@ impl GpuContext {
 
 /// Error scopes for validation, out-of-memory and internal errors, closed
 /// by `finish` in reverse order.
-pub struct ErrorScopes([wgpu::ErrorScopeGuard; 3]);
+pub struct ErrorScopes(
+    [wgpu::ErrorScopeGuard; 3],
+    /// Where a browser records what the scopes catch (natively unused).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    Fault,
+);
 
 impl ErrorScopes {
-    /// The first error the scopes caught, as a `GpuError`.
+    /// The first error the scopes caught, as a `GpuError`. In a browser
+    /// the scopes answer later (promises): their first error is recorded
+    /// as the device's fault, which the next `GpuContext::check` (every
+    /// `scoped` call and readback) reports, so an error still never passes.
     pub fn finish(self) -> Result<(), GpuError> {
-        let mut first = None;
-        for scope in self.0.into_iter().rev() {
-            if let Some(error) = pollster::block_on(scope.pop()) {
-                first.get_or_insert(error);
+        #[cfg(not(target_arch = "wasm32"))]
+        {
+            crate::block::wait_for(self.finish_async())
+        }
+        #[cfg(target_arch = "wasm32")]
+        {
+            let fault = self.1.clone();
+            // Popped now (the scope stack is the device's), answered later.
+            let answer = self.finish_async();
+            wasm_bindgen_futures::spawn_local(async move {
+                if let Err(GpuError::Failed(what)) = answer.await {
+                    fault.lock().unwrap_or_else(|e| e.into_inner()).get_or_insert(what);
+                }
+            });
+            Ok(())
+        }
+    }
+
+    /// `finish` waiting without blocking. The scopes are popped when this
+    /// is called, before the returned future runs.
+    pub fn finish_async(self) -> impl Future<Output = Result<(), GpuError>> + use<> {
+        let answers: Vec<_> = self.0.into_iter().rev().map(|scope| scope.pop()).collect();
+        async move {
+            let mut first = None;
+            for answer in answers {
+                if let Some(error) = answer.await {
+                    first.get_or_insert(error);
+                }
             }
+            first_error(first)
         }
-        match first {
-            Some(error) => Err(GpuError::Failed(first_line(&error.to_string()))),
-            None => Ok(()),
-        }
+    }
+}
+
+fn first_error(first: Option<wgpu::Error>) -> Result<(), GpuError> {
+    match first {
+        Some(error) => Err(GpuError::Failed(first_line(&error.to_string()))),
+        None => Ok(()),
     }
 }
 

@@ -25,6 +25,7 @@
 
 pub mod accumulate;
 pub mod binding;
+pub mod block;
 pub mod capabilities;
 pub mod context;
 pub mod direct;

@@ -1,12 +1,24 @@
-//! Copying textures back to the CPU (tests, image output).
+//! Copying textures and buffers back to the CPU (image output, status
+//! words, traced photons). Each read has an `_async` form, which waits
+//! without blocking (a browser's only way), and a blocking one for native
+//! callers, which runs the same future.
 
+use crate::block::wait_for;
 use crate::context::{GpuContext, GpuError};
 use glam::Vec4;
+use std::pin::Pin;
+use std::sync::{Arc, Mutex};
+use std::task::{Context, Poll, Waker};
 
 /// Reads a 2D `Rgba32Float` or `Rgba16Float` texture as row-major RGBA,
 /// row 0 at the top.
 pub fn read_rgba(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>, GpuError> {
-    read_rgba_layer(ctx, texture, 0)
+    wait_for(read_rgba_layer_async(ctx, texture, 0))
+}
+
+/// `read_rgba` without blocking.
+pub async fn read_rgba_async(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<Vec4>, GpuError> {
+    read_rgba_layer_async(ctx, texture, 0).await
 }
 
 /// Every layer of a 2D-array texture, each as `read_rgba` reads one.
@@ -19,17 +31,21 @@ pub fn read_rgba8(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>, 
     if texture.format() != wgpu::TextureFormat::Rgba8Unorm {
         return Err(GpuError::Readback(format!("not Rgba8Unorm: {:?}", texture.format())));
     }
-    read_rows(ctx, texture, 0, 4)
+    wait_for(read_rows(ctx, texture, 0, 4))
 }
 
 /// One layer of a 2D (array) texture.
 pub fn read_rgba_layer(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -> Result<Vec<Vec4>, GpuError> {
+    wait_for(read_rgba_layer_async(ctx, texture, layer))
+}
+
+async fn read_rgba_layer_async(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) -> Result<Vec<Vec4>, GpuError> {
     let texel_bytes = match texture.format() {
         wgpu::TextureFormat::Rgba32Float => 16,
         wgpu::TextureFormat::Rgba16Float => 8,
         other => return Err(GpuError::Readback(format!("cannot read back {other:?}"))),
     };
-    let bytes = read_rows(ctx, texture, layer, texel_bytes)?;
+    let bytes = read_rows(ctx, texture, layer, texel_bytes).await?;
     if texel_bytes == 16 {
         Ok(bytemuck::cast_slice::<u8, [f32; 4]>(&bytes).iter().map(|&v| Vec4::from(v)).collect())
     } else {
@@ -38,7 +54,12 @@ pub fn read_rgba_layer(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32) ->
 }
 
 /// The texels of one layer, rows unpadded, `texel_bytes` each.
-fn read_rows(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32, texel_bytes: u32) -> Result<Vec<u8>, GpuError> {
+async fn read_rows(
+    ctx: &GpuContext,
+    texture: &wgpu::Texture,
+    layer: u32,
+    texel_bytes: u32,
+) -> Result<Vec<u8>, GpuError> {
     let (width, height) = (texture.width(), texture.height());
     let unpadded = width * texel_bytes;
     let padded = unpadded.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
@@ -67,7 +88,7 @@ fn read_rows(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32, texel_bytes:
         wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
     );
     ctx.queue.submit([encoder.finish()]);
-    let data = map_read(ctx, &buffer)?;
+    let data = map_read(ctx, &buffer).await?;
     let mut out = Vec::with_capacity((unpadded * height) as usize);
     for row in 0..height {
         out.extend_from_slice(&data[(row * padded) as usize..(row * padded + unpadded) as usize]);
@@ -76,22 +97,68 @@ fn read_rows(ctx: &GpuContext, texture: &wgpu::Texture, layer: u32, texel_bytes:
 }
 
 /// Maps a MAP_READ buffer after the submitted work and copies its bytes out.
-fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+async fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let error = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
     let slice = buffer.slice(..);
-    let (tx, rx) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
+    let answer = Answer::default();
+    let callback = answer.clone();
+    slice.map_async(wgpu::MapMode::Read, move |r| callback.set(r));
+    // Natively the callback runs inside the device's poll; in a browser
+    // the map is a promise that resolves once the work is done.
     ctx.wait()?;
-    rx.recv().map_err(|e| error(&e))?.map_err(|e| error(&e))?;
+    answer.await.map_err(|e| error(&e))?;
+    ctx.check()?;
     let bytes = slice.get_mapped_range().map_err(|e| error(&e))?.to_vec();
     buffer.unmap();
     Ok(bytes)
 }
 
+/// A value that a callback sets once, awaited as a future.
+struct Answer<T>(Arc<Mutex<(Option<T>, Option<Waker>)>>);
+
+impl<T> Default for Answer<T> {
+    fn default() -> Self {
+        Answer(Arc::new(Mutex::new((None, None))))
+    }
+}
+
+impl<T> Clone for Answer<T> {
+    fn clone(&self) -> Self {
+        Answer(self.0.clone())
+    }
+}
+
+impl<T> Answer<T> {
+    fn set(&self, value: T) {
+        let mut slot = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        slot.0 = Some(value);
+        if let Some(waker) = slot.1.take() {
+            waker.wake();
+        }
+    }
+}
+
+impl<T> Future for Answer<T> {
+    type Output = T;
+    fn poll(self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<T> {
+        let mut slot = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        match slot.0.take() {
+            Some(value) => Poll::Ready(value),
+            None => {
+                slot.1 = Some(cx.waker().clone());
+                Poll::Pending
+            }
+        }
+    }
+}
+
 /// Reads the first `count` u32 words of `buffer` (which needs COPY_SRC).
 pub fn read_u32s(ctx: &GpuContext, buffer: &wgpu::Buffer, count: u64) -> Result<Vec<u32>, GpuError> {
+    wait_for(read_u32s_async(ctx, buffer, count))
+}
+
+/// `read_u32s` without blocking.
+pub async fn read_u32s_async(ctx: &GpuContext, buffer: &wgpu::Buffer, count: u64) -> Result<Vec<u32>, GpuError> {
     let staging = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback words"),
         size: count * 4,
@@ -101,7 +168,7 @@ pub fn read_u32s(ctx: &GpuContext, buffer: &wgpu::Buffer, count: u64) -> Result<
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, count * 4);
     ctx.queue.submit([encoder.finish()]);
-    Ok(bytemuck::pod_collect_to_vec(&map_read(ctx, &staging)?))
+    Ok(bytemuck::pod_collect_to_vec(&map_read(ctx, &staging).await?))
 }
 
 /// IEEE half to single precision, exactly.

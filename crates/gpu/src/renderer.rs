@@ -221,8 +221,20 @@ impl GpuRenderer {
     /// optical depths off by 8e-4 where they are 0, fog frames off by more
     /// than 2%).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
-        (!ctx.float32_blend && !scene.media.is_empty())
-            .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string())
+        let media = (!ctx.float32_blend && !scene.media.is_empty())
+            .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string());
+        media.or_else(|| {
+            let specular = crate::specular::has_specular_surfaces(scene);
+            specular
+                .then(|| {
+                    crate::capabilities::storage_buffer_shortfall(
+                        &ctx.limits,
+                        crate::capabilities::FULL_STORAGE_BUFFERS,
+                        "the mirror and glass pass",
+                    )
+                })
+                .flatten()
+        })
     }
 
     /// What a frame of `scene` with `settings` allocates, for `photons`
@@ -534,6 +546,12 @@ impl GpuRenderer {
     /// `specular::MAX_SLICES`; past that the frame is an error, never an
     /// image with light silently missing.
     pub fn render(&self) -> Result<(), GpuError> {
+        crate::block::wait_for(self.render_async())
+    }
+
+    /// `render` without blocking: the status readbacks that settle the
+    /// frame are awaited (a browser's frame goes on once they resolve).
+    pub async fn render_async(&self) -> Result<(), GpuError> {
         let scopes = self.ctx.error_scopes();
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         for stage in Stage::ALL {
@@ -542,8 +560,8 @@ impl GpuRenderer {
         self.ctx.queue.submit([encoder.finish()]);
         scopes.finish()?;
         self.ctx.wait()?;
-        self.settle_specular()?;
-        self.settle_tiled()
+        self.settle_specular().await?;
+        self.settle_tiled().await
     }
 
     /// The tiled estimator's pass, made on first use.
@@ -585,16 +603,24 @@ impl GpuRenderer {
     /// sized to what the frame needed and the estimate and resolve run
     /// again; a photon covering more tiles than the loop budget allows is an
     /// error. Never an image with photons silently left out.
-    fn settle_tiled(&self) -> Result<(), GpuError> {
+    async fn settle_tiled(&self) -> Result<(), GpuError> {
         if self.settings.estimator != Estimator::Tiled {
             return Ok(());
         }
         for _ in 0..4 {
             let mut rerun = false;
             for (cell, kind, output, target) in self.tiled_maps() {
+                let Some(status) = ({
+                    let binding = cell.borrow();
+                    match binding.as_ref() {
+                        Some(current) => Some(current.check_async(&self.ctx).await?),
+                        None => None,
+                    }
+                }) else {
+                    continue;
+                };
                 let mut binding = cell.borrow_mut();
                 let Some(current) = binding.as_ref() else { continue };
-                let status = current.check(&self.ctx)?;
                 if current.fits(&status) {
                     continue;
                 }
@@ -632,13 +658,13 @@ impl GpuRenderer {
 
     /// Re-runs the specular pass with more slices until no pixel runs over
     /// budget (see `render`).
-    fn settle_specular(&self) -> Result<(), GpuError> {
+    async fn settle_specular(&self) -> Result<(), GpuError> {
         let pass = &self.specular_pass;
         if !pass.enabled() {
             return Ok(());
         }
         loop {
-            let status = pass.read_status(&self.ctx)?;
+            let status = pass.read_status_async(&self.ctx).await?;
             if status.over_budget == 0 {
                 return Ok(());
             }
@@ -688,7 +714,7 @@ impl GpuRenderer {
         } else {
             let mut times = Vec::new();
             for stage in Stage::ALL {
-                let start = std::time::Instant::now();
+                let start = web_time::Instant::now();
                 let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                 self.record_stage(stage, &mut encoder);
                 self.ctx.queue.submit([encoder.finish()]);
@@ -698,7 +724,7 @@ impl GpuRenderer {
             (times, false)
         };
         scopes.finish()?;
-        self.settle_specular()?;
+        crate::block::wait_for(self.settle_specular())?;
         Ok(timed)
     }
 

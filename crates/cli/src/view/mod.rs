@@ -35,10 +35,6 @@
 //! a file with an error prints it (`FILE:LINE:COLUMN`, also in the title
 //! and the panel) and the last good scene stays on screen.
 
-mod clock;
-mod frame_stats;
-mod orbit;
-mod panel;
 mod photon_sets;
 mod scene_watch;
 mod trace_budget;
@@ -47,19 +43,18 @@ use crate::render_cmd::{MAX_PHOTONS, Resolution, UsageError, load_scene, parse_r
 use crate::tracing::{PhotonTracer, TraceDevice};
 use anyhow::{Result, anyhow};
 use clap::Args;
-use clock::AnimationClock;
-use frame_stats::FrameStats;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use hikari_core::output::write_image;
-use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_jitter};
-use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
 use hikari_gpu::points::PointColors;
 use hikari_gpu::present::{PresentMode, PresentPass};
-use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
-use orbit::Orbit;
-use panel::{Controls, Panel, Readouts};
+use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
+use hikari_viewer::clock::AnimationClock;
+use hikari_viewer::frame_stats::FrameStats;
+use hikari_viewer::orbit::Orbit;
+use hikari_viewer::panel::{Controls, Panel, Readouts};
+use hikari_viewer::settings::{controls_for_scene, gpu_settings, restart_for_edits, set_pass};
 use photon_sets::{Job, PhotonSet, PhotonSets};
 use scene_watch::SceneWatch;
 use std::path::PathBuf;
@@ -214,24 +209,7 @@ struct Viewer {
 
 /// The panel's starting values for `scene` (its lights and objects unedited).
 fn controls_for(scene: &Scene, args: &ViewArgs) -> Controls {
-    let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
-    let rest = scene.rest_pose();
-    Controls {
-        exposure: args.exposure,
-        global_radius: global.radius,
-        caustic_radius: caustic.radius,
-        volume_radius: default_radius(scene),
-        volume_slices: GpuSettings::new(global, caustic).volume_slices,
-        terms: hikari_gpu::resolve::Terms::ALL,
-        lod: None,
-        mode: PresentMode::Radiance,
-        photons: args.photons,
-        trace_every_frame: args.trace_every_frame,
-        progressive: true,
-        playing: true,
-        lights: rest.lights,
-        offsets: rest.offsets,
-    }
+    controls_for_scene(scene, args.exposure, args.photons, args.trace_every_frame)
 }
 
 impl Viewer {
@@ -368,17 +346,7 @@ impl Viewer {
         let format = surface.get_capabilities(&ctx.adapter).formats.first().copied().ok_or_else(|| {
             anyhow!("the window offers no surface format on {}; `hikari render` writes an image", ctx.describe())
         })?;
-        let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            format,
-            width,
-            height,
-            present_mode: wgpu::PresentMode::Fifo,
-            desired_maximum_frame_latency: 2,
-            alpha_mode: wgpu::CompositeAlphaMode::Auto,
-            view_formats: vec![],
-            color_space: wgpu::SurfaceColorSpace::Auto,
-        };
+        let config = hikari_viewer::surface::surface_config(format, width, height);
         ctx.scoped(|| surface.configure(&ctx.device, &config))?;
         if self.shown.is_none() {
             self.clock.tick(Instant::now());
@@ -405,20 +373,7 @@ impl Viewer {
         r.has_regions = hikari_gpu::media::GpuMedia::has_regions(&scene);
         r.light_names = self.base.names.lights.clone();
         r.objects = self.base.names.objects.clone();
-        let (mut global, mut caustic) = PhotonCpuSettings::default().estimate_params(&scene);
-        global.radius = self.applied.global_radius;
-        caustic.radius = self.applied.caustic_radius;
-        // Converging frames use the normal test, as `render --passes` does.
-        (global.normal_test, caustic.normal_test) = (self.applied.progressive, self.applied.progressive);
-        let settings = GpuSettings {
-            volume_radius: self.applied.volume_radius,
-            volume_slices: self.applied.volume_slices,
-            terms: self.applied.terms,
-            lod: self.applied.lod,
-            // The documented rule (`render --estimator auto`).
-            estimator: hikari_gpu::tiled::Estimator::for_adapter(&ctx),
-            ..GpuSettings::new(global, caustic)
-        };
+        let settings = gpu_settings(&scene, &self.applied, &ctx);
         Ok(GpuRenderer::new(ctx, &scene, &shown.traced, settings)?)
     }
 
@@ -541,34 +496,19 @@ impl Viewer {
             session.renderer.set_camera(&camera)?;
             session.mean.reset();
         }
-        let c = &self.controls;
-        let a = &self.applied;
-        let restart = c.terms != a.terms
-            || c.lod != a.lod
-            || c.global_radius != a.global_radius
-            || c.caustic_radius != a.caustic_radius
-            || c.volume_radius != a.volume_radius
-            || c.progressive != a.progressive;
-        if restart {
-            let settings = &mut session.renderer.settings;
-            settings.terms = c.terms;
-            settings.lod = c.lod;
-            let radii_changed = settings.global.radius != c.global_radius
-                || settings.caustic.radius != c.caustic_radius
-                || settings.volume_radius != c.volume_radius;
-            settings.global.radius = c.global_radius;
-            settings.caustic.radius = c.caustic_radius;
-            settings.volume_radius = c.volume_radius;
-            let test_changed = settings.global.normal_test != c.progressive;
-            (settings.global.normal_test, settings.caustic.normal_test) = (c.progressive, c.progressive);
-            let radii_changed = radii_changed || test_changed;
-            if radii_changed && new_set.is_none() {
-                // The specular pass's grids are cells of the radii.
-                let shown = self.shown.as_ref().expect("a photon set is drawn");
-                session.renderer.set_photons(&shown.scene, &shown.traced)?;
+        let (c, a) = (&self.controls, &self.applied);
+        let restart = match restart_for_edits(&mut session.renderer, c, a) {
+            Some(radii_changed) => {
+                if radii_changed && new_set.is_none() {
+                    // The specular pass's grids are cells of the radii.
+                    let shown = self.shown.as_ref().expect("a photon set is drawn");
+                    session.renderer.set_photons(&shown.scene, &shown.traced)?;
+                }
+                session.mean.reset();
+                true
             }
-            session.mean.reset();
-        }
+            None => false,
+        };
         if *c != *a {
             self.applied = c.clone();
         }
@@ -579,18 +519,7 @@ impl Viewer {
             // change): progressive radii and a sub-pixel jitter for pass k, so
             // the mean converges as `render --passes` does (docs/progressive.md).
             let pass = if same_scene { session.mean.count() + 1 } else { 1 };
-            let progressive = self.controls.progressive;
-            let c = &self.controls;
-            let schedules = Schedules::new([c.global_radius, c.caustic_radius, c.volume_radius], DEFAULT_ALPHA);
-            let [global, caustic, volume] = schedules.radii(if progressive { pass } else { 1 });
-            let settings = &mut session.renderer.settings;
-            (settings.global.radius, settings.caustic.radius, settings.volume_radius) = (global, caustic, volume);
-            (settings.global.normal_test, settings.caustic.normal_test) = (progressive, progressive);
-            // Glossy lobes and area lights draw new samples each pass.
-            settings.pass = pass;
-            let mut camera = session.renderer.camera().clone();
-            camera.jitter = if progressive { pass_jitter(pass) } else { Vec2::ZERO };
-            session.renderer.set_camera(&camera)?;
+            set_pass(&mut session.renderer, &self.controls, pass)?;
             let applied = if same_scene {
                 session.renderer.set_photons(&set.scene, &set.traced)
             } else {
@@ -686,6 +615,7 @@ impl Viewer {
             size,
             &mut self.controls,
             &self.readouts,
+            |_| {},
         );
         ctx.queue.submit([encoder.finish()]);
         session.window.pre_present_notify();

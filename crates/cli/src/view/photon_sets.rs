@@ -8,30 +8,12 @@
 
 use crate::tracing::PhotonTracer;
 use anyhow::{Result, anyhow};
-use hikari_core::photon::{TraceSettings, TracedPhotons};
+use hikari_core::photon::TraceSettings;
 use hikari_core::scene::{Pose, Scene};
+pub use hikari_viewer::photon_set::{Job, PhotonSet};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::time::Instant;
-
-/// One request.
-#[derive(Clone, Debug)]
-pub struct Job {
-    pub pose: Pose,
-    pub photons: u64,
-    pub seed: u64,
-}
-
-/// A traced set: the request's number, the posed scene and its photons.
-pub struct PhotonSet {
-    pub id: u64,
-    pub pose: Pose,
-    pub scene: Arc<Scene>,
-    pub traced: TracedPhotons,
-    /// Seconds spent posing and tracing, and the photon paths traced.
-    pub seconds: f64,
-    pub photons: u64,
-}
 
 pub struct PhotonSets {
     /// None once dropping (closing it ends the thread).
@@ -142,7 +124,7 @@ impl Drop for PhotonSets {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hikari_core::photon::trace_photons;
+    use hikari_core::photon::{TracedPhotons, trace_photons};
 
     fn bits(t: &TracedPhotons) -> Vec<[u32; 3]> {
         t.global.iter().map(|p| p.position.map(f32::to_bits)).collect()

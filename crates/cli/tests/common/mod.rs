@@ -73,3 +73,15 @@ pub fn unlit_glb() -> Vec<u8> {
     scene.lights.clear();
     hikari_core::scene::gltf::export::scene_to_glb(&scene).unwrap()
 }
+
+/// Relative RMS difference of two images: √(Σ|a−b|²/Σ|b|²).
+pub fn relative_rms(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (p, q) in a.iter().zip(b) {
+        for c in 0..3 {
+            num += ((p[c] - q[c]) as f64).powi(2);
+            den += (q[c] as f64).powi(2);
+        }
+    }
+    (num / den).sqrt()
+}

@@ -11,7 +11,7 @@
 //! conversion to a CWBVH.
 
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::{Bvh2, node::Bvh2Node, reinsertion::ReinsertionOptimizer};
+use obvhs::bvh2::{Bvh2, leaf_collapser::collapse, node::Bvh2Node, reinsertion::ReinsertionOptimizer};
 use obvhs::cwbvh::{CwBvh, bvh2_to_cwbvh::bvh2_to_cwbvh};
 use obvhs::ploc::PlocBuilder;
 use obvhs::{Boundable, BvhBuildParams};
@@ -22,18 +22,39 @@ const MAX_BVH2_DEPTH: usize = 31;
 
 /// A CWBVH over `primitives` (at least one) with depth below 32.
 pub(crate) fn build_cwbvh<T: Boundable>(primitives: &[T], params: BvhBuildParams) -> CwBvh {
-    let mut bvh2 = PlocBuilder::with_capacity(primitives.len()).build(
-        params.ploc_search_distance,
-        primitives,
-        (0..primitives.len() as u32).collect::<Vec<_>>(),
-        params.sort_precision,
-        params.search_depth_threshold,
-    );
+    let mut bvh2 = ploc(primitives, &params);
     ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
     if depth(&bvh2) > MAX_BVH2_DEPTH {
         bvh2 = median_split(primitives);
     }
     bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false)
+}
+
+/// A binary BVH as obvhs's `build_bvh2` makes it (PLOC, reinsertion, leaf
+/// collapse, reinsertion), without its build timer: `std::time::Instant`
+/// panics in a browser, where the GPU renderer builds this BVH too.
+pub(crate) fn build_bvh2<T: Boundable>(primitives: &[T], params: BvhBuildParams) -> Bvh2 {
+    let mut bvh2 = ploc(primitives, &params);
+    let mut reinsertion = ReinsertionOptimizer::default();
+    reinsertion.run(&mut bvh2, params.reinsertion_batch_ratio, None);
+    collapse(&mut bvh2, params.max_prims_per_leaf.clamp(1, 255), params.collapse_traversal_cost);
+    reinsertion.run(
+        &mut bvh2,
+        params.reinsertion_batch_ratio * params.post_collapse_reinsertion_batch_ratio_multiplier,
+        None,
+    );
+    bvh2
+}
+
+/// The binary BVH of obvhs's PLOC builder, one primitive per leaf.
+fn ploc<T: Boundable>(primitives: &[T], params: &BvhBuildParams) -> Bvh2 {
+    PlocBuilder::with_capacity(primitives.len()).build(
+        params.ploc_search_distance,
+        primitives,
+        (0..primitives.len() as u32).collect::<Vec<_>>(),
+        params.sort_precision,
+        params.search_depth_threshold,
+    )
 }
 
 /// Number of levels of a binary BVH (a lone leaf: 1), without recursion.

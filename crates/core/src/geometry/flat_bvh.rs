@@ -5,8 +5,7 @@
 use super::{Accel, Ray};
 use bytemuck::Zeroable;
 use glam::{Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, bvh2::builder::build_bvh2};
-use std::time::Duration;
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb};
 
 /// A node: inner when `prim_count` is 0 (children at `first` and `first + 1`),
 /// else a leaf holding primitives `first .. first + prim_count`.
@@ -113,7 +112,7 @@ impl FlatBvh {
                 }
             })
             .collect();
-        let bvh = build_bvh2(&bounds, BvhBuildParams::medium_build(), &mut Duration::default());
+        let bvh = super::bvh_build::build_bvh2(&bounds, BvhBuildParams::medium_build());
         let nodes = bvh
             .nodes
             .iter()

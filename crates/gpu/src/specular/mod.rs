@@ -144,8 +144,10 @@ pub struct SpecularInputs<'a> {
 }
 
 pub struct SpecularPass {
-    pipeline: wgpu::ComputePipeline,
-    bind_group: wgpu::BindGroup,
+    /// None where the adapter offers too few storage buffers (the pass is
+    /// then never enabled: such scenes are refused).
+    pipeline: Option<wgpu::ComputePipeline>,
+    bind_group: Option<wgpu::BindGroup>,
     width: u32,
     height: u32,
     /// False when no surface is a mirror or glass: the pass is skipped and
@@ -205,7 +207,8 @@ fn padded_buffer(device: &wgpu::Device, label: &str, bytes: &[u8], usage: wgpu::
 
 /// Everything the pass binds but the photon grids, kept to rebind new ones.
 struct Bindings {
-    layout: wgpu::BindGroupLayout,
+    /// None where the adapter cannot run the pass.
+    layout: Option<wgpu::BindGroupLayout>,
     params: wgpu::Buffer,
     nodes: wgpu::Buffer,
     prims: wgpu::Buffer,
@@ -227,16 +230,17 @@ struct Bindings {
 }
 
 impl Bindings {
-    fn bind_group(&self, device: &wgpu::Device, grid: &wgpu::Buffer) -> wgpu::BindGroup {
+    fn bind_group(&self, device: &wgpu::Device, grid: &wgpu::Buffer) -> Option<wgpu::BindGroup> {
+        let layout = self.layout.as_ref()?;
         fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
         fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
         }
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
+        Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("specular"),
-            layout: &self.layout,
+            layout,
             entries: &[
                 buffer(0, &self.params),
                 buffer(1, &self.nodes),
@@ -265,7 +269,7 @@ impl Bindings {
                 buffer(17, &self.textures),
                 buffer(18, &self.environment),
             ],
-        })
+        }))
     }
 }
 
@@ -341,33 +345,41 @@ impl SpecularPass {
         use crate::binding::{storage, storage_texture_rgba32f, texture, uniform};
         use wgpu::TextureViewDimension::{D2, D2Array};
         let entry = |b, ty| crate::binding::entry(b, wgpu::ShaderStages::COMPUTE, ty);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("specular"),
-            entries: &[
-                entry(0, uniform()),
-                entry(1, storage(true)),
-                entry(2, storage(true)),
-                entry(3, storage(true)),
-                entry(4, storage(true)),
-                entry(5, storage(true)),
-                entry(6, uniform()),
-                entry(7, storage(true)),
-                entry(8, storage(true)),
-                entry(9, storage(true)),
-                entry(10, texture(D2Array)),
-                entry(11, texture(D2)),
-                entry(12, storage_texture_rgba32f()),
-                entry(13, uniform()),
-                entry(14, storage(false)),
-                entry(15, storage(false)),
-                entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
-                entry(17, storage(true)),
-                entry(18, storage(true)),
-            ],
+        // An adapter with too few storage buffers (a browser's) cannot
+        // even make the layout: the pass is left out, and scenes that need
+        // it are refused (`GpuRenderer::unsupported`).
+        let runnable =
+            device.limits().max_storage_buffers_per_shader_stage >= crate::capabilities::FULL_STORAGE_BUFFERS;
+        let layout = runnable.then(|| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("specular"),
+                entries: &[
+                    entry(0, uniform()),
+                    entry(1, storage(true)),
+                    entry(2, storage(true)),
+                    entry(3, storage(true)),
+                    entry(4, storage(true)),
+                    entry(5, storage(true)),
+                    entry(6, uniform()),
+                    entry(7, storage(true)),
+                    entry(8, storage(true)),
+                    entry(9, storage(true)),
+                    entry(10, texture(D2Array)),
+                    entry(11, texture(D2)),
+                    entry(12, storage_texture_rgba32f()),
+                    entry(13, uniform()),
+                    entry(14, storage(false)),
+                    entry(15, storage(false)),
+                    entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
+                    entry(17, storage(true)),
+                    entry(18, storage(true)),
+                ],
+            })
         });
-        let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
-        let pipeline =
-            crate::binding::square_compute_pipeline(device, "specular", &pipeline_layout, &module, "main", WORKGROUP);
+        let pipeline = layout.as_ref().map(|layout| {
+            let pipeline_layout = crate::binding::pipeline_layout(device, "specular", layout);
+            crate::binding::square_compute_pipeline(device, "specular", &pipeline_layout, &module, "main", WORKGROUP)
+        });
 
         let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();
@@ -564,7 +576,12 @@ impl SpecularPass {
 
     /// What the last recorded frame reported (waits for it).
     pub fn read_status(&self, ctx: &crate::GpuContext) -> Result<SpecularStatus, crate::GpuError> {
-        let words = crate::readback::read_u32s(ctx, &self.status, 2)?;
+        crate::block::wait_for(self.read_status_async(ctx))
+    }
+
+    /// `read_status` without blocking.
+    pub async fn read_status_async(&self, ctx: &crate::GpuContext) -> Result<SpecularStatus, crate::GpuError> {
+        let words = crate::readback::read_u32s_async(ctx, &self.status, 2).await?;
         Ok(SpecularStatus { over_budget: words[0], most_iterations: words[1] })
     }
 
@@ -587,9 +604,10 @@ impl SpecularPass {
         encoder.clear_buffer(&self.status, 0, None);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("specular"), timestamp_writes: None });
-        pass.set_pipeline(&self.pipeline);
+        let (Some(pipeline), Some(bind_group)) = (&self.pipeline, &self.bind_group) else { return };
+        pass.set_pipeline(pipeline);
         for index in 0..count {
-            pass.set_bind_group(0, &self.bind_group, &[index * SLICE_STRIDE as u32]);
+            pass.set_bind_group(0, bind_group, &[index * SLICE_STRIDE as u32]);
             pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
         }
     }

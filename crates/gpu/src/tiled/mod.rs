@@ -34,9 +34,19 @@ impl Estimator {
     /// The documented rule: tiled where the adapter is a hardware GPU
     /// (compute runs on the whole chip, rasterization on part of it), the
     /// raster splat on software adapters, where the splat's fixed-function
-    /// path is cheaper than the gather's loops and needs no loop slicing.
+    /// path is cheaper than the gather's loops and needs no loop slicing,
+    /// and where the adapter offers too few storage buffers for the gather
+    /// (a browser's WebGPU may offer 8).
     pub fn for_adapter(ctx: &GpuContext) -> Estimator {
-        if ctx.adapter_info.device_type == wgpu::DeviceType::Cpu { Estimator::Raster } else { Estimator::Tiled }
+        let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
+        // A browser may offer too few storage buffers for the tiled gather.
+        let tiled_fits = crate::capabilities::storage_buffer_shortfall(
+            &ctx.limits,
+            crate::capabilities::TILED_STORAGE_BUFFERS,
+            "the tiled estimator",
+        )
+        .is_none();
+        if software || !tiled_fits { Estimator::Raster } else { Estimator::Tiled }
     }
 }
 
@@ -344,7 +354,12 @@ impl TiledPass {
 impl TiledBinding {
     /// The last recorded frame's needs (waits for it).
     pub fn check(&self, ctx: &GpuContext) -> Result<TiledStatus, GpuError> {
-        let s = crate::readback::read_u32s(ctx, &self.status, 4)?;
+        crate::block::wait_for(self.check_async(ctx))
+    }
+
+    /// `check` without blocking.
+    pub async fn check_async(&self, ctx: &GpuContext) -> Result<TiledStatus, GpuError> {
+        let s = crate::readback::read_u32s_async(ctx, &self.status, 4).await?;
         self.checked.set(true);
         Ok(TiledStatus { list_entries: s[0], longest_list: s[1], over_budget: s[2] })
     }

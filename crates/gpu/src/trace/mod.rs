@@ -19,7 +19,7 @@ use hikari_core::material::{Rgb, mean};
 use hikari_core::photon::{Photon, TraceSettings, TraceStats, TracedPhotons};
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
-use std::time::Instant;
+use web_time::Instant;
 use wgpu::util::DeviceExt;
 
 /// Paths per batch: bounds the batch buffers (about 100 bytes per path).
@@ -418,6 +418,10 @@ pub struct GpuTracer {
 
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
+        let needed = crate::capabilities::FULL_STORAGE_BUFFERS;
+        if let Some(why) = crate::capabilities::storage_buffer_shortfall(&ctx.limits, needed, "the GPU photon tracer") {
+            return Err(GpuError::SceneUnsupported(why));
+        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -517,6 +521,16 @@ impl GpuTracer {
         ctx: &GpuContext,
         settings: &TraceSettings,
     ) -> Result<(TracedPhotons, GpuTraceReport), GpuError> {
+        crate::block::wait_for(self.trace_async(ctx, settings))
+    }
+
+    /// `trace` without blocking: each batch's readbacks are awaited, so a
+    /// browser's frames go on while a large set is traced.
+    pub async fn trace_async(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &TraceSettings,
+    ) -> Result<(TracedPhotons, GpuTraceReport), GpuError> {
         let n = settings.photons.max(1);
         let power_unit = self.scene.total_power / n as f32;
         let mut traced = TracedPhotons {
@@ -532,18 +546,19 @@ impl GpuTracer {
         while first < n {
             let paths = (n - first).min(self.batch_paths.max(1) as u64) as u32;
             let started = Instant::now();
-            let result = self.run_batch(ctx, settings, n, first, paths, &mut report)?;
+            let result = self.run_batch(ctx, settings, n, first, paths, &mut report).await?;
             report.gpu_seconds += started.elapsed().as_secs_f64();
             let started = Instant::now();
             let batch = self.batch.as_ref().expect("run_batch made the batch");
             let [caustic_start, volume_start, total] = result.map_starts;
-            let words = crate::readback::read_u32s(ctx, &batch.photons, total as u64 * 5)?;
+            let words = crate::readback::read_u32s_async(ctx, &batch.photons, total as u64 * 5).await?;
             let photons: &[Photon] = bytemuck::cast_slice(&words);
             traced.global.extend_from_slice(&photons[..caustic_start as usize]);
             traced.caustic.extend_from_slice(&photons[caustic_start as usize..volume_start as usize]);
             traced.volume.extend_from_slice(&photons[volume_start as usize..]);
             if self.per_bounce_statistics {
-                bounces_of_global.extend(crate::readback::read_u32s(ctx, &batch.bounces, caustic_start as u64)?);
+                let bounces = crate::readback::read_u32s_async(ctx, &batch.bounces, caustic_start as u64).await?;
+                bounces_of_global.extend(bounces);
             }
             report.readback_seconds += started.elapsed().as_secs_f64();
             traced.stats.truncated += result.truncated as u64;
@@ -564,6 +579,10 @@ impl GpuTracer {
     /// Traces without reading the maps back: how many photons each map got.
     /// For measuring the tracing rate.
     pub fn trace_on_gpu(&mut self, ctx: &GpuContext, settings: &TraceSettings) -> Result<[u64; 3], GpuError> {
+        crate::block::wait_for(self.trace_on_gpu_async(ctx, settings))
+    }
+
+    async fn trace_on_gpu_async(&mut self, ctx: &GpuContext, settings: &TraceSettings) -> Result<[u64; 3], GpuError> {
         let n = settings.photons.max(1);
         let mut report = GpuTraceReport::default();
         let mut sizes = [0u64; 3];
@@ -571,7 +590,7 @@ impl GpuTracer {
         while first < n {
             let paths = (n - first).min(self.batch_paths.max(1) as u64) as u32;
             let [caustic_start, volume_start, total] =
-                self.run_batch(ctx, settings, n, first, paths, &mut report)?.map_starts;
+                self.run_batch(ctx, settings, n, first, paths, &mut report).await?.map_starts;
             sizes[0] += caustic_start as u64;
             sizes[1] += (volume_start - caustic_start) as u64;
             sizes[2] += (total - volume_start) as u64;
@@ -582,7 +601,7 @@ impl GpuTracer {
 
     /// Traces paths `first .. first + paths` of a run of `n` and compacts
     /// their maps, running again with more record room if they overflowed.
-    fn run_batch(
+    async fn run_batch(
         &mut self,
         ctx: &GpuContext,
         settings: &TraceSettings,
@@ -602,7 +621,7 @@ impl GpuTracer {
         }
         loop {
             self.ensure_batch(ctx, paths, record_capacity)?;
-            let status = self.dispatch(ctx, settings, n, first, paths)?;
+            let status = self.dispatch(ctx, settings, n, first, paths).await?;
             let [taken, truncated, over_budget, iterations] = [status[0], status[1], status[2], status[3]];
             report.most_iterations = report.most_iterations.max(iterations);
             if over_budget > 0 {
@@ -716,7 +735,7 @@ impl GpuTracer {
 
     /// Records and runs one batch; returns the tracer's status words then
     /// the map starts.
-    fn dispatch(
+    async fn dispatch(
         &self,
         ctx: &GpuContext,
         settings: &TraceSettings,
@@ -790,8 +809,8 @@ impl GpuTracer {
             pass.dispatch_workgroups(x, y, 1);
         }
         ctx.scoped(|| queue.submit([encoder.finish()]))?;
-        let status = crate::readback::read_u32s(ctx, &batch.status, 4)?;
-        let starts = crate::readback::read_u32s(ctx, &batch.map_starts, 3)?;
+        let status = crate::readback::read_u32s_async(ctx, &batch.status, 4).await?;
+        let starts = crate::readback::read_u32s_async(ctx, &batch.map_starts, 3).await?;
         Ok([status[0], status[1], status[2], status[3], starts[0], starts[1], starts[2]])
     }
 }

@@ -93,6 +93,14 @@ impl Orbit {
         self.distance = (self.distance * ZOOM_STEP.powf(lines)).clamp(1e-4, 1e7);
     }
 
+    /// Two fingers spread `ratio` times as far apart as before: the eye
+    /// comes that many times closer to the target (a pinch on a touch screen).
+    pub fn pinch(&mut self, ratio: f32) {
+        if ratio.is_finite() && ratio > 0.0 {
+            self.distance = (self.distance / ratio).clamp(1e-4, 1e7);
+        }
+    }
+
     /// The view as a scene file's `[camera]` table.
     pub fn toml(&self, width: u32, height: u32) -> String {
         let v = |p: Vec3| format!("[{}, {}, {}]", p.x, p.y, p.z);
@@ -153,6 +161,17 @@ mod tests {
         orbit.fly(0.5, 0.0, 0.0);
         assert!((orbit.position() - (eye + forward * 0.5)).length() < 1e-4);
         assert!((orbit.camera(64, 48).basis().0 - forward).length() < 1e-5);
+    }
+
+    #[test]
+    fn a_pinch_scales_the_distance() {
+        let mut orbit = Orbit::new(&camera());
+        let before = orbit.distance;
+        orbit.pinch(2.0);
+        assert!((orbit.distance - before / 2.0).abs() < 1e-5 * before);
+        orbit.pinch(0.0);
+        orbit.pinch(f32::NAN);
+        assert!((orbit.distance - before / 2.0).abs() < 1e-5 * before);
     }
 
     #[test]

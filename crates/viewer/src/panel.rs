@@ -76,6 +76,10 @@ pub struct Panel {
     state: egui_winit::State,
     renderer: egui_wgpu::Renderer,
     pub visible: bool,
+    /// Where the last frame drew the term checkboxes, by term name, as
+    /// [left, top, right, bottom] in points (CSS pixels in a browser):
+    /// the web page's tests click them.
+    pub widget_rects: Vec<(String, [f32; 4])>,
 }
 
 impl Panel {
@@ -83,7 +87,7 @@ impl Panel {
         let ctx = egui::Context::default();
         let state = egui_winit::State::new(ctx.clone(), egui::ViewportId::ROOT, window, None, None, None);
         let renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
-        Panel { ctx, state, renderer, visible: true }
+        Panel { ctx, state, renderer, visible: true, widget_rects: Vec::new() }
     }
 
     /// Passes a window event to egui; true when egui used it (a click on
@@ -92,7 +96,8 @@ impl Panel {
         self.visible && self.state.on_window_event(window, event).consumed
     }
 
-    /// Lays out the panel, letting it edit `controls`, and draws it into `target`.
+    /// Lays out the panel, letting it edit `controls`, and draws it into
+    /// `target`; `front_end` adds widgets of its own at the top.
     #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &mut self,
@@ -104,13 +109,23 @@ impl Panel {
         size: [u32; 2],
         controls: &mut Controls,
         readouts: &Readouts,
+        front_end: impl FnOnce(&mut egui::Ui),
     ) {
         if !self.visible {
             return;
         }
         let input = self.state.take_egui_input(window);
+        let mut front_end = Some(front_end);
+        let rects = &mut self.widget_rects;
+        rects.clear();
         let output = self.ctx.run_pass(input, |ctx| {
-            egui::Window::new("hikari").default_width(260.0).show(ctx, |ui| layout(ui, controls, readouts));
+            egui::Window::new("hikari").default_width(260.0).show(ctx, |ui| {
+                // The front end's own widgets first (the web page's scene menu).
+                if let Some(widgets) = front_end.take() {
+                    widgets(ui);
+                }
+                layout(ui, controls, readouts, rects)
+            });
         });
         let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
         self.state.handle_platform_output(window, platform_output);
@@ -147,7 +162,7 @@ impl Panel {
     }
 }
 
-fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
+fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts, rects: &mut Vec<(String, [f32; 4])>) {
     ui.label(&r.adapter);
     ui.label(format!("{:.1} fps; mean of {} frames ({} photon sets)", r.fps, r.frames_in_mean, r.photon_sets));
     if let Some(noise) = r.noise {
@@ -177,11 +192,13 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
     ui.separator();
     ui.label("terms");
     ui.horizontal_wrapped(|ui| {
-        let toggle = |ui: &mut egui::Ui, value: &mut f32, name: &str| {
+        let mut toggle = |ui: &mut egui::Ui, value: &mut f32, name: &str| {
             let mut on = *value > 0.0;
-            if ui.checkbox(&mut on, name).changed() {
+            let response = ui.checkbox(&mut on, name);
+            if response.changed() {
                 *value = on as u32 as f32;
             }
+            rects.push((name.to_string(), rect_of(&response)));
         };
         toggle(ui, &mut c.terms.direct, "direct");
         toggle(ui, &mut c.terms.indirect, "indirect");
@@ -230,6 +247,12 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
         ui.radio_value(&mut c.mode, PresentMode::Photons, "as points");
         ui.radio_value(&mut c.mode, PresentMode::DetailLevels, "LOD level");
     });
+}
+
+/// A widget's place as [left, top, right, bottom] in points.
+pub fn rect_of(response: &egui::Response) -> [f32; 4] {
+    let r = response.rect;
+    [r.min.x, r.min.y, r.max.x, r.max.y]
 }
 
 /// Three drag fields for a point or vector; true when one changed.

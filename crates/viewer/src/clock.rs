@@ -2,7 +2,7 @@
 //! fixed step per frame in unattended runs (so a run with `--frames` draws
 //! the same moments on any machine).
 
-use std::time::Instant;
+use web_time::Instant;
 
 pub struct AnimationClock {
     time: f32,

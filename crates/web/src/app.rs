@@ -1,0 +1,684 @@
+//! The viewer in a tab. winit owns the canvas and its events; a frame is
+//! a task (`frame`) started by a redraw (`requestAnimationFrame`) when the
+//! last one is done: it applies what changed (camera, panel edits, a new
+//! photon set) to the renderer, awaits `GpuRenderer::render_async`, adds
+//! the frame to the running mean and presents the mean with the panel. A
+//! hidden tab gets no animation frames, so it renders nothing.
+
+use crate::files::{DroppedFile, scene_from_files};
+use crate::input::CameraInput;
+use crate::options::PageOptions;
+use crate::page;
+use crate::photons::{Job, PhotonSet, Tracing};
+use hikari_core::scene::{Pose, Scene, builtin};
+use hikari_gpu::accumulate::AccumulatePass;
+use hikari_gpu::points::PointColors;
+use hikari_gpu::present::{PresentMode, PresentPass};
+use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
+use hikari_viewer::clock::AnimationClock;
+use hikari_viewer::frame_stats::FrameStats;
+use hikari_viewer::orbit::Orbit;
+use hikari_viewer::panel::{Controls, Panel, Readouts, rect_of};
+use hikari_viewer::settings::{controls_for_scene, gpu_settings, restart_for_edits, set_pass};
+use std::cell::RefCell;
+use std::rc::{Rc, Weak};
+use std::sync::Arc;
+use wasm_bindgen::JsCast;
+use web_time::Instant;
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, EventLoop};
+use winit::platform::web::{EventLoopExtWebSys, WindowAttributesExtWebSys};
+use winit::window::{Window, WindowId};
+
+pub type Shared = Rc<RefCell<Viewer>>;
+
+thread_local! {
+    /// The page's viewer, for the functions the page's script calls (`api`).
+    pub static VIEWER: RefCell<Weak<RefCell<Viewer>>> = RefCell::new(Weak::new());
+}
+
+/// What the panel's page widgets ask for, done at the next frame.
+enum Action {
+    Builtin(String),
+    Files(Vec<DroppedFile>),
+    SavePng,
+}
+
+/// The device and the canvas's surface, once WebGPU answered.
+pub struct Gpu {
+    pub window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    config: wgpu::SurfaceConfiguration,
+    pub ctx: GpuContext,
+    present: PresentPass,
+    panel: Panel,
+    /// The renderer and the mean, once the scene's first photon set came.
+    pub view: Option<View>,
+}
+
+pub struct View {
+    /// Shared with the frame task while a frame renders (`Rc::get_mut`
+    /// works between frames, when the task has dropped its handle).
+    renderer: Rc<GpuRenderer>,
+    pub mean: AccumulatePass,
+}
+
+pub struct Viewer {
+    options: PageOptions,
+    /// What the page shows: a built-in scene's name or a dropped file's.
+    pub scene_name: String,
+    base: Arc<Scene>,
+    orbit: Orbit,
+    input: CameraInput,
+    controls: Controls,
+    applied: Controls,
+    pub readouts: Readouts,
+    clock: AnimationClock,
+    stats: FrameStats,
+    last_frame: Option<Instant>,
+    started: Option<Instant>,
+    pub gpu: Option<Gpu>,
+    tracing: Option<Tracing>,
+    /// The photon set on screen.
+    shown: Option<PhotonSet>,
+    /// The pose and count last asked of the tracer.
+    requested: Option<(Pose, u64)>,
+    /// Whether the renderer must be made anew (a new scene, a new size).
+    rebuild: bool,
+    frame_in_flight: bool,
+    actions: Vec<Action>,
+    /// The error on the page, if any (the last good scene stays).
+    pub error: Option<String>,
+    pub saved_pngs: u32,
+    /// Where the page's own panel widgets were drawn (see `Panel::widget_rects`).
+    pub page_rects: Vec<(String, [f32; 4])>,
+}
+
+/// Starts the page's viewer with `options`.
+pub fn run(options: PageOptions) {
+    let scene = match Scene::load(&options.scene) {
+        Ok(scene) => scene,
+        Err(e) => return page::show_error(&e.to_string()),
+    };
+    let event_loop = match EventLoop::new() {
+        Ok(event_loop) => event_loop,
+        Err(e) => return page::show_error(&format!("cannot start the page's event loop: {e}")),
+    };
+    let name = options.scene.clone();
+    let viewer = Rc::new(RefCell::new(Viewer::new(options, name, scene)));
+    VIEWER.with(|v| *v.borrow_mut() = Rc::downgrade(&viewer));
+    let files = Rc::downgrade(&viewer);
+    let listening = page::on_files(move |dropped| {
+        if let Some(viewer) = files.upgrade() {
+            viewer.borrow_mut().actions.push(Action::Files(dropped));
+        }
+    });
+    if let Err(e) = listening {
+        page::show_error(&format!("cannot listen for dropped files: {e:?}"));
+    }
+    event_loop.spawn_app(Page { viewer });
+}
+
+impl Viewer {
+    fn new(options: PageOptions, scene_name: String, scene: Scene) -> Self {
+        let controls = controls_for_scene(&scene, options.exposure, options.photons, false);
+        Viewer {
+            orbit: Orbit::new(&scene.camera),
+            input: CameraInput::new(scene.diagonal()),
+            base: Arc::new(scene),
+            scene_name,
+            applied: controls.clone(),
+            controls,
+            readouts: Readouts::default(),
+            clock: AnimationClock::new(0.0, None),
+            stats: FrameStats::default(),
+            last_frame: None,
+            started: None,
+            gpu: None,
+            tracing: None,
+            shown: None,
+            requested: None,
+            rebuild: true,
+            frame_in_flight: false,
+            actions: Vec::new(),
+            error: None,
+            saved_pngs: 0,
+            page_rects: Vec::new(),
+            options,
+        }
+    }
+
+    /// Frames in the mean on screen.
+    pub fn frames_in_mean(&self) -> u32 {
+        self.gpu.as_ref().and_then(|g| g.view.as_ref()).map_or(0, |v| v.mean.count())
+    }
+
+    fn pose(&self) -> Pose {
+        Pose {
+            time: if self.base.is_animated() { self.clock.time() } else { 0.0 },
+            lights: self.controls.lights.clone(),
+            offsets: self.controls.offsets.clone(),
+        }
+    }
+
+    /// A scene replaces the one on screen (which stays until the new
+    /// one's first photon set is traced).
+    fn open_scene(&mut self, name: String, scene: Scene) {
+        for note in &scene.notes {
+            page::set_status(&format!("{name}: {note}"));
+        }
+        self.controls = controls_for_scene(&scene, self.controls.exposure, self.controls.photons, false);
+        self.applied = self.controls.clone();
+        self.orbit = Orbit::new(&scene.camera);
+        self.input = CameraInput::new(scene.diagonal());
+        self.base = Arc::new(scene);
+        self.scene_name = name;
+        self.requested = None;
+        self.clock = AnimationClock::new(0.0, None);
+        if let Some(gpu) = &self.gpu {
+            self.tracing = Some(Tracing::new(gpu.ctx.clone(), self.base.clone()));
+        }
+        self.rebuild = true;
+    }
+
+    fn act(&mut self) {
+        for action in std::mem::take(&mut self.actions) {
+            match action {
+                Action::Builtin(name) => match Scene::load(&name) {
+                    Ok(scene) => {
+                        self.error = None;
+                        page::clear_error();
+                        self.open_scene(name, scene);
+                    }
+                    Err(e) => self.show_error(e.to_string()),
+                },
+                Action::Files(files) => match scene_from_files(&files) {
+                    Ok(scene) => {
+                        self.error = None;
+                        page::clear_error();
+                        let name = files.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ");
+                        self.open_scene(name, scene);
+                    }
+                    Err(e) => self.show_error(format!("{e} (the last scene stays)")),
+                },
+                Action::SavePng => self.save_png(),
+            }
+        }
+    }
+
+    fn show_error(&mut self, text: String) {
+        page::show_error(&text);
+        self.error = Some(text);
+    }
+
+    /// Asks the tracer for the next set when it is free: the pose the
+    /// panel and the clock ask for when it moved, else (to converge) one
+    /// more set of the pose on screen. With `frames=N` the mean stops at
+    /// N frames, each of its own set.
+    fn ask_for_photons(&mut self) {
+        let pose = self.pose();
+        let in_mean = self.frames_in_mean();
+        let Some(tracing) = &mut self.tracing else { return };
+        if tracing.busy() {
+            return;
+        }
+        let photons = self.controls.photons;
+        let changed = self.requested.as_ref().is_none_or(|(p, n)| *p != pose || *n != photons);
+        let done = self.options.frames.is_some_and(|n| in_mean >= n) && !changed;
+        if done {
+            return;
+        }
+        let shown_is_newest = self.shown.as_ref().is_some_and(|s| s.id + 1 == tracing.next_id());
+        if changed || shown_is_newest || self.rebuild {
+            let seed = self.options.seed.wrapping_add(tracing.next_id());
+            tracing.request(Job { pose: pose.clone(), photons, seed });
+            self.requested = Some((pose, photons));
+        }
+    }
+
+    /// Prepares a frame: the renderer made or updated for what changed.
+    /// Returns the renderer when the frame is to be rendered.
+    fn prepare(&mut self) -> Result<Option<Rc<GpuRenderer>>, GpuError> {
+        self.act();
+        let now = Instant::now();
+        if self.last_frame.is_some() {
+            self.clock.playing = self.controls.playing;
+            self.clock.tick(now);
+        }
+        self.readouts.time = self.base.is_animated().then(|| self.clock.time());
+        let Some(gpu) = &mut self.gpu else { return Ok(None) };
+        if self.tracing.is_none() {
+            self.tracing = Some(Tracing::new(gpu.ctx.clone(), self.base.clone()));
+        }
+        if self.input.fly(&mut self.orbit) {
+            // Applied below, as any camera move.
+        }
+        let mut new_set = self.tracing.as_mut().and_then(Tracing::take);
+        if let Some(set) = &new_set {
+            let r = &mut self.readouts;
+            r.trace_ms = set.seconds * 1e3;
+            r.photons_per_set = set.photons;
+            r.stored = [set.traced.indirect().len(), set.traced.caustic.len(), set.traced.volume.len()];
+        }
+        let tracing = self.tracing.as_ref().expect("made above");
+        self.readouts.photon_sets = tracing.received;
+        self.readouts.adapter = format!("{}; photons traced on the {}", gpu.ctx.describe(), tracing.device());
+        self.readouts.warning = tracing
+            .gpu_failed
+            .as_ref()
+            .map(|why| format!("{why}: photons are traced on the CPU, at most {} a set", crate::photons::CPU_PHOTONS));
+        let (width, height) = (gpu.config.width, gpu.config.height);
+        let camera = self.orbit.camera(width, height);
+        let mut fresh = false;
+        // A new scene (or size): a renderer of its first set.
+        if self.rebuild {
+            let Some(set) = new_set.take() else {
+                self.ask_for_photons();
+                return Ok(None);
+            };
+            let mut scene = Scene::clone(&set.scene);
+            scene.camera = camera.clone();
+            let r = &mut self.readouts;
+            r.diagonal = scene.diagonal();
+            r.has_media = !scene.media.is_empty();
+            r.has_regions = hikari_gpu::media::GpuMedia::has_regions(&scene);
+            r.light_names = self.base.names.lights.clone();
+            r.objects = self.base.names.objects.clone();
+            let settings = gpu_settings(&scene, &self.applied, &gpu.ctx);
+            let mut renderer = GpuRenderer::new(gpu.ctx.clone(), &scene, &set.traced, settings)?;
+            set_pass(&mut renderer, &self.applied, 1)?;
+            let mean = AccumulatePass::new(&gpu.ctx.device, renderer.resolved());
+            gpu.view = Some(View { renderer: Rc::new(renderer), mean });
+            self.shown = Some(set);
+            self.rebuild = false;
+            page::set_status("");
+            fresh = true;
+        }
+        let view = gpu.view.as_mut().expect("built above");
+        let renderer = Rc::get_mut(&mut view.renderer).expect("no frame holds the renderer between frames");
+        let moved = camera.position != renderer.camera().position || camera.look_at != renderer.camera().look_at;
+        if moved {
+            renderer.set_camera(&camera)?;
+            view.mean.reset();
+        }
+        let mut restart = false;
+        if let Some(radii_changed) = restart_for_edits(renderer, &self.controls, &self.applied) {
+            if radii_changed && !fresh && new_set.is_none() {
+                let shown = self.shown.as_ref().expect("a photon set is drawn");
+                renderer.set_photons(&shown.scene, &shown.traced)?;
+            }
+            view.mean.reset();
+            restart = true;
+        }
+        if self.controls != self.applied {
+            self.applied = self.controls.clone();
+        }
+        if let Some(set) = new_set {
+            let same_scene = self.shown.as_ref().is_some_and(|s| s.pose == set.pose);
+            let pass = if same_scene { view.mean.count() + 1 } else { 1 };
+            set_pass(renderer, &self.applied, pass)?;
+            if same_scene {
+                renderer.set_photons(&set.scene, &set.traced)?;
+            } else {
+                renderer.set_scene(&set.scene, &set.traced)?;
+                view.mean.reset();
+            }
+            self.shown = Some(set);
+            fresh = true;
+        }
+        let unattended_done = self.options.frames.is_some_and(|n| view.mean.count() >= n);
+        let render = !unattended_done && (moved || fresh || restart || view.mean.count() == 0);
+        let renderer = render.then(|| view.renderer.clone());
+        self.ask_for_photons();
+        Ok(renderer)
+    }
+
+    /// Adds the rendered frame (if one was) to the mean and presents the
+    /// mean with the panel.
+    fn finish(&mut self, rendered: bool) -> Result<(), GpuError> {
+        let Some(gpu) = &mut self.gpu else { return Ok(()) };
+        let Some(view) = &mut gpu.view else { return Ok(()) };
+        let ctx = &gpu.ctx;
+        if rendered {
+            let mut encoder = ctx.device.create_command_encoder(&Default::default());
+            view.mean.record(&ctx.queue, &mut encoder);
+            ctx.queue.submit([encoder.finish()]);
+        }
+        let texture = match gpu.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => return Ok(()),
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                gpu.surface.configure(&ctx.device, &gpu.config);
+                return Ok(());
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                return Err(GpuError::Failed("the canvas refused a frame".into()));
+            }
+        };
+        let target = texture.texture.create_view(&Default::default());
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        let renderer = &view.renderer;
+        let shown = match self.controls.mode {
+            PresentMode::Radiance => &view.mean.mean,
+            PresentMode::Normals => &renderer.targets.gbuffer.normal,
+            PresentMode::Albedo => &renderer.targets.gbuffer.albedo,
+            PresentMode::Photons => renderer.draw_points(PointColors::Power)?,
+            PresentMode::DetailLevels => renderer.draw_points(PointColors::DetailLevel)?,
+        };
+        gpu.present.record(
+            &ctx.device,
+            &ctx.queue,
+            &mut encoder,
+            shown,
+            &target,
+            self.controls.exposure,
+            self.controls.mode,
+        );
+        self.readouts.frames_in_mean = view.mean.count();
+        let size = [gpu.config.width, gpu.config.height];
+        let mut asked = None;
+        let scene_name = self.scene_name.clone();
+        let error = self.error.clone();
+        let page_rects = &mut self.page_rects;
+        gpu.panel.draw(
+            &gpu.window,
+            &ctx.device,
+            &ctx.queue,
+            &mut encoder,
+            &target,
+            size,
+            &mut self.controls,
+            &self.readouts,
+            |ui| asked = page_widgets(ui, &scene_name, error.as_deref(), page_rects),
+        );
+        ctx.queue.submit([encoder.finish()]);
+        ctx.queue.present(texture);
+        ctx.check()?;
+        self.actions.extend(asked);
+        let now = Instant::now();
+        if let Some(last) = self.last_frame {
+            self.stats.push((now - last).as_secs_f64());
+        }
+        self.started.get_or_insert(now);
+        self.last_frame = Some(now);
+        if self.stats.frames() > 0 {
+            self.readouts.fps = self.stats.mean_fps();
+        }
+        Ok(())
+    }
+
+    /// Reads the mean back and offers it as a PNG download (tone-mapped
+    /// at the panel's exposure, as shown).
+    fn save_png(&mut self) {
+        let Some((ctx, texture)) = self.mean_texture() else { return };
+        let (exposure, name) = (self.controls.exposure, self.scene_name.clone());
+        let me = VIEWER.with(|v| v.borrow().clone());
+        wasm_bindgen_futures::spawn_local(async move {
+            let result = async {
+                let pixels = hikari_gpu::readback::read_rgba_async(&ctx, &texture).await.map_err(|e| e.to_string())?;
+                let png = png_bytes(texture.width(), texture.height(), &pixels, exposure)?;
+                let stem = name.split([',', '.']).next().unwrap_or("hikari").trim().to_string();
+                page::download(&format!("{stem}.png"), &png, "image/png").map_err(|e| format!("{e:?}"))
+            }
+            .await;
+            match result {
+                Ok(()) => {
+                    if let Some(viewer) = me.upgrade() {
+                        viewer.borrow_mut().saved_pngs += 1;
+                    }
+                }
+                Err(e) => page::show_error(&format!("cannot save the PNG: {e}")),
+            }
+        });
+    }
+
+    /// The device and the mean's texture, for reading it back.
+    pub fn mean_texture(&self) -> Option<(GpuContext, wgpu::Texture)> {
+        let gpu = self.gpu.as_ref()?;
+        Some((gpu.ctx.clone(), gpu.view.as_ref()?.mean.mean.clone()))
+    }
+
+    fn resized(&mut self, width: u32, height: u32) {
+        let Some(gpu) = &mut self.gpu else { return };
+        if width == 0 || height == 0 || (width, height) == (gpu.config.width, gpu.config.height) {
+            return;
+        }
+        gpu.config.width = width;
+        gpu.config.height = height;
+        gpu.surface.configure(&gpu.ctx.device, &gpu.config);
+        // The renderer's targets are of the canvas's size: made anew from
+        // the set on screen.
+        if let (Some(view), Some(shown)) = (&mut gpu.view, &self.shown) {
+            let mut scene = Scene::clone(&shown.scene);
+            scene.camera = self.orbit.camera(width, height);
+            let settings = gpu_settings(&scene, &self.applied, &gpu.ctx);
+            match GpuRenderer::new(gpu.ctx.clone(), &scene, &shown.traced, settings) {
+                Ok(mut renderer) => {
+                    if let Err(e) = set_pass(&mut renderer, &self.applied, 1) {
+                        page::show_error(&e.to_string());
+                    }
+                    view.mean = AccumulatePass::new(&gpu.ctx.device, renderer.resolved());
+                    view.renderer = Rc::new(renderer);
+                }
+                Err(e) => page::show_error(&e.to_string()),
+            }
+        }
+    }
+}
+
+/// The page's own widgets at the top of the panel: the scene menu, the
+/// file dialog, the PNG download.
+fn page_widgets(
+    ui: &mut egui::Ui,
+    scene_name: &str,
+    error: Option<&str>,
+    rects: &mut Vec<(String, [f32; 4])>,
+) -> Option<Action> {
+    let mut asked = None;
+    rects.clear();
+    ui.horizontal(|ui| {
+        ui.label("scene");
+        egui::ComboBox::from_id_salt("scene").selected_text(scene_name).show_ui(ui, |ui| {
+            for name in builtin::NAMES {
+                if ui.selectable_label(scene_name == *name, *name).clicked() {
+                    asked = Some(Action::Builtin(name.to_string()));
+                }
+            }
+        });
+    });
+    ui.horizontal(|ui| {
+        let open = ui.button("open .glb / .gltf…");
+        if open.clicked() {
+            page::open_file_dialog();
+        }
+        let save = ui.button("save PNG");
+        if save.clicked() {
+            asked = Some(Action::SavePng);
+        }
+        rects.push(("open".into(), rect_of(&open)));
+        rects.push(("save PNG".into(), rect_of(&save)));
+    });
+    ui.label("or drop a .glb file onto the page");
+    if let Some(error) = error {
+        ui.colored_label(egui::Color32::LIGHT_RED, error);
+    }
+    ui.separator();
+    asked
+}
+
+/// `pixels` (RGBA, linear) tone-mapped to an sRGB PNG.
+fn png_bytes(width: u32, height: u32, pixels: &[glam::Vec4], exposure: f32) -> Result<Vec<u8>, String> {
+    let mut image = hikari_core::render::Image::new(width, height);
+    for (pixel, value) in image.pixels.iter_mut().zip(pixels) {
+        let v = value.truncate();
+        *pixel = if v.is_finite() { v } else { glam::Vec3::ZERO };
+    }
+    let rgb = hikari_core::output::tone_map(&image, exposure);
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
+        &rgb,
+        width,
+        height,
+        image::ExtendedColorType::Rgb8,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok(png)
+}
+
+/// Renders one frame of `viewer`: see the module's comment.
+async fn frame(viewer: Shared) {
+    let prepared = viewer.borrow_mut().prepare();
+    let outcome = match prepared {
+        Ok(Some(renderer)) => {
+            let rendered = renderer.render_async().await;
+            drop(renderer);
+            rendered.and_then(|()| viewer.borrow_mut().finish(true))
+        }
+        Ok(None) => viewer.borrow_mut().finish(false),
+        Err(e) => Err(e),
+    };
+    let mut v = viewer.borrow_mut();
+    v.frame_in_flight = false;
+    if let Err(e) = outcome {
+        // A GPU error stops the frames (never a silently wrong image).
+        v.show_error(format!("{e}"));
+        return;
+    }
+    if let Some(gpu) = &v.gpu {
+        gpu.window.request_redraw();
+    }
+}
+
+/// Opens WebGPU on the canvas.
+async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
+    page::set_status("opening WebGPU…");
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
+    let surface = instance.create_surface(window.clone()).map_err(|e| format!("cannot draw in the canvas: {e}"))?;
+    let ctx = match GpuContext::for_surface_async(&instance, &surface).await {
+        Ok(ctx) => ctx,
+        // `navigator.gpu` without an adapter (WebGPU switched off, or a
+        // blocklisted GPU): as good as no WebGPU.
+        Err(GpuError::NoAdapter(_)) => {
+            page::show_no_webgpu();
+            return Ok(());
+        }
+        Err(e) => return Err(format!("{e} (WebGPU is present, but its adapter cannot run hikari)")),
+    };
+    let size = window.inner_size();
+    let (width, height) = (size.width.max(1), size.height.max(1));
+    let format = surface
+        .get_capabilities(&ctx.adapter)
+        .formats
+        .first()
+        .copied()
+        .ok_or_else(|| format!("the canvas offers no surface format on {}", ctx.describe()))?;
+    let config = hikari_viewer::surface::surface_config(format, width, height);
+    surface.configure(&ctx.device, &config);
+    let present = PresentPass::new(&ctx.device, format);
+    let mut panel = Panel::new(&window, &ctx.device, format);
+    let mut v = viewer.borrow_mut();
+    panel.visible = v.options.panel;
+    v.readouts.adapter = ctx.describe();
+    web_sys::console::log_1(&format!("hikari: {} on {}", v.scene_name, ctx.describe()).into());
+    page::set_status(&format!("tracing photons of {} on {}…", v.scene_name, ctx.describe()));
+    v.gpu = Some(Gpu { window: window.clone(), surface, config, ctx, present, panel, view: None });
+    window.request_redraw();
+    Ok(())
+}
+
+/// winit's handler: the canvas's events and redraws.
+struct Page {
+    viewer: Shared,
+}
+
+impl ApplicationHandler for Page {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.viewer.borrow().gpu.is_some() {
+            return;
+        }
+        let canvas =
+            page::document().get_element_by_id("hikari").and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok());
+        let attributes = Window::default_attributes()
+            .with_title("hikari")
+            .with_canvas(canvas)
+            .with_append(true)
+            .with_focusable(true)
+            .with_prevent_default(true);
+        let window = match event_loop.create_window(attributes) {
+            Ok(window) => Arc::new(window),
+            Err(e) => return page::show_error(&format!("cannot use the canvas: {e}")),
+        };
+        let viewer = self.viewer.clone();
+        wasm_bindgen_futures::spawn_local(async move {
+            if let Err(e) = open_gpu(viewer.clone(), window).await {
+                page::set_status("");
+                viewer.borrow_mut().show_error(e);
+            }
+        });
+    }
+
+    fn window_event(&mut self, _: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let mut v = self.viewer.borrow_mut();
+        let v = &mut *v;
+        let Some(gpu) = &mut v.gpu else { return };
+        let input = matches!(
+            event,
+            WindowEvent::MouseInput { .. }
+                | WindowEvent::CursorMoved { .. }
+                | WindowEvent::MouseWheel { .. }
+                | WindowEvent::KeyboardInput { .. }
+                | WindowEvent::Touch(_)
+        );
+        if gpu.panel.on_event(&gpu.window, &event) && input {
+            return;
+        }
+        if let WindowEvent::KeyboardInput { event: key, .. } = &event {
+            use winit::keyboard::{Key, NamedKey};
+            match key.logical_key {
+                Key::Named(NamedKey::F1) if key.state.is_pressed() => gpu.panel.visible = !gpu.panel.visible,
+                Key::Named(NamedKey::Home) if key.state.is_pressed() => v.orbit.reset(),
+                _ => {}
+            }
+        }
+        match event {
+            WindowEvent::Resized(size) => v.resized(size.width, size.height),
+            WindowEvent::RedrawRequested => {
+                if !v.frame_in_flight {
+                    v.frame_in_flight = true;
+                    wasm_bindgen_futures::spawn_local(frame(self.viewer.clone()));
+                }
+            }
+            other => {
+                let height = gpu.config.height;
+                v.input.event(&mut v.orbit, &other, height);
+            }
+        }
+    }
+}
+
+impl Viewer {
+    /// Where the panel last drew the widget named `name`.
+    pub fn widget_rect(&self, name: &str) -> Option<[f32; 4]> {
+        let panel = self.gpu.as_ref().map(|g| g.panel.widget_rects.iter()).into_iter().flatten();
+        panel.chain(&self.page_rects).find(|(n, _)| n == name).map(|(_, r)| *r)
+    }
+
+    /// The terms switched on, by name.
+    pub fn terms(&self) -> String {
+        let t = &self.controls.terms;
+        [
+            (t.direct, "direct"),
+            (t.indirect, "indirect"),
+            (t.caustic, "caustic"),
+            (t.volume, "volume"),
+            (t.specular, "specular"),
+        ]
+        .iter()
+        .filter(|(on, _)| *on > 0.0)
+        .map(|(_, name)| *name)
+        .collect::<Vec<_>>()
+        .join(",")
+    }
+}

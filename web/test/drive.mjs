@@ -1,0 +1,191 @@
+// Drives hikari's web page in Debian's headless Chromium (playwright-core,
+// which downloads no browser) for crates/cli/tests/web.rs, which makes the
+// assertions: `node drive.mjs SCENARIO OUT_DIR` serves web/dist on a free
+// localhost port, runs the scenario, and writes OUT_DIR/result.json (and
+// any images) for the Rust test to check.
+import { chromium } from "playwright-core";
+import { createServer } from "node:http";
+import { readFile, writeFile } from "node:fs/promises";
+import { extname, join, normalize } from "node:path";
+import { fileURLToPath } from "node:url";
+
+const [scenario, out] = process.argv.slice(2);
+const dist = fileURLToPath(new URL("../dist/", import.meta.url));
+const chromiumPath = process.env.HIKARI_CHROMIUM || "/usr/bin/chromium";
+
+// WebGPU on SwiftShader (Chromium's CPU Vulkan), the flags the issue names;
+// no network (this machine has none, and a test must not need it). Without
+// --use-angle=swiftshader, headless Chromium 156 destroys a device that
+// presents to a canvas after a few dozen frames ("Device was destroyed",
+// reproduced in plain JavaScript, without hikari).
+const webgpuFlags = [
+  "--use-angle=swiftshader",
+  "--enable-unsafe-webgpu",
+  "--enable-features=Vulkan",
+  "--use-vulkan=swiftshader",
+  "--use-webgpu-adapter=swiftshader",
+  "--enable-unsafe-swiftshader",
+  "--ignore-gpu-blocklist",
+];
+const quietFlags = [
+  "--no-sandbox",
+  "--no-first-run",
+  "--disable-background-networking",
+  "--disable-component-update",
+  "--disable-sync",
+  "--disable-quic",
+];
+
+const types = { ".html": "text/html", ".js": "text/javascript", ".wasm": "application/wasm" };
+
+function serve() {
+  const server = createServer(async (request, response) => {
+    const path = normalize(decodeURIComponent(new URL(request.url, "http://x").pathname)).replace(/^\/+/, "");
+    try {
+      const body = await readFile(join(dist, path || "index.html"));
+      response.writeHead(200, { "content-type": types[extname(path || "index.html")] || "application/octet-stream" });
+      response.end(body);
+    } catch {
+      response.writeHead(404);
+      response.end();
+    }
+  });
+  return new Promise((resolve) => server.listen(0, "127.0.0.1", () => resolve(server)));
+}
+
+async function open(browser, query, { width = 48, height = 36, log } = {}) {
+  const context = await browser.newContext({ viewport: { width, height }, deviceScaleFactor: 1, acceptDownloads: true });
+  const page = await context.newPage();
+  page.on("console", (m) => log.push({ type: m.type(), text: m.text() }));
+  page.on("pageerror", (e) => log.push({ type: "pageerror", text: String(e) }));
+  const started = Date.now();
+  await page.goto(`${base}/${query}`);
+  return { page, started };
+}
+
+/** Waits until `predicate` (run in the page) is true, at most `seconds`. */
+async function until(page, predicate, seconds, arg) {
+  await page.waitForFunction(predicate, arg, { timeout: seconds * 1000, polling: 100 });
+}
+
+const hikariReady = () => window.hikari && window.hikari.framesInMean && window.hikari.framesInMean() > 0;
+
+async function readMean(page) {
+  const values = await page.evaluate(async () => Array.from(await window.hikari.readMean()));
+  return { width: values[0], height: values[1], rgba: values.slice(2) };
+}
+
+function meanOf(rgba) {
+  let sum = 0;
+  for (let i = 0; i < rgba.length; i += 4) sum += rgba[i] + rgba[i + 1] + rgba[i + 2];
+  return sum / (rgba.length / 4) / 3;
+}
+
+async function writeMean(file, mean) {
+  await writeFile(join(out, file), Buffer.from(new Float32Array([mean.width, mean.height, ...mean.rgba]).buffer));
+}
+
+const server = await serve();
+const base = `http://127.0.0.1:${server.address().port}`;
+const result = { scenario };
+const log = [];
+let browser;
+try {
+  if (scenario === "no-webgpu") {
+    // A browser without WebGPU: the page says so in one line.
+    browser = await chromium.launch({ executablePath: chromiumPath, args: [...quietFlags, "--disable-webgpu"] });
+    const { page } = await open(browser, "", { width: 640, height: 480, log });
+    await until(page, () => getComputedStyle(document.getElementById("no-webgpu")).display !== "none", 30);
+    result.message = await page.textContent("#no-webgpu");
+    result.canvasHidden = await page.evaluate(() => getComputedStyle(document.getElementById("hikari")).display === "none");
+  } else {
+    browser = await chromium.launch({ executablePath: chromiumPath, args: [...quietFlags, ...webgpuFlags] });
+    if (scenario === "converge") {
+      // The default scene, 3000 photons a set, 30 frames: the mean and
+      // how long the first frame took.
+      const frames = Number(process.env.HIKARI_FRAMES || 30);
+      const { page, started } = await open(browser, `?photons=3000&frames=${frames}&panel=0`, { log });
+      await until(page, hikariReady, 120);
+      result.firstFrameMs = Date.now() - started;
+      result.adapter = await page.evaluate(() => window.hikari.adapter());
+      await until(page, (n) => window.hikari.framesInMean() >= n, 300, frames);
+      result.frames = await page.evaluate(() => window.hikari.framesInMean());
+      await writeMean(`web-${frames}.f32`, await readMean(page));
+      result.error = await page.evaluate(() => window.hikari.lastError());
+    } else if (scenario === "drop") {
+      // A .glb dropped on the page renders; a broken one shows its error
+      // and leaves the scene as it was.
+      const { page } = await open(browser, "?photons=3000&panel=0", { log });
+      await until(page, hikariReady, 120);
+      const drop = async (name, bytes) => {
+        const transfer = await page.evaluateHandle(
+          ({ name, bytes }) => {
+            const t = new DataTransfer();
+            t.items.add(new File([new Uint8Array(bytes)], name));
+            return t;
+          },
+          { name, bytes: Array.from(bytes) },
+        );
+        await page.dispatchEvent("body", "drop", { dataTransfer: transfer });
+      };
+      const glb = await readFile(process.env.HIKARI_GLB);
+      await drop("fixture.glb", glb);
+      await until(page, () => window.hikari.sceneName() === "fixture.glb" && window.hikari.framesInMean() > 2, 120);
+      result.afterGood = await page.evaluate(() => [window.hikari.sceneName(), window.hikari.lastError()]);
+      await writeMean("web-dropped.f32", await readMean(page));
+      await drop("broken.glb", glb.subarray(0, Math.floor(glb.length / 2)));
+      await until(page, () => window.hikari.lastError() !== "", 60);
+      const framesBefore = await page.evaluate(() => window.hikari.framesInMean());
+      await page.waitForTimeout(500);
+      result.afterBroken = await page.evaluate(() => [
+        window.hikari.sceneName(),
+        window.hikari.lastError(),
+        document.getElementById("error").textContent,
+        getComputedStyle(document.getElementById("error")).display,
+      ]);
+      result.framesGoOn = (await page.evaluate(() => window.hikari.framesInMean())) >= framesBefore;
+    } else if (scenario === "controls") {
+      // A mouse drag moves the view (the mean starts over, the image
+      // changes), the panel's checkbox switches a term off, and the save
+      // button downloads a PNG.
+      const { page } = await open(browser, "?photons=3000", { width: 640, height: 480, log });
+      await until(page, hikariReady, 120);
+      await until(page, () => window.hikari.framesInMean() >= 4, 120);
+      const before = await readMean(page);
+      // Drag on the right half, away from the panel.
+      await page.mouse.move(560, 240);
+      await page.mouse.down();
+      await page.mouse.move(600, 250, { steps: 4 });
+      await page.mouse.up();
+      await page.waitForTimeout(200);
+      result.framesAfterDrag = await page.evaluate(() => window.hikari.framesInMean());
+      const after = await readMean(page);
+      let diff = 0;
+      for (let i = 0; i < before.rgba.length; i++) diff += Math.abs(before.rgba[i] - after.rgba[i]);
+      result.dragChange = diff / before.rgba.length;
+      result.termsBefore = await page.evaluate(() => window.hikari.terms());
+      const box = await page.evaluate(() => window.hikari.widgetRect("indirect"));
+      result.checkbox = box;
+      await page.mouse.click(box[0] + 6, (box[1] + box[3]) / 2);
+      await until(page, () => !window.hikari.terms().includes("indirect"), 30);
+      result.termsAfter = await page.evaluate(() => window.hikari.terms());
+      const save = await page.evaluate(() => window.hikari.widgetRect("save PNG"));
+      const [download] = await Promise.all([
+        page.waitForEvent("download", { timeout: 60000 }),
+        page.mouse.click((save[0] + save[2]) / 2, (save[1] + save[3]) / 2),
+      ]);
+      result.download = download.suggestedFilename();
+      await download.saveAs(join(out, "saved.png"));
+      await page.waitForTimeout(300);
+    } else {
+      throw new Error(`unknown scenario ${scenario}`);
+    }
+  }
+} catch (e) {
+  result.failure = String(e && e.stack ? e.stack : e);
+} finally {
+  result.console = log;
+  await writeFile(join(out, "result.json"), JSON.stringify(result, null, 1));
+  if (browser) await browser.close();
+  server.close();
+}
