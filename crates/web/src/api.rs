@@ -67,3 +67,9 @@ pub async fn read_mean() -> Result<js_sys::Float32Array, JsValue> {
 pub fn widget_rect(name: &str) -> Vec<f32> {
     with_viewer(|v| v.widget_rect(name)).flatten().map_or(Vec::new(), |r| r.to_vec())
 }
+
+/// Mean frames per second since the page's first frame (the panel's figure).
+#[wasm_bindgen]
+pub fn fps() -> f64 {
+    with_viewer(|v| v.readouts.fps).unwrap_or(0.0)
+}

@@ -12,14 +12,14 @@ use crate::page;
 use crate::photons::{Job, PhotonSet, Tracing};
 use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
-use hikari_gpu::points::PointColors;
-use hikari_gpu::present::{PresentMode, PresentPass};
+use hikari_gpu::present::PresentPass;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
 use hikari_viewer::clock::AnimationClock;
 use hikari_viewer::frame_stats::FrameStats;
 use hikari_viewer::orbit::Orbit;
 use hikari_viewer::panel::{Controls, Panel, Readouts, rect_of};
 use hikari_viewer::settings::{controls_for_scene, gpu_settings, restart_for_edits, set_pass};
+use hikari_viewer::surface::{next_frame, shown_texture};
 use std::cell::RefCell;
 use std::rc::{Rc, Weak};
 use std::sync::Arc;
@@ -345,27 +345,10 @@ impl Viewer {
             view.mean.record(&ctx.queue, &mut encoder);
             ctx.queue.submit([encoder.finish()]);
         }
-        let texture = match gpu.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => return Ok(()),
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                gpu.surface.configure(&ctx.device, &gpu.config);
-                return Ok(());
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                return Err(GpuError::Failed("the canvas refused a frame".into()));
-            }
-        };
+        let Some(texture) = next_frame(&gpu.surface, &ctx.device, &gpu.config)? else { return Ok(()) };
         let target = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let renderer = &view.renderer;
-        let shown = match self.controls.mode {
-            PresentMode::Radiance => &view.mean.mean,
-            PresentMode::Normals => &renderer.targets.gbuffer.normal,
-            PresentMode::Albedo => &renderer.targets.gbuffer.albedo,
-            PresentMode::Photons => renderer.draw_points(PointColors::Power)?,
-            PresentMode::DetailLevels => renderer.draw_points(PointColors::DetailLevel)?,
-        };
+        let shown = shown_texture(self.controls.mode, &view.renderer, &view.mean)?;
         gpu.present.record(
             &ctx.device,
             &ctx.queue,

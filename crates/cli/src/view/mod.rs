@@ -47,14 +47,14 @@ use glam::Vec3;
 use hikari_core::output::write_image;
 use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_gpu::accumulate::AccumulatePass;
-use hikari_gpu::points::PointColors;
-use hikari_gpu::present::{PresentMode, PresentPass};
+use hikari_gpu::present::PresentPass;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
 use hikari_viewer::clock::AnimationClock;
 use hikari_viewer::frame_stats::FrameStats;
 use hikari_viewer::orbit::Orbit;
 use hikari_viewer::panel::{Controls, Panel, Readouts};
 use hikari_viewer::settings::{controls_for_scene, gpu_settings, restart_for_edits, set_pass};
+use hikari_viewer::surface::{next_frame, shown_texture};
 use photon_sets::{Job, PhotonSet, PhotonSets};
 use scene_watch::SceneWatch;
 use std::path::PathBuf;
@@ -573,27 +573,11 @@ impl Viewer {
             }
         }
         let ctx = &session.renderer.ctx;
-        let texture = match session.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t) | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => return Ok(()),
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                session.surface.configure(&ctx.device, &session.config);
-                return Ok(());
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                return Err(GpuError::Failed("the window's surface refused a frame".into()).into());
-            }
-        };
+        let Some(texture) = next_frame(&session.surface, &ctx.device, &session.config)? else { return Ok(()) };
         let scopes = ctx.error_scopes();
         let view = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let shown = match self.controls.mode {
-            PresentMode::Radiance => &session.mean.mean,
-            PresentMode::Normals => &session.renderer.targets.gbuffer.normal,
-            PresentMode::Albedo => &session.renderer.targets.gbuffer.albedo,
-            PresentMode::Photons => session.renderer.draw_points(PointColors::Power)?,
-            PresentMode::DetailLevels => session.renderer.draw_points(PointColors::DetailLevel)?,
-        };
+        let shown = shown_texture(self.controls.mode, &session.renderer, &session.mean)?;
         session.present.record(
             &ctx.device,
             &ctx.queue,

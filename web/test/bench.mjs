@@ -1,0 +1,43 @@
+// Frame rate of hikari's web page in Debian's headless Chromium (WebGPU on
+// SwiftShader) for BENCHMARKS.md: `node web/test/bench.mjs [SCENE] [WxH]
+// [PHOTONS] [SECONDS]` serves web/dist, opens the page at that size and
+// prints the time to the first frame and the page's mean fps.
+import { chromium } from "playwright-core";
+import { createServer } from "node:http";
+import { readFile } from "node:fs/promises";
+import { extname, join } from "node:path";
+import { fileURLToPath } from "node:url";
+
+const [scene = "cornell-box", size = "640x480", photons = "20000", seconds = "20"] = process.argv.slice(2);
+const [width, height] = size.split("x").map(Number);
+const dist = fileURLToPath(new URL("../dist/", import.meta.url));
+const types = { ".html": "text/html", ".js": "text/javascript", ".wasm": "application/wasm" };
+const server = createServer(async (request, response) => {
+  const path = new URL(request.url, "http://x").pathname.replace(/^\/+/, "") || "index.html";
+  try {
+    const body = await readFile(join(dist, path));
+    response.writeHead(200, { "content-type": types[extname(path)] || "application/octet-stream" });
+    response.end(body);
+  } catch {
+    response.writeHead(404);
+    response.end();
+  }
+});
+await new Promise((resolve) => server.listen(0, "127.0.0.1", resolve));
+const browser = await chromium.launch({
+  executablePath: process.env.HIKARI_CHROMIUM || "/usr/bin/chromium",
+  args: ["--no-sandbox", "--no-first-run", "--disable-background-networking", "--use-angle=swiftshader",
+         "--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader",
+         "--use-webgpu-adapter=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"],
+});
+const page = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
+const started = Date.now();
+await page.goto(`http://127.0.0.1:${server.address().port}/?scene=${scene}&photons=${photons}&panel=0`);
+await page.waitForFunction(() => window.hikari && window.hikari.framesInMean() > 0, null, { timeout: 120000, polling: 20 });
+const firstFrame = Date.now() - started;
+await page.waitForTimeout(Number(seconds) * 1000);
+const [fps, adapter, error] = await page.evaluate(() => [window.hikari.fps(), window.hikari.adapter(), window.hikari.lastError()]);
+console.log(`${scene} ${size}, ${photons} photons a set: first frame ${firstFrame} ms after navigation, ` +
+  `${fps.toFixed(1)} fps over ${seconds} s on ${adapter}${error ? "; error: " + error : ""}`);
+await browser.close();
+server.close();
