@@ -97,7 +97,7 @@ try {
     const { page } = await open(browser, "", { width: 640, height: 480, log });
     await until(page, () => getComputedStyle(document.getElementById("no-webgpu")).display !== "none", 30);
     result.message = await page.textContent("#no-webgpu");
-    result.canvasHidden = await page.evaluate(() => getComputedStyle(document.getElementById("hikari")).display === "none");
+    result.canvasHidden = await page.evaluate(() => getComputedStyle(document.getElementById("hikari-canvas")).display === "none");
   } else {
     browser = await chromium.launch({ executablePath: chromiumPath, args: [...quietFlags, ...webgpuFlags] });
     if (scenario === "converge") {

@@ -582,7 +582,7 @@ impl ApplicationHandler for Page {
             return;
         }
         let canvas =
-            page::document().get_element_by_id("hikari").and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok());
+            page::document().get_element_by_id("hikari-canvas").and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok());
         let attributes = Window::default_attributes()
             .with_title("hikari")
             .with_canvas(canvas)

@@ -77,7 +77,7 @@ pub fn has_webgpu() -> bool {
 
 pub fn show_no_webgpu() {
     set_status("");
-    if let Some(canvas) = element("hikari") {
+    if let Some(canvas) = element("hikari-canvas") {
         let _ = canvas.style().set_property("display", "none");
     }
     if let Some(message) = element("no-webgpu") {
