@@ -581,8 +581,9 @@ impl ApplicationHandler for Page {
         if self.viewer.borrow().gpu.is_some() {
             return;
         }
-        let canvas =
-            page::document().get_element_by_id("hikari-canvas").and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok());
+        let canvas = page::document()
+            .get_element_by_id("hikari-canvas")
+            .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok());
         let attributes = Window::default_attributes()
             .with_title("hikari")
             .with_canvas(canvas)
