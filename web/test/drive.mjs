@@ -104,12 +104,14 @@ try {
       // The default scene, 3000 photons a set, 30 frames: the mean and
       // how long the first frame took.
       const frames = Number(process.env.HIKARI_FRAMES || 30);
-      const { page, started } = await open(browser, `?photons=3000&frames=${frames}&panel=0`, { log });
+      const scene = process.env.HIKARI_SCENE ? `&scene=${process.env.HIKARI_SCENE}` : "";
+      const { page, started } = await open(browser, `?photons=3000&frames=${frames}&panel=0${scene}`, { log });
       await until(page, hikariReady, 120);
       result.firstFrameMs = Date.now() - started;
       result.adapter = await page.evaluate(() => window.hikari.adapter());
       await until(page, (n) => window.hikari.framesInMean() >= n, 300, frames);
       result.frames = await page.evaluate(() => window.hikari.framesInMean());
+      result.tracer = await page.evaluate(() => window.hikari.tracer());
       await writeMean(`web-${frames}.f32`, await readMean(page));
       result.error = await page.evaluate(() => window.hikari.lastError());
     } else if (scenario === "drop") {
@@ -151,13 +153,19 @@ try {
       const { page } = await open(browser, "?photons=3000", { width: 640, height: 480, log });
       await until(page, hikariReady, 120);
       await until(page, () => window.hikari.framesInMean() >= 4, 120);
+      // The panel's per-pass times and noise estimate.
+      await until(page, () => window.hikari.noise() > 0, 60);
+      result.noise = await page.evaluate(() => window.hikari.noise());
+      result.passTimes = JSON.parse(await page.evaluate(() => window.hikari.passTimes()));
       const before = await readMean(page);
+      const framesBefore = await page.evaluate(() => window.hikari.framesInMean());
       // Drag on the right half, away from the panel.
       await page.mouse.move(560, 240);
       await page.mouse.down();
       await page.mouse.move(600, 250, { steps: 4 });
       await page.mouse.up();
-      await page.waitForTimeout(200);
+      // The mean starts over once the frame in flight is done.
+      await until(page, (n) => window.hikari.framesInMean() >= 1 && window.hikari.framesInMean() < n, 60, framesBefore);
       result.framesAfterDrag = await page.evaluate(() => window.hikari.framesInMean());
       const after = await readMean(page);
       let diff = 0;

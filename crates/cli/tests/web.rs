@@ -80,25 +80,45 @@ fn exr(path: &Path) -> Vec<[f32; 3]> {
 /// The page opens on the default scene by itself, names its adapter, and
 /// after 30 frames its mean is `hikari render --passes 30` of the same
 /// scene, photons and seeds on the same driver (SwiftShader, natively
-/// through Vulkan; the photons traced by the same CPU tracer).
+/// through Vulkan; the photons traced by the same compute shader).
 /// No errors reach the console meanwhile.
 #[test]
 fn the_page_converges_to_the_native_render() {
-    let dir = scratch_dir("web-converge");
     let frames = std::env::var("HIKARI_FRAMES").unwrap_or("30".into());
-    let Some(result) = drive("converge", &dir, &[]) else { return };
+    page_against_native_render("web-converge", None, &frames);
+}
+
+/// Glass on the page: the mirror/glass pass and the caustic map run in the
+/// browser (their tables packed into WebGPU's default of 8 storage
+/// buffers) and give the native render's frames.
+#[test]
+fn glass_and_caustics_render_on_the_page_as_natively() {
+    page_against_native_render("web-glass", Some("cornell-caustic"), "4");
+}
+
+/// The page's mean after `frames` frames of `scene` (None: the default)
+/// against `hikari render` of the same on the same driver.
+fn page_against_native_render(name: &str, scene: Option<&str>, frames: &str) {
+    let dir = scratch_dir(name);
+    let mut env = vec![("HIKARI_FRAMES", Path::new(frames))];
+    if let Some(scene) = scene {
+        env.push(("HIKARI_SCENE", Path::new(scene)));
+    }
+    let Some(result) = drive("converge", &dir, &env) else { return };
     eprintln!("adapter: {}; first frame after {} ms", result["adapter"], result["firstFrameMs"]);
     assert!(result["adapter"].as_str().unwrap().contains("BrowserWebGpu"), "{}", result["adapter"]);
     assert_eq!(result["frames"].to_string(), frames);
     assert_eq!(result["error"], "");
+    assert_eq!(result["tracer"], "GPU", "the page traced its photons on the CPU");
     let (width, height, web) = read_mean(&dir.join(format!("web-{frames}.f32")));
     assert_eq!((width, height), (48, 36));
     // The same renderer natively on the same driver: Chromium's own
     // SwiftShader Vulkan, through its ICD file. (Against lavapipe the frames
     // differ as two drivers do: 5.8% at one pass, 0.9% at 30, mean 0.1%.)
     let out = Command::new(env!("CARGO_BIN_EXE_hikari"))
-        .args(["render", "-q", "--renderer", "gpu", "--resolution", "48x36", "--photons", "3000"])
-        .args(["--passes", &frames, "-o", "native.exr"])
+        .args(["render", "-q", scene.unwrap_or("cornell-box"), "--renderer", "gpu"])
+        .args(["--resolution", "48x36", "--photons", "3000"])
+        .args(["--passes", frames, "--trace", "gpu", "-o", "native.exr"])
         .env("VK_ICD_FILENAMES", SWIFTSHADER_ICD)
         .env_remove("WGPU_BACKEND")
         .current_dir(&dir)
@@ -141,6 +161,15 @@ fn dropped_files_open_or_say_why_not() {
 fn the_mouse_and_the_panel_work() {
     let dir = scratch_dir("web-controls");
     let Some(result) = drive("controls", &dir, &[]) else { return };
+    // The panel shows each pass's time and the noise estimate.
+    let passes = result["passTimes"]["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["pass"].as_str().unwrap()).collect();
+    eprintln!("page passes ({}): {passes:?}", result["passTimes"]["timed"]);
+    assert!(names.len() >= 5 && names.iter().all(|n| !n.is_empty()), "{names:?}");
+    assert!(passes.iter().all(|p| p["ms"].as_f64().is_some_and(|ms| ms >= 0.0 && ms.is_finite())), "{passes:?}");
+    assert!(passes.iter().map(|p| p["ms"].as_f64().unwrap()).sum::<f64>() > 0.0, "{passes:?}");
+    let noise = result["noise"].as_f64().unwrap();
+    assert!(noise > 0.0 && noise < 1.0, "noise estimate {noise}");
     assert!(result["dragChange"].as_f64().unwrap() > 1e-3, "the drag did not move the view: {result}");
     assert!(result["termsBefore"].as_str().unwrap().contains("indirect"));
     assert!(!result["termsAfter"].as_str().unwrap().contains("indirect"), "{}", result["termsAfter"]);

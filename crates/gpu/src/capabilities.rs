@@ -27,13 +27,6 @@ pub const DOWNLEVEL: [(DownlevelFlags, &str); 4] = [
     (DownlevelFlags::FRAGMENT_STORAGE, "storage buffers in fragment shaders (lights)"),
 ];
 
-/// Storage buffers per shader stage that the GPU tracer (BVH nodes,
-/// primitives and shading normals, surfaces, lights, media, photon
-/// records, counts, status words, region triangles, emissive triangles and
-/// textures) and the specular pass bind: every native adapter has them;
-/// browsers offer 8 or 10.
-pub const FULL_STORAGE_BUFFERS: u32 = 12;
-
 /// Storage buffers per stage that the tiled estimator's gather binds.
 pub const TILED_STORAGE_BUFFERS: u32 = 10;
 
@@ -53,13 +46,14 @@ pub fn required_limits() -> wgpu::Limits {
         max_color_attachments: 4,
         max_color_attachment_bytes_per_sample: 64,
         // WebGPU's default, which every browser offers (Chrome at most
-        // 10): the frame's passes bind at most 7. The GPU tracer and the
-        // mirror/glass pass bind more (`FULL_STORAGE_BUFFERS`) and say so
-        // where the adapter has fewer.
+        // 10): the GPU tracer and the mirror/glass pass bind 8, their
+        // small tables packed into one buffer (`tables`); the tiled
+        // estimator binds more and gives way to the raster splat where the
+        // adapter has fewer (`TILED_STORAGE_BUFFERS`).
         max_storage_buffers_per_shader_stage: 8,
         max_storage_textures_per_shader_stage: 1,
-        // The specular pass's bindings 0–18.
-        max_bindings_per_bind_group: 19,
+        // The tiled estimator's bindings 0–17 and the specular pass's.
+        max_bindings_per_bind_group: 18,
         max_compute_invocations_per_workgroup: 256,
         max_compute_workgroup_size_x: 256,
         max_compute_workgroup_storage_size: 1024,

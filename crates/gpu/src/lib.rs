@@ -42,6 +42,7 @@ pub mod scene_upload;
 pub mod shadow;
 pub mod specular;
 pub mod splat;
+pub mod tables;
 pub mod textures;
 pub mod trace;
 pub mod volume;

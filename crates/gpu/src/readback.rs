@@ -113,6 +113,17 @@ async fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, Gp
     Ok(bytes)
 }
 
+/// Waits, without blocking in a browser, until the work submitted so far
+/// is done (wall-clock timing of a pass where there are no timestamps).
+pub async fn work_done_async(ctx: &GpuContext) -> Result<(), GpuError> {
+    let answer = Answer::default();
+    let callback = answer.clone();
+    ctx.queue.on_submitted_work_done(move || callback.set(()));
+    ctx.wait()?;
+    answer.await;
+    ctx.check()
+}
+
 /// A value that a callback sets once, awaited as a future.
 struct Answer<T>(Arc<Mutex<(Option<T>, Option<Waker>)>>);
 

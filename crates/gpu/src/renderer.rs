@@ -221,20 +221,8 @@ impl GpuRenderer {
     /// optical depths off by 8e-4 where they are 0, fog frames off by more
     /// than 2%).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
-        let media = (!ctx.float32_blend && !scene.media.is_empty())
-            .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string());
-        media.or_else(|| {
-            let specular = crate::specular::has_specular_surfaces(scene);
-            specular
-                .then(|| {
-                    crate::capabilities::storage_buffer_shortfall(
-                        &ctx.limits,
-                        crate::capabilities::FULL_STORAGE_BUFFERS,
-                        "the mirror and glass pass",
-                    )
-                })
-                .flatten()
-        })
+        (!ctx.float32_blend && !scene.media.is_empty())
+            .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string())
     }
 
     /// What a frame of `scene` with `settings` allocates, for `photons`
@@ -706,29 +694,42 @@ impl GpuRenderer {
     /// between the stages when the adapter has them (true = timestamps),
     /// else wall-clock around a separate submit per stage, waited for.
     /// The frame is a whole one, as `render` makes it (the specular pass
-    /// split further if it ran over budget; that rerun is not timed).
+    /// split further if it ran over budget, the tiled estimator's buffers
+    /// resized; those reruns are not timed).
     pub fn render_timed(&self) -> Result<(Vec<(Stage, f64)>, bool), GpuError> {
-        let scopes = self.ctx.error_scopes();
+        crate::block::wait_for(self.render_timed_async())
+    }
+
+    /// `render_timed` without blocking (the web page's timed frames).
+    pub async fn render_timed_async(&self) -> Result<(Vec<(Stage, f64)>, bool), GpuError> {
         let timed = if self.ctx.timestamps {
-            (self.render_timestamped()?, true)
+            let scopes = self.ctx.error_scopes();
+            let times = self.render_timestamped().await;
+            scopes.finish_async().await?;
+            (times?, true)
         } else {
             let mut times = Vec::new();
             for stage in Stage::ALL {
                 let start = web_time::Instant::now();
+                // Scopes closed before the wait: a browser's page runs
+                // other tasks (the photon tracer) meanwhile.
+                let scopes = self.ctx.error_scopes();
                 let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
                 self.record_stage(stage, &mut encoder);
                 self.ctx.queue.submit([encoder.finish()]);
-                self.wait()?;
+                scopes.finish_async().await?;
+                crate::readback::work_done_async(&self.ctx).await?;
                 times.push((stage, start.elapsed().as_secs_f64()));
             }
             (times, false)
         };
-        scopes.finish()?;
-        crate::block::wait_for(self.settle_specular())?;
+        // As `render_async` settles them (reruns untimed).
+        self.settle_specular().await?;
+        self.settle_tiled().await?;
         Ok(timed)
     }
 
-    fn render_timestamped(&self) -> Result<Vec<(Stage, f64)>, GpuError> {
+    async fn render_timestamped(&self) -> Result<Vec<(Stage, f64)>, GpuError> {
         let device = &self.ctx.device;
         let count = Stage::ALL.len() as u32 + 1;
         let queries = device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -750,7 +751,7 @@ impl GpuRenderer {
         }
         encoder.resolve_query_set(&queries, 0..count, &resolved, 0);
         self.ctx.queue.submit([encoder.finish()]);
-        let words = crate::readback::read_u32s(&self.ctx, &resolved, count as u64 * 2)?;
+        let words = crate::readback::read_u32s_async(&self.ctx, &resolved, count as u64 * 2).await?;
         let ticks: Vec<u64> = words.chunks(2).map(|w| w[0] as u64 | ((w[1] as u64) << 32)).collect();
         let period_ns = self.ctx.queue.get_timestamp_period() as f64;
         Ok(Stage::ALL

@@ -254,7 +254,8 @@ impl SceneBuffers {
             environment: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("sky image"),
                 contents: bytemuck::cast_slice(&crate::textures::environment_words(scene)),
-                usage: wgpu::BufferUsages::STORAGE,
+                // COPY_SRC: the specular pass copies it into its tables.
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             }),
             bvh,
             textures: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -172,7 +172,11 @@ fn shared_structs_match_wgsl_layouts() {
             volume_max,
             jitter_y,
             sky_radiance,
-            _pad
+            light_table,
+            sample_table,
+            view_table,
+            region_table,
+            environment_table
         ]
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
@@ -238,7 +242,11 @@ fn shared_structs_match_wgsl_layouts() {
             global_mask,
             region_triangles,
             _pad0,
-            distant_disc
+            distant_disc,
+            light_table,
+            medium_table,
+            region_table,
+            emissive_table
         ]
     );
     assert_layout!(

@@ -21,6 +21,13 @@ pub fn adapter() -> String {
     with_viewer(|v| v.readouts.adapter.clone()).unwrap_or_default()
 }
 
+/// Where photons are traced: "GPU" (the compute-shader tracer), "CPU"
+/// (the page's thread, where the GPU tracer cannot run), "" before the first set.
+#[wasm_bindgen]
+pub fn tracer() -> String {
+    with_viewer(|v| v.tracer_device().to_string()).unwrap_or_default()
+}
+
 /// The scene on screen: a built-in scene's name or the dropped files'.
 #[wasm_bindgen(js_name = sceneName)]
 pub fn scene_name() -> String {
@@ -66,6 +73,27 @@ pub async fn read_mean() -> Result<js_sys::Float32Array, JsValue> {
 #[wasm_bindgen(js_name = widgetRect)]
 pub fn widget_rect(name: &str) -> Vec<f32> {
     with_viewer(|v| v.widget_rect(name)).flatten().map_or(Vec::new(), |r| r.to_vec())
+}
+
+/// The last timed frame's passes as JSON, `{"timed": "wall clock",
+/// "passes": [{"pass": "g-buffer", "ms": 1.5}, …]}` (or "timestamps"): the panel's
+/// "GPU passes" (a frame is timed every 2 s while the panel shows).
+#[wasm_bindgen(js_name = passTimes)]
+pub fn pass_times() -> String {
+    with_viewer(|v| {
+        let passes: Vec<String> =
+            v.readouts.passes.iter().map(|(name, ms)| format!("{{\"pass\":\"{name}\",\"ms\":{ms}}}")).collect();
+        let how = if v.readouts.timestamps { "timestamps" } else { "wall clock" };
+        format!("{{\"timed\":\"{how}\",\"passes\":[{}]}}", passes.join(","))
+    })
+    .unwrap_or_default()
+}
+
+/// The mean's noise as its frames estimate it, relative to its mean (the
+/// panel's "noise ≈"); NaN before it was first read.
+#[wasm_bindgen]
+pub fn noise() -> f64 {
+    with_viewer(|v| v.readouts.noise).flatten().unwrap_or(f64::NAN)
 }
 
 /// Mean frames per second since the page's first frame (the panel's figure).

@@ -11,7 +11,7 @@ use crate::options::PageOptions;
 use crate::page;
 use crate::photons::{Job, PhotonSet, Tracing};
 use hikari_core::scene::{Pose, Scene, builtin};
-use hikari_gpu::accumulate::AccumulatePass;
+use hikari_gpu::accumulate::{AccumulatePass, NoiseReading};
 use hikari_gpu::present::PresentPass;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
 use hikari_viewer::clock::AnimationClock;
@@ -87,6 +87,9 @@ pub struct Viewer {
     /// Whether the renderer must be made anew (a new scene, a new size).
     rebuild: bool,
     frame_in_flight: bool,
+    /// When a frame was last timed pass by pass, and frames since.
+    last_timing: Option<Instant>,
+    frames_since_timing: u32,
     actions: Vec<Action>,
     /// The error on the page, if any (the last good scene stays).
     pub error: Option<String>,
@@ -141,6 +144,8 @@ impl Viewer {
             requested: None,
             rebuild: true,
             frame_in_flight: false,
+            last_timing: None,
+            frames_since_timing: 0,
             actions: Vec::new(),
             error: None,
             saved_pngs: 0,
@@ -152,6 +157,11 @@ impl Viewer {
     /// Frames in the mean on screen.
     pub fn frames_in_mean(&self) -> u32 {
         self.gpu.as_ref().and_then(|g| g.view.as_ref()).map_or(0, |v| v.mean.count())
+    }
+
+    /// Where photon sets are traced now ("" before the adapter answered).
+    pub fn tracer_device(&self) -> &'static str {
+        self.tracing.as_ref().map_or("", Tracing::device)
     }
 
     fn pose(&self) -> Pose {
@@ -334,6 +344,34 @@ impl Viewer {
         Ok(renderer)
     }
 
+    /// Whether this frame is the timed one: every 2 s while the panel
+    /// shows, as in the native viewer, and at most one in `TIMED_EVERY`
+    /// frames (a timed frame waits for each pass, and where frames take
+    /// seconds, as on a software adapter, every frame would be timed).
+    /// Not the first two frames: they include compiling the pipelines.
+    fn timing_due(&mut self) -> bool {
+        const TIMED_EVERY: u32 = 8;
+        let visible = self.gpu.as_ref().is_some_and(|g| g.panel.visible);
+        let due = visible
+            && match self.last_timing {
+                None => self.frames_since_timing >= 2,
+                Some(t) => t.elapsed().as_secs_f64() > 2.0 && self.frames_since_timing >= TIMED_EVERY,
+            };
+        self.frames_since_timing += 1;
+        if due {
+            self.last_timing = Some(Instant::now());
+            self.frames_since_timing = 0;
+        }
+        due
+    }
+
+    /// The mean's noise estimate to read back, at the frames it is due.
+    fn noise_reading(&self) -> Option<(GpuContext, NoiseReading)> {
+        let gpu = self.gpu.as_ref()?;
+        let mean = &gpu.view.as_ref()?.mean;
+        mean.noise_due().then(|| (gpu.ctx.clone(), mean.noise_reading()))
+    }
+
     /// Adds the rendered frame (if one was) to the mean and presents the
     /// mean with the panel.
     fn finish(&mut self, rendered: bool) -> Result<(), GpuError> {
@@ -344,6 +382,9 @@ impl Viewer {
             let mut encoder = ctx.device.create_command_encoder(&Default::default());
             view.mean.record(&ctx.queue, &mut encoder);
             ctx.queue.submit([encoder.finish()]);
+            if view.mean.count() == 1 {
+                self.readouts.noise = None;
+            }
         }
         let Some(texture) = next_frame(&gpu.surface, &ctx.device, &gpu.config)? else { return Ok(()) };
         let target = texture.texture.create_view(&Default::default());
@@ -515,9 +556,26 @@ async fn frame(viewer: Shared) {
     let prepared = viewer.borrow_mut().prepare();
     let outcome = match prepared {
         Ok(Some(renderer)) => {
-            let rendered = renderer.render_async().await;
+            let rendered = if viewer.borrow_mut().timing_due() {
+                renderer.render_timed_async().await.map(|(times, timestamps)| {
+                    let readouts = &mut viewer.borrow_mut().readouts;
+                    readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
+                    readouts.timestamps = timestamps;
+                })
+            } else {
+                renderer.render_async().await
+            };
             drop(renderer);
-            rendered.and_then(|()| viewer.borrow_mut().finish(true))
+            let finished = rendered.and_then(|()| viewer.borrow_mut().finish(true));
+            // The noise estimate, when the mean asks for one (read back
+            // without holding the viewer: input goes on meanwhile).
+            let reading = viewer.borrow().noise_reading();
+            match (finished, reading) {
+                (Ok(()), Some((ctx, reading))) => {
+                    reading.read_async(&ctx).await.map(|noise| viewer.borrow_mut().readouts.noise = noise)
+                }
+                (finished, _) => finished,
+            }
         }
         Ok(None) => viewer.borrow_mut().finish(false),
         Err(e) => Err(e),

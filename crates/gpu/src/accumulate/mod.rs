@@ -108,18 +108,13 @@ impl AccumulatePass {
     /// The noise of the mean as its frames estimate it, relative to the
     /// mean (None before two frames): the means read back.
     pub fn read_noise(&self, ctx: &crate::GpuContext) -> Result<Option<f64>, crate::GpuError> {
-        let mean = crate::readback::read_rgba(ctx, &self.mean)?;
-        let odd_mean = crate::readback::read_rgba(ctx, &self.odd_mean)?;
-        Ok(self.noise_from(&mean, &odd_mean))
+        crate::block::wait_for(self.noise_reading().read_async(ctx))
     }
 
-    /// The estimate from `mean` and `odd_mean` as read back.
-    fn noise_from(&self, mean: &[glam::Vec4], odd_mean: &[glam::Vec4]) -> Option<f64> {
-        let (n, odd) = (self.count as f64, self.count.div_ceil(2) as f64);
-        let sums = |m: &[glam::Vec4], k: f64| -> Vec<[f64; 3]> {
-            m.iter().map(|v| [v.x as f64 * k, v.y as f64 * k, v.z as f64 * k]).collect()
-        };
-        hikari_core::progressive::noise_from_sums(self.width as usize, self.count, &sums(mean, n), &sums(odd_mean, odd))
+    /// What `read_noise` reads, taken now, to read back without holding
+    /// the mean (the web page's frames await it while input goes on).
+    pub fn noise_reading(&self) -> NoiseReading {
+        NoiseReading { mean: self.mean.clone(), odd_mean: self.odd_mean.clone(), width: self.width, count: self.count }
     }
 
     /// Starts a new mean with the next frame (the camera or scene changed).
@@ -137,5 +132,32 @@ impl AccumulatePass {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
+    }
+}
+
+/// The mean's noise estimate to read back (`AccumulatePass::noise_reading`).
+pub struct NoiseReading {
+    mean: wgpu::Texture,
+    odd_mean: wgpu::Texture,
+    width: u32,
+    count: u32,
+}
+
+impl NoiseReading {
+    /// The estimate, read back without blocking; valid until the mean
+    /// takes another frame.
+    pub async fn read_async(self, ctx: &crate::GpuContext) -> Result<Option<f64>, crate::GpuError> {
+        let mean = crate::readback::read_rgba_async(ctx, &self.mean).await?;
+        let odd_mean = crate::readback::read_rgba_async(ctx, &self.odd_mean).await?;
+        Ok(self.noise_from(&mean, &odd_mean))
+    }
+
+    /// The estimate from `mean` and `odd_mean` as read back.
+    fn noise_from(&self, mean: &[glam::Vec4], odd_mean: &[glam::Vec4]) -> Option<f64> {
+        let (n, odd) = (self.count as f64, self.count.div_ceil(2) as f64);
+        let sums = |m: &[glam::Vec4], k: f64| -> Vec<[f64; 3]> {
+            m.iter().map(|v| [v.x as f64 * k, v.y as f64 * k, v.z as f64 * k]).collect()
+        };
+        hikari_core::progressive::noise_from_sums(self.width as usize, self.count, &sums(mean, n), &sums(odd_mean, odd))
     }
 }

@@ -16,8 +16,9 @@
 // emissive mesh's likewise from area-uniform points on its triangles and,
 // for small meshes, BRDF samples (`mesh_glossy`). The shadow-mapped samples
 // give the fraction seen, as for Lambertian points. The includer declares
-// `direct_params`, `lights`,
-// `samples`, `views`, `shadow_maps`, and `light_transmittance(x, end)` (the
+// `direct_params` and `shadow_maps` and defines `light_record(i)`,
+// `light_sample(i)`, `shadow_view(i)` (its lights, samples and views, from
+// arrays as `LIGHT_ARRAYS` reads them or from packed tables), and `light_transmittance(x, end)` (the
 // media's transmittance from x to a point toward the light; 1 where media
 // are not drawn).
 
@@ -148,7 +149,7 @@ fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
         }
     }
     let layer = s.first_view + face;
-    let view = views[layer];
+    let view = shadow_view(layer);
     // Offset along the normal by about a texel's footprint against acne: a
     // 90° view's texel spans 2·distance / size there, an orthographic
     // view's its width / size everywhere.
@@ -321,13 +322,13 @@ fn sky_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<funct
             if (!loop_iteration()) {
                 break;
             }
-            let c = dot(wi, samples[l.first_sample + k].direction);
+            let c = dot(wi, light_sample(l.first_sample + k).direction);
             if (c > best) {
                 best = c;
                 nearest = k;
             }
         }
-        let s = samples[l.first_sample + nearest];
+        let s = light_sample(l.first_sample + nearest);
         if (visible(s, x, n)) {
             sum += b.weight * light_transmittance(x, distant_start(l, x, s.direction));
         }
@@ -346,7 +347,7 @@ fn sky_image(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector) -> vec3<f32> {
         if (!loop_iteration()) {
             break;
         }
-        let s = samples[l.first_sample + k];
+        let s = light_sample(l.first_sample + k);
         let cos = dot(n, s.direction);
         if (cos > 0.0 && visible(s, x, n)) {
             let t = light_transmittance(x, distant_start(l, x, s.direction));
@@ -372,7 +373,7 @@ struct MeshTriangle {
 }
 
 fn mesh_triangle(l: Light, i: u32) -> MeshTriangle {
-    let s = samples[l.first_triangle + i];
+    let s = light_sample(l.first_triangle + i);
     return MeshTriangle(s.position, s.direction, s.weight, bitcast<f32>(s.first_view));
 }
 
@@ -498,7 +499,7 @@ fn mesh_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
         if (!loop_iteration()) {
             break;
         }
-        let s = samples[l.first_sample + k];
+        let s = light_sample(l.first_sample + k);
         let to_light = s.position - x;
         let d2 = dot(to_light, to_light);
         if (d2 <= 0.0) {
@@ -541,7 +542,7 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
         if (!loop_iteration()) {
             break;
         }
-        let s = samples[l.first_sample + k];
+        let s = light_sample(l.first_sample + k);
         var weight = 0.0;
         var end = s.position;
         if (l.kind == KIND_SKY) {
@@ -581,7 +582,7 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, 
         if (!loop_iteration()) {
             break;
         }
-        let l = lights[i];
+        let l = light_record(i);
         if (l.kind == KIND_SKY || l.kind == KIND_MESH) {
             sum += sampled_radiance(l, x, n, r, rng);
             continue;
@@ -595,7 +596,7 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, 
             if (!loop_iteration()) {
                 break;
             }
-            let s = samples[l.first_sample + k];
+            let s = light_sample(l.first_sample + k);
             if (visible(s, x, n)) {
                 var end = s.position;
                 if (l.kind == KIND_SUN) {

@@ -21,10 +21,29 @@ pub static LIGHT_EVAL: crate::wgsl::Module = crate::wgsl::Module {
     ],
 };
 
+/// light_eval.wgsl's lights, samples and views from the includer's arrays
+/// `lights`, `samples` and `views`.
+pub static LIGHT_ARRAYS: crate::wgsl::Module = crate::wgsl::Module {
+    name: "light_arrays",
+    source: "fn light_record(i: u32) -> Light {\n    return lights[i];\n}\n\
+             fn light_sample(i: u32) -> LightSample {\n    return samples[i];\n}\n\
+             fn shadow_view(i: u32) -> ShadowView {\n    return views[i];\n}\n",
+    requires: &[&LIGHT_EVAL],
+};
+
 pub fn shader_source() -> String {
     use crate::wgsl::{FULLSCREEN, Module, UNCOUNTED_LOOPS, compose};
     static DIRECT: Module = Module { name: "direct.wgsl", source: include_str!("direct.wgsl"), requires: &[] };
-    compose(&[&UNCOUNTED_LOOPS, &FULLSCREEN, &crate::media::MEDIA, &crate::wgsl::SURFACE, &LIGHT_EVAL, &DIRECT])
+    compose(&[
+        &UNCOUNTED_LOOPS,
+        &FULLSCREEN,
+        &crate::media::MEDIA,
+        &crate::media::REGION_ARRAY,
+        &crate::wgsl::SURFACE,
+        &LIGHT_EVAL,
+        &LIGHT_ARRAYS,
+        &DIRECT,
+    ])
 }
 
 /// Light and BRDF samples per area light at a glossy point (`AREA_SAMPLES`

@@ -3,7 +3,8 @@
 // optical depth along any segment, and the transmittance light_eval.wgsl
 // asks for (light reaching a surface).
 // Prepended to the shaders that use media; the includer declares `media`
-// and `regions` (view_depth.wgsl adds the optical depth along view rays).
+// and defines `region_triangle(i)` (from a `regions` array: REGION_ARRAY)
+// (view_depth.wgsl adds the optical depth along view rays).
 
 struct MediaParams {
     camera_position: vec3<f32>,
@@ -88,7 +89,7 @@ fn segment_optical_depth(origin: vec3<f32>, dir: vec3<f32>, len: f32) -> vec3<f3
         if (!loop_iteration()) {
             break;
         }
-        let tri = regions[i];
+        let tri = region_triangle(i);
         let t = region_crossing(origin, dir, tri.a.xyz, tri.b.xyz, tri.c.xyz);
         if (t <= 0.0) {
             continue;

@@ -16,6 +16,12 @@ pub static MEDIA: crate::wgsl::Module = crate::wgsl::Module {
     source: include_str!("media.wgsl"),
     requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::REGION_CROSSING],
 };
+/// `region_triangle(i)` for media.wgsl from the includer's `regions` array.
+pub static REGION_ARRAY: crate::wgsl::Module = crate::wgsl::Module {
+    name: "region_array",
+    source: "fn region_triangle(i: u32) -> RegionTriangle {\n    return regions[i];\n}\n",
+    requires: &[&MEDIA],
+};
 /// The optical depth along view rays from the slices.
 pub static VIEW_DEPTH: crate::wgsl::Module =
     crate::wgsl::Module { name: "view_depth.wgsl", source: include_str!("view_depth.wgsl"), requires: &[&MEDIA] };
@@ -24,7 +30,7 @@ pub fn optical_depth_shader_source() -> String {
     use crate::wgsl::{Module, UNCOUNTED_LOOPS, compose};
     static OPTICAL_DEPTH: Module =
         Module { name: "optical_depth.wgsl", source: include_str!("optical_depth.wgsl"), requires: &[] };
-    compose(&[&UNCOUNTED_LOOPS, &MEDIA, &OPTICAL_DEPTH])
+    compose(&[&UNCOUNTED_LOOPS, &MEDIA, &REGION_ARRAY, &OPTICAL_DEPTH])
 }
 
 /// Mirrors `MediaParams` in media.wgsl.
@@ -204,7 +210,8 @@ impl GpuMedia {
         let regions = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("region triangles"),
             contents: bytemuck::cast_slice(&triangles),
-            usage: wgpu::BufferUsages::STORAGE,
+            // COPY_SRC: the specular pass copies them into its tables.
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
         });
         let slices_texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("optical-depth slices"),

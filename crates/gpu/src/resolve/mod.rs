@@ -7,6 +7,7 @@ pub fn shader_source() -> String {
     compose(&[
         &UNCOUNTED_LOOPS,
         &crate::media::MEDIA,
+        &crate::media::REGION_ARRAY,
         &crate::media::VIEW_DEPTH,
         &crate::textures::ENVIRONMENT,
         &RESOLVE,

@@ -34,6 +34,10 @@ struct Terms {
 // The sky image (textures::environment_words), by which `sky` is multiplied.
 @group(0) @binding(13) var<storage, read> environment: array<u32>;
 
+fn environment_word(i: u32) -> u32 {
+    return environment[i];
+}
+
 // Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
 override WORKGROUP: u32;
 

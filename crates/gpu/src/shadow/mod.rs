@@ -256,7 +256,8 @@ impl ShadowPass {
         let views_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("shadow views"),
             contents: bytemuck::cast_slice(if params.is_empty() { &zero[..] } else { &params }),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            // COPY_SRC: the specular pass copies the views into its tables.
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         });
         let occluders = lights.occluders.clone();
         let mesh_vertices = (!occluders.vertices.is_empty()).then(|| {

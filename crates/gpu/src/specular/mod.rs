@@ -58,6 +58,7 @@ pub fn shader_source() -> String {
         &crate::wgsl::CUT_OUTS,
         &crate::textures::ENVIRONMENT,
         &crate::wgsl::VOLUME_CHORD,
+        &crate::tables::TABLES,
         &SPECULAR,
     ])
 }
@@ -99,7 +100,12 @@ pub struct SpecularParams {
     pub jitter_y: f32,
     /// Radiance of rays that leave the scene (the sky's; zero without one).
     pub sky_radiance: [f32; 3],
-    pub _pad: u32,
+    /// Word offsets in the tables buffer (`SpecularTables`).
+    pub light_table: u32,
+    pub sample_table: u32,
+    pub view_table: u32,
+    pub region_table: u32,
+    pub environment_table: u32,
 }
 
 /// Mirrors `SliceParams` in specular.wgsl: which share of the photon
@@ -144,10 +150,8 @@ pub struct SpecularInputs<'a> {
 }
 
 pub struct SpecularPass {
-    /// None where the adapter offers too few storage buffers (the pass is
-    /// then never enabled: such scenes are refused).
-    pipeline: Option<wgpu::ComputePipeline>,
-    bind_group: Option<wgpu::BindGroup>,
+    pipeline: wgpu::ComputePipeline,
+    bind_group: wgpu::BindGroup,
     width: u32,
     height: u32,
     /// False when no surface is a mirror or glass: the pass is skipped and
@@ -168,14 +172,12 @@ pub struct SpecularPass {
     shadow_bias: f32,
 }
 
-/// What the pass reads of the scene itself: the flat BVH, and the lights
-/// (with their shadow maps) for direct light at specular hits.
+/// What the pass reads of the scene itself: the flat BVH, and the
+/// parameters of direct light at specular hits.
 struct SceneData {
     nodes: wgpu::Buffer,
     prims: wgpu::Buffer,
     direct: wgpu::Buffer,
-    lights: wgpu::Buffer,
-    samples: wgpu::Buffer,
 }
 
 impl SceneData {
@@ -192,8 +194,67 @@ impl SceneData {
                 bytemuck::bytes_of(&direct_params),
                 wgpu::BufferUsages::UNIFORM,
             ),
-            lights: padded_buffer(device, "specular lights", bytemuck::cast_slice(&lights.lights), storage),
-            samples: padded_buffer(device, "specular light samples", bytemuck::cast_slice(&lights.samples), storage),
+        }
+    }
+}
+
+/// The pass's small tables in one storage buffer (specular.wgsl's
+/// `light_record` and the other readers): the lights and light samples
+/// written from the host, then the shadow views, region triangles and sky
+/// image, copied in on the GPU from the renderer's buffers by `copy_in`
+/// (the views and regions every frame, as moving lights and objects
+/// rewrite them in place; the sky image once).
+struct SpecularTables {
+    buffer: wgpu::Buffer,
+    /// Word offsets: lights, samples, views, regions, sky image.
+    offsets: [u32; 5],
+    views: wgpu::Buffer,
+    regions: wgpu::Buffer,
+    environment: wgpu::Buffer,
+    environment_copied: std::cell::Cell<bool>,
+}
+
+impl SpecularTables {
+    fn new(
+        device: &wgpu::Device,
+        lights: &GpuLights,
+        views: &wgpu::Buffer,
+        regions: &wgpu::Buffer,
+        environment: &wgpu::Buffer,
+    ) -> Self {
+        let mut tables = crate::tables::PackedTables::after(Vec::new());
+        let words = |b: &wgpu::Buffer| (b.size() / 4) as usize;
+        let offsets = [
+            tables.push(&lights.lights),
+            tables.push(&lights.samples),
+            tables.reserve_words(words(views)),
+            tables.reserve_words(words(regions)),
+            tables.reserve_words(words(environment)),
+        ];
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        SpecularTables {
+            buffer: padded_buffer(device, "specular tables", bytemuck::cast_slice(&tables.words), usage),
+            offsets,
+            views: views.clone(),
+            regions: regions.clone(),
+            environment: environment.clone(),
+            environment_copied: std::cell::Cell::new(false),
+        }
+    }
+
+    /// `params` pointing at these tables.
+    fn locate(&self, params: SpecularParams) -> SpecularParams {
+        let [light_table, sample_table, view_table, region_table, environment_table] = self.offsets;
+        SpecularParams { light_table, sample_table, view_table, region_table, environment_table, ..params }
+    }
+
+    /// Records the copies of what the renderer may have rewritten.
+    fn copy_in(&self, encoder: &mut wgpu::CommandEncoder) {
+        let [_, _, views, regions, environment] = self.offsets.map(|words| words as u64 * 4);
+        encoder.copy_buffer_to_buffer(&self.views, 0, &self.buffer, views, self.views.size());
+        encoder.copy_buffer_to_buffer(&self.regions, 0, &self.buffer, regions, self.regions.size());
+        if !self.environment_copied.replace(true) {
+            encoder.copy_buffer_to_buffer(&self.environment, 0, &self.buffer, environment, self.environment.size());
         }
     }
 }
@@ -207,19 +268,14 @@ fn padded_buffer(device: &wgpu::Device, label: &str, bytes: &[u8], usage: wgpu::
 
 /// Everything the pass binds but the photon grids, kept to rebind new ones.
 struct Bindings {
-    /// None where the adapter cannot run the pass.
-    layout: Option<wgpu::BindGroupLayout>,
+    layout: wgpu::BindGroupLayout,
     params: wgpu::Buffer,
     nodes: wgpu::Buffer,
     prims: wgpu::Buffer,
     surfaces: wgpu::Buffer,
     textures: wgpu::Buffer,
-    environment: wgpu::Buffer,
-    regions: wgpu::Buffer,
+    tables: SpecularTables,
     direct: wgpu::Buffer,
-    lights: wgpu::Buffer,
-    samples: wgpu::Buffer,
-    views: wgpu::Buffer,
     maps: wgpu::TextureView,
     normal: wgpu::TextureView,
     output: wgpu::TextureView,
@@ -230,15 +286,15 @@ struct Bindings {
 }
 
 impl Bindings {
-    fn bind_group(&self, device: &wgpu::Device, grid: &wgpu::Buffer) -> Option<wgpu::BindGroup> {
-        let layout = self.layout.as_ref()?;
+    fn bind_group(&self, device: &wgpu::Device, grid: &wgpu::Buffer) -> wgpu::BindGroup {
+        let layout = &self.layout;
         fn buffer(binding: u32, b: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: b.as_entire_binding() }
         }
         fn view(binding: u32, v: &wgpu::TextureView) -> wgpu::BindGroupEntry<'_> {
             wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(v) }
         }
-        Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("specular"),
             layout,
             entries: &[
@@ -247,11 +303,8 @@ impl Bindings {
                 buffer(2, &self.prims),
                 buffer(3, &self.surfaces),
                 buffer(4, grid),
-                buffer(5, &self.regions),
+                buffer(5, &self.tables.buffer),
                 buffer(6, &self.direct),
-                buffer(7, &self.lights),
-                buffer(8, &self.samples),
-                buffer(9, &self.views),
                 view(10, &self.maps),
                 view(11, &self.normal),
                 view(12, &self.output),
@@ -267,9 +320,8 @@ impl Bindings {
                     }),
                 },
                 buffer(17, &self.textures),
-                buffer(18, &self.environment),
             ],
-        }))
+        })
     }
 }
 
@@ -345,45 +397,35 @@ impl SpecularPass {
         use crate::binding::{storage, storage_texture_rgba32f, texture, uniform};
         use wgpu::TextureViewDimension::{D2, D2Array};
         let entry = |b, ty| crate::binding::entry(b, wgpu::ShaderStages::COMPUTE, ty);
-        // An adapter with too few storage buffers (a browser's) cannot
-        // even make the layout: the pass is left out, and scenes that need
-        // it are refused (`GpuRenderer::unsupported`).
-        let runnable =
-            device.limits().max_storage_buffers_per_shader_stage >= crate::capabilities::FULL_STORAGE_BUFFERS;
-        let layout = runnable.then(|| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("specular"),
-                entries: &[
-                    entry(0, uniform()),
-                    entry(1, storage(true)),
-                    entry(2, storage(true)),
-                    entry(3, storage(true)),
-                    entry(4, storage(true)),
-                    entry(5, storage(true)),
-                    entry(6, uniform()),
-                    entry(7, storage(true)),
-                    entry(8, storage(true)),
-                    entry(9, storage(true)),
-                    entry(10, texture(D2Array)),
-                    entry(11, texture(D2)),
-                    entry(12, storage_texture_rgba32f()),
-                    entry(13, uniform()),
-                    entry(14, storage(false)),
-                    entry(15, storage(false)),
-                    entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
-                    entry(17, storage(true)),
-                    entry(18, storage(true)),
-                ],
-            })
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("specular"),
+            entries: &[
+                entry(0, uniform()),
+                entry(1, storage(true)),
+                entry(2, storage(true)),
+                entry(3, storage(true)),
+                entry(4, storage(true)),
+                entry(5, storage(true)),
+                entry(6, uniform()),
+                entry(10, texture(D2Array)),
+                entry(11, texture(D2)),
+                entry(12, storage_texture_rgba32f()),
+                entry(13, uniform()),
+                entry(14, storage(false)),
+                entry(15, storage(false)),
+                entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
+                entry(17, storage(true)),
+            ],
         });
-        let pipeline = layout.as_ref().map(|layout| {
-            let pipeline_layout = crate::binding::pipeline_layout(device, "specular", layout);
-            crate::binding::square_compute_pipeline(device, "specular", &pipeline_layout, &module, "main", WORKGROUP)
-        });
+        let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
+        let pipeline =
+            crate::binding::square_compute_pipeline(device, "specular", &pipeline_layout, &module, "main", WORKGROUP);
 
         let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();
-        let params = SpecularParams {
+        let tables =
+            SpecularTables::new(device, lights, &maps.views_buffer, &media.regions, &scene_buffers.environment);
+        let params = tables.locate(SpecularParams {
             camera_position: scene.camera.position.to_array(),
             tan_half_fov,
             camera_right: right.to_array(),
@@ -399,7 +441,7 @@ impl SpecularPass {
             jitter_y: scene.camera.jitter.y,
             sky_radiance: lights.sky_radiance.to_array(),
             ..grid_params
-        };
+        });
         let storage_usage = wgpu::BufferUsages::STORAGE;
         let params_buffer = padded_buffer(
             device,
@@ -409,7 +451,7 @@ impl SpecularPass {
         );
         let grid = padded_buffer(device, "photon grids", bytemuck::cast_slice(&words), storage_usage);
         let keep = |b: &wgpu::Buffer| b.clone();
-        let SceneData { nodes, prims, direct, lights, samples } =
+        let SceneData { nodes, prims, direct } =
             SceneData::upload(device, &scene_buffers.bvh, lights, maps, inputs.shadow_bias);
         let output = crate::binding::storage_output_texture(device, "specular radiance", width, height);
         let accum = device.create_buffer(&wgpu::BufferDescriptor {
@@ -439,12 +481,8 @@ impl SpecularPass {
             prims,
             surfaces: keep(&scene_buffers.surfaces),
             textures: keep(&scene_buffers.textures),
-            environment: keep(&scene_buffers.environment),
-            regions: keep(&media.regions),
+            tables,
             direct,
-            lights,
-            samples,
-            views: keep(&maps.views_buffer),
             maps: maps_view,
             normal: gbuffer.normal.create_view(&Default::default()),
             output: output.create_view(&Default::default()),
@@ -518,14 +556,16 @@ impl SpecularPass {
         maps: &ShadowMaps,
     ) {
         let sky_radiance = lights.sky_radiance.to_array();
-        let SceneData { nodes, prims, direct, lights, samples } =
+        let SceneData { nodes, prims, direct } =
             SceneData::upload(device, &scene_buffers.bvh, lights, maps, self.shadow_bias);
         let b = &mut self.bindings;
-        (b.nodes, b.prims, b.direct, b.lights, b.samples) = (nodes, prims, direct, lights, samples);
+        (b.nodes, b.prims, b.direct) = (nodes, prims, direct);
         b.surfaces = scene_buffers.surfaces.clone();
         b.textures = scene_buffers.textures.clone();
-        b.environment = scene_buffers.environment.clone();
-        b.views = maps.views_buffer.clone();
+        // The region triangles stay the renderer's (rewritten in place).
+        let regions = b.tables.regions.clone();
+        b.tables = SpecularTables::new(device, lights, &maps.views_buffer, &regions, &scene_buffers.environment);
+        self.params = b.tables.locate(self.params);
         b.maps = maps.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -601,13 +641,13 @@ impl SpecularPass {
             })
             .collect();
         queue.write_buffer(&self.slice_params, 0, &params);
+        self.bindings.tables.copy_in(encoder);
         encoder.clear_buffer(&self.status, 0, None);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("specular"), timestamp_writes: None });
-        let (Some(pipeline), Some(bind_group)) = (&self.pipeline, &self.bind_group) else { return };
-        pass.set_pipeline(pipeline);
+        pass.set_pipeline(&self.pipeline);
         for index in 0..count {
-            pass.set_bind_group(0, bind_group, &[index * SLICE_STRIDE as u32]);
+            pass.set_bind_group(0, &self.bind_group, &[index * SLICE_STRIDE as u32]);
             pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
         }
     }

@@ -49,7 +49,12 @@ struct SpecularParams {
     jitter_y: f32,
     // Radiance of rays that leave the scene (the sky's; zero without one).
     sky_radiance: vec3<f32>,
-    _pad: u32,
+    // Word offsets in `tables` (specular::SpecularTables).
+    light_table: u32,
+    sample_table: u32,
+    view_table: u32,
+    region_table: u32,
+    environment_table: u32,
 }
 
 
@@ -60,11 +65,11 @@ struct SpecularParams {
 // The three photon grids (global, caustic, volume) in one buffer: their
 // bucket starts, then their photons (5 words each); the offsets are words.
 @group(0) @binding(4) var<storage, read> grid: array<u32>;
-@group(0) @binding(5) var<storage, read> regions: array<RegionTriangle>;
+// The lights, light samples, shadow views, region triangles and sky image,
+// one after another (the readers below), so that the pass binds no more
+// than WebGPU's default of 8 storage buffers.
+@group(0) @binding(5) var<storage, read> tables: array<u32>;
 @group(0) @binding(6) var<uniform> direct_params: DirectParams;
-@group(0) @binding(7) var<storage, read> lights: array<Light>;
-@group(0) @binding(8) var<storage, read> samples: array<LightSample>;
-@group(0) @binding(9) var<storage, read> views: array<ShadowView>;
 @group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
@@ -75,7 +80,44 @@ struct SpecularParams {
 @group(0) @binding(15) var<storage, read_write> status: array<atomic<u32>, 4>;
 @group(0) @binding(16) var<uniform> slice: SliceParams;
 @group(0) @binding(17) var<storage, read> texture_data: array<u32>;
-@group(0) @binding(18) var<storage, read> environment: array<u32>;
+
+fn table_word(at: u32) -> u32 {
+    return tables[at];
+}
+
+// The tables' records (tables.wgsl), field by field as the Rust structs
+// (GpuLight, GpuLightSample, ShadowViewParams, RegionTriangle) lay them out.
+fn light_record(i: u32) -> Light {
+    let at = params.light_table + i * 24u;
+    return Light(
+        table_vec3(at), table_u32(at + 3u),
+        table_vec3(at + 4u), table_u32(at + 7u),
+        table_vec3(at + 8u), table_u32(at + 11u),
+        table_vec3(at + 12u), table_f32(at + 15u),
+        table_f32(at + 16u), table_f32(at + 17u), table_u32(at + 18u), table_u32(at + 19u),
+        table_u32(at + 20u), table_u32(at + 21u),
+    );
+}
+
+fn light_sample(i: u32) -> LightSample {
+    let at = params.sample_table + i * 12u;
+    return LightSample(table_vec3(at), table_u32(at + 3u), table_vec3(at + 4u), table_u32(at + 7u), table_vec3(at + 8u), 0u);
+}
+
+fn shadow_view(i: u32) -> ShadowView {
+    let at = params.view_table + i * 24u;
+    let clip_from_world = mat4x4<f32>(table_vec4(at), table_vec4(at + 4u), table_vec4(at + 8u), table_vec4(at + 12u));
+    return ShadowView(clip_from_world, table_vec4(at + 16u), table_vec4(at + 20u));
+}
+
+fn region_triangle(i: u32) -> RegionTriangle {
+    let at = params.region_table + i * 16u;
+    return RegionTriangle(table_vec4(at), table_vec4(at + 4u), table_vec4(at + 8u), table_vec4(at + 12u));
+}
+
+fn environment_word(i: u32) -> u32 {
+    return tables[params.environment_table + i];
+}
 
 // Which slice this dispatch computes (mirrors specular::SliceParams).
 struct SliceParams {

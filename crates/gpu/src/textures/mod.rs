@@ -196,8 +196,8 @@ pub fn environment_words(scene: &Scene) -> Vec<u32> {
     words
 }
 
-/// The environment lookup (`environment_radiance`); the includer declares
-/// `environment: array<u32>`.
+/// The environment lookup (`environment_radiance`); the includer defines
+/// `environment_word(i)`, the words of `environment_words`.
 pub static ENVIRONMENT: crate::wgsl::Module = crate::wgsl::Module {
     name: "environment.wgsl",
     source: include_str!("environment.wgsl"),

@@ -61,6 +61,7 @@ pub fn shader_source(radiance_format: wgpu::TextureFormat) -> String {
             &PREFIX_SUM,
             &crate::lod::LOD_PHOTON,
             &crate::media::VIEW_DEPTH,
+            &crate::media::REGION_ARRAY,
             &crate::wgsl::VOLUME_CHORD,
         ],
     };

@@ -11,6 +11,7 @@
 
 use crate::context::{GpuContext, GpuError};
 use crate::lod::dispatch_grid;
+use crate::tables::PackedTables;
 use crate::wgsl::{BVH, Module, OPTICS, PHOTON_ENCODING, PREFIX_SUM, RANDOM, SAMPLING, SPOT, SURFACE, compose};
 use bytemuck::{Pod, Zeroable};
 use hikari_core::geometry::{FlatBvh, FlatNode};
@@ -48,6 +49,7 @@ pub fn trace_shader_source() -> String {
             &PHOTON_ENCODING,
             &RECORD,
             &crate::wgsl::REGION_CROSSING,
+            &crate::tables::TABLES,
         ],
     };
     compose(&[&TRACE])
@@ -78,6 +80,11 @@ pub struct TraceParams {
     pub _pad0: u32,
     /// The distant lights' disc: centre and radius (0 without distant lights).
     pub distant_disc: [f32; 4],
+    /// Word offsets of the tables behind the texture words.
+    pub light_table: u32,
+    pub medium_table: u32,
+    pub region_table: u32,
+    pub emissive_table: u32,
 }
 
 /// Mirrors `TraceLight` in trace.wgsl.
@@ -256,14 +263,17 @@ struct TraceScene {
     prims: wgpu::Buffer,
     shading: wgpu::Buffer,
     surfaces: wgpu::Buffer,
-    media: wgpu::Buffer,
-    regions: wgpu::Buffer,
     region_triangles: u32,
     global_mask: u32,
-    /// The emissive meshes' triangles, and each light's first one there.
-    emissive: wgpu::Buffer,
-    /// The packed textures, coordinates in the BVH's order (`textures::pack_scene`).
-    textures: wgpu::Buffer,
+    /// The packed textures, coordinates in the BVH's order
+    /// (`textures::pack_scene`), then the tables (`tables::PackedTables`):
+    /// media, region triangles, emissive meshes' triangles and room for
+    /// the lights, which each dispatch writes.
+    tables: wgpu::Buffer,
+    light_table: u32,
+    medium_table: u32,
+    region_table: u32,
+    emissive_table: u32,
     /// Where the sky image's sampling block starts in `textures` (0: none).
     sky_image: u32,
     first_triangles: Vec<u32>,
@@ -281,7 +291,7 @@ fn storage_buffer(device: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buf
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
         contents: bytes,
-        usage: wgpu::BufferUsages::STORAGE,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
     })
 }
 
@@ -327,6 +337,12 @@ impl TraceScene {
             })
             .collect();
         let (triangles, first_triangles) = trace_triangles(&scene.lights);
+        let sky_image = texture_words[2];
+        let mut tables = PackedTables::after(texture_words);
+        let medium_table = tables.push(&entries);
+        let region_table = tables.push(&regions);
+        let emissive_table = tables.push(&triangles);
+        let light_table = tables.reserve_for::<TraceLight>(scene.lights.len());
         TraceScene {
             nodes: storage_buffer(device, "trace bvh nodes", bytemuck::cast_slice(nodes)),
             prims: storage_buffer(device, "trace bvh prims", bytemuck::cast_slice(&bvh.prims)),
@@ -336,13 +352,14 @@ impl TraceScene {
                 "trace surfaces",
                 bytemuck::cast_slice(&crate::scene_upload::scene_surfaces(scene)),
             ),
-            media: storage_buffer(device, "trace media", bytemuck::cast_slice(&entries)),
-            regions: storage_buffer(device, "trace region triangles", bytemuck::cast_slice(&regions)),
             region_triangles: regions.len() as u32,
             global_mask: media.global_mask(),
-            emissive: storage_buffer(device, "trace emissive triangles", bytemuck::cast_slice(&triangles)),
-            textures: storage_buffer(device, "trace textures", bytemuck::cast_slice(&texture_words)),
-            sky_image: texture_words[2],
+            tables: storage_buffer(device, "trace textures and tables", bytemuck::cast_slice(&tables.words)),
+            light_table,
+            medium_table,
+            region_table,
+            emissive_table,
+            sky_image,
             first_triangles,
             distant_disc: scene
                 .lights
@@ -363,7 +380,6 @@ struct Batch {
     paths: u32,
     record_capacity: u32,
     params: wgpu::Buffer,
-    lights: wgpu::Buffer,
     compact_params: wgpu::Buffer,
     status: wgpu::Buffer,
     photons: wgpu::Buffer,
@@ -418,10 +434,6 @@ pub struct GpuTracer {
 
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
-        let needed = crate::capabilities::FULL_STORAGE_BUFFERS;
-        if let Some(why) = crate::capabilities::storage_buffer_shortfall(&ctx.limits, needed, "the GPU photon tracer") {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -434,14 +446,10 @@ impl GpuTracer {
                     compute(2, storage(true)),
                     compute(3, storage(true)),
                     compute(4, storage(true)),
-                    compute(5, storage(true)),
-                    compute(6, storage(true)),
+                    compute(5, storage(false)),
+                    compute(6, storage(false)),
                     compute(7, storage(false)),
-                    compute(8, storage(false)),
-                    compute(9, storage(false)),
-                    compute(10, storage(true)),
-                    compute(11, storage(true)),
-                    compute(12, storage(true)),
+                    compute(8, storage(true)),
                 ],
             });
             let compact_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -670,11 +678,6 @@ impl GpuTracer {
         use wgpu::BufferUsages as U;
         let elements = 3 * paths as u64;
         let params = buffer("trace params", std::mem::size_of::<TraceParams>() as u64, U::UNIFORM | U::COPY_DST);
-        let lights = buffer(
-            "trace lights",
-            (self.scene.lights.len() * std::mem::size_of::<TraceLight>()) as u64,
-            U::STORAGE | U::COPY_DST,
-        );
         let compact_params =
             buffer("trace compact params", std::mem::size_of::<CompactParams>() as u64, U::UNIFORM | U::COPY_DST);
         let records =
@@ -697,21 +700,7 @@ impl GpuTracer {
         let trace_bind_group = bind(
             &self.trace_layout,
             "trace",
-            &[
-                &params,
-                &s.nodes,
-                &s.prims,
-                &s.shading,
-                &s.surfaces,
-                &lights,
-                &s.media,
-                &records,
-                &counts,
-                &status,
-                &s.regions,
-                &s.emissive,
-                &s.textures,
-            ],
+            &[&params, &s.nodes, &s.prims, &s.shading, &s.surfaces, &records, &counts, &status, &s.tables],
         );
         let compact_bind_group = bind(
             &self.compact_layout,
@@ -722,7 +711,6 @@ impl GpuTracer {
             paths,
             record_capacity,
             params,
-            lights,
             compact_params,
             status,
             photons,
@@ -776,6 +764,10 @@ impl GpuTracer {
             region_triangles: s.region_triangles,
             _pad0: 0,
             distant_disc: s.distant_disc,
+            light_table: s.light_table,
+            medium_table: s.medium_table,
+            region_table: s.region_table,
+            emissive_table: s.emissive_table,
         };
         let elements = 3 * paths;
         let scan_workgroups = elements.div_ceil(crate::wgsl::SCAN_WORKGROUP);
@@ -783,7 +775,7 @@ impl GpuTracer {
             CompactParams { elements, paths, record_capacity: batch.record_capacity, workgroups: scan_workgroups };
         let queue = &ctx.queue;
         queue.write_buffer(&batch.params, 0, bytemuck::bytes_of(&params));
-        queue.write_buffer(&batch.lights, 0, bytemuck::cast_slice(&lights));
+        queue.write_buffer(&s.tables, s.light_table as u64 * 4, bytemuck::cast_slice(&lights));
         queue.write_buffer(&batch.compact_params, 0, bytemuck::bytes_of(&compact));
         queue.write_buffer(&batch.status, 0, &[0; 16]);
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -818,6 +810,21 @@ impl GpuTracer {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// trace.wgsl's `light_at` and the other readers step through the
+    /// tables by these strides (in words).
+    #[test]
+    fn table_records_have_the_strides_the_shader_reads() {
+        use std::mem::size_of;
+        assert_eq!(size_of::<TraceLight>(), 28 * 4);
+        assert_eq!(size_of::<TraceMedium>(), 12 * 4);
+        assert_eq!(size_of::<TraceRegionTriangle>(), 12 * 4);
+        assert_eq!(size_of::<TraceTriangle>(), 16 * 4);
+        let source = trace_shader_source();
+        for stride in ["i * 28u", "i * 12u", "i * 16u"] {
+            assert!(source.contains(stride), "trace.wgsl reads records with stride {stride}");
+        }
+    }
 
     #[test]
     fn quad_lights_carry_the_normal_emit_uses() {

@@ -30,6 +30,13 @@ struct TraceParams {
     // w = 0 without distant lights): photons that leave the scene fly
     // through the media up to its plane (Scene::escape_distance).
     distant_disc: vec4<f32>,
+    // Word offsets of the tables behind the texture words (tables/mod.rs):
+    // the lights (rewritten each dispatch), media, region triangles and
+    // emissive triangles.
+    light_table: u32,
+    medium_table: u32,
+    region_table: u32,
+    emissive_table: u32,
 }
 
 // A light as the tracer emits from it (trace::TraceLight).
@@ -112,17 +119,48 @@ struct FlatShading {
 @group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;
 @group(0) @binding(3) var<storage, read> shading: array<FlatShading>;
 @group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
-@group(0) @binding(5) var<storage, read> lights: array<TraceLight>;
-@group(0) @binding(6) var<storage, read> media: array<TraceMedium>;
-@group(0) @binding(7) var<storage, read_write> records: array<PhotonRecord>;
+@group(0) @binding(5) var<storage, read_write> records: array<PhotonRecord>;
 // Photons stored per path: global map, then caustic, then volume (each `paths` long).
-@group(0) @binding(8) var<storage, read_write> counts: array<u32>;
+@group(0) @binding(6) var<storage, read_write> counts: array<u32>;
 // [records taken (may pass the capacity), paths truncated, paths over the
 // loop budget, most loop iterations one path ran].
-@group(0) @binding(9) var<storage, read_write> status: array<atomic<u32>, 4>;
-@group(0) @binding(10) var<storage, read> regions: array<TraceRegionTriangle>;
-@group(0) @binding(11) var<storage, read> emissive: array<TraceTriangle>;
-@group(0) @binding(12) var<storage, read> texture_data: array<u32>;
+@group(0) @binding(7) var<storage, read_write> status: array<atomic<u32>, 4>;
+// The packed textures, then the lights, media, region and emissive
+// triangles (`light_at` and the others below read them).
+@group(0) @binding(8) var<storage, read> texture_data: array<u32>;
+
+fn table_word(at: u32) -> u32 {
+    return texture_data[at];
+}
+
+// The tables' records, field by field as the Rust structs lay them out.
+fn light_at(i: u32) -> TraceLight {
+    let at = params.light_table + i * 28u;
+    return TraceLight(
+        table_vec3(at), table_u32(at + 3u),
+        table_vec3(at + 4u), table_f32(at + 7u),
+        table_vec3(at + 8u), table_f32(at + 11u),
+        table_vec3(at + 12u), table_f32(at + 15u),
+        table_vec3(at + 16u), table_f32(at + 19u),
+        table_f32(at + 20u), table_u32(at + 21u), table_u32(at + 22u), table_u32(at + 23u),
+        table_u32(at + 24u), 0u, 0u, 0u,
+    );
+}
+
+fn medium_at(i: u32) -> TraceMedium {
+    let at = params.medium_table + i * 12u;
+    return TraceMedium(table_vec3(at), table_u32(at + 3u), table_vec3(at + 4u), table_f32(at + 7u), table_f32(at + 8u), 0u, 0u, 0u);
+}
+
+fn region_at(i: u32) -> TraceRegionTriangle {
+    let at = params.region_table + i * 12u;
+    return TraceRegionTriangle(table_vec3(at), table_u32(at + 3u), table_vec3(at + 4u), 0u, table_vec3(at + 8u), 0u);
+}
+
+fn emissive_at(i: u32) -> TraceTriangle {
+    let at = params.emissive_table + i * 16u;
+    return TraceTriangle(table_vec3(at), table_f32(at + 3u), table_vec3(at + 4u), table_f32(at + 7u), table_vec3(at + 8u), 0u, table_vec3(at + 12u), 0u);
+}
 
 const GLOBAL_MAP: u32 = 0u;
 const CAUSTIC_MAP: u32 = 1u;
@@ -190,7 +228,7 @@ fn choose_light(xi: f32) -> u32 {
         if (!loop_iteration()) {
             break;
         }
-        acc += lights[i].probability;
+        acc += light_at(i).probability;
         if (xi < acc) {
             index = i;
             break;
@@ -351,13 +389,13 @@ fn mesh_point(l: TraceLight, u: vec2<f32>) -> MeshPoint {
             break;
         }
         let mid = (lo + hi) / 2u;
-        if (emissive[l.first_triangle + mid].cumulative_area <= target_area) {
+        if (emissive_at(l.first_triangle + mid).cumulative_area <= target_area) {
             lo = mid + 1u;
         } else {
             hi = mid;
         }
     }
-    let tri = emissive[l.first_triangle + min(lo, l.triangle_count - 1u)];
+    let tri = emissive_at(l.first_triangle + min(lo, l.triangle_count - 1u));
     let width = tri.cumulative_area - tri.start_area;
     var ux = 0.5;
     if (width > 0.0) {
@@ -423,7 +461,7 @@ fn trace_paths(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
 }
 
 fn trace_one(rng: ptr<function, Rng>) {
-    let light = lights[choose_light(rng_next_f32(rng))];
+    let light = light_at(choose_light(rng_next_f32(rng)));
     emission_weight = vec3<f32>(1.0);
     var ray = emit(light, rng);
     var power = light.power * emission_weight;
@@ -449,7 +487,7 @@ fn trace_one(rng: ptr<function, Rng>) {
                 }
                 power *= flight.weight * scattering.xyz;
                 let x = ray.origin + ray.dir * flight.distance;
-                let m = media[choose_scatterer(flight.mask, rng_next_f32(rng))];
+                let m = medium_at(choose_scatterer(flight.mask, rng_next_f32(rng)));
                 store(VOLUME_MAP, diffuse_bounces, x, power, ray.dir, m.phase_slot);
                 diffuse_bounces += 1u;
                 ray = Ray(x, phase_sample(m.phase_kind, m.phase_parameter, ray.dir, rng_next_2d(rng)));
@@ -557,7 +595,7 @@ fn mask_coefficients(mask: u32) -> Coefficients {
         if (!loop_iteration()) {
             break;
         }
-        let m = media[firstTrailingBit(bits)];
+        let m = medium_at(firstTrailingBit(bits));
         total.sigma_t += m.sigma_t;
         total.sigma_s += m.sigma_s;
         bits &= bits - 1u;
@@ -593,7 +631,7 @@ fn choose_scatterer(mask: u32, xi: f32) -> u32 {
         }
         let i = firstTrailingBit(bits);
         bits &= bits - 1u;
-        acc += rgb_mean(media[i].sigma_s) / total;
+        acc += rgb_mean(medium_at(i).sigma_s) / total;
         last = i;
         if (xi < acc) {
             break;
@@ -649,8 +687,9 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             if (!loop_iteration()) {
                 break;
             }
-            if (triangle_crossing(o, d, regions[i]) > 0.0) {
-                winding[regions[i].medium] += crossing_sign(d, regions[i]);
+            let tri = region_at(i);
+            if (triangle_crossing(o, d, tri) > 0.0) {
+                winding[tri.medium] += crossing_sign(d, tri);
             }
         }
         mask = winding_mask(params.medium_count);
@@ -665,7 +704,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             if (!loop_iteration()) {
                 break;
             }
-            let t = triangle_crossing(o, d, regions[i]);
+            let t = triangle_crossing(o, d, region_at(i));
             if (t > t0 && t < t_next) {
                 t_next = t;
             }
@@ -692,8 +731,9 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             if (!loop_iteration()) {
                 break;
             }
-            if (triangle_crossing(o, d, regions[i]) == t_next) {
-                winding[regions[i].medium] -= crossing_sign(d, regions[i]);
+            let tri = region_at(i);
+            if (triangle_crossing(o, d, tri) == t_next) {
+                winding[tri.medium] -= crossing_sign(d, tri);
             }
         }
         t0 = t_next;

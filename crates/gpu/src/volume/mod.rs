@@ -29,6 +29,7 @@ pub fn shader_source() -> String {
         &ESTIMATE,
         &crate::splat::FOOTPRINT,
         &crate::media::MEDIA,
+        &crate::media::REGION_ARRAY,
         &crate::media::VIEW_DEPTH,
         &crate::wgsl::VOLUME_CHORD,
         &VOLUME,
