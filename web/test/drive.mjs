@@ -146,6 +146,16 @@ try {
         getComputedStyle(document.getElementById("error")).display,
       ]);
       result.framesGoOn = (await page.evaluate(() => window.hikari.framesInMean())) >= framesBefore;
+      // A .gltf dropped with its buffer and texture (three files at once).
+      const dir = process.env.HIKARI_GLTF_DIR;
+      const transfer = await page.evaluateHandle(() => new DataTransfer());
+      for (const name of ["checker.gltf", "checker.bin", "checker texture.png"]) {
+        const bytes = Array.from(await readFile(join(dir, name)));
+        await page.evaluate(({ t, name, bytes }) => t.items.add(new File([new Uint8Array(bytes)], name)), { t: transfer, name, bytes });
+      }
+      await page.dispatchEvent("body", "drop", { dataTransfer: transfer });
+      await until(page, () => window.hikari.sceneName() === "checker.gltf" && window.hikari.framesInMean() > 1, 120);
+      result.afterGltf = await page.evaluate(() => [window.hikari.sceneName(), window.hikari.lastError()]);
     } else if (scenario === "controls") {
       // A mouse drag moves the view (the mean starts over, the image
       // changes), the panel's checkbox switches a term off, and the save

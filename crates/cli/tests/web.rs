@@ -140,7 +140,12 @@ fn dropped_files_open_or_say_why_not() {
     let dir = scratch_dir("web-drop");
     let glb = dir.join("fixture.glb");
     std::fs::write(&glb, common::unlit_glb()).unwrap();
-    let Some(result) = drive("drop", &dir, &[("HIKARI_GLB", &glb)]) else { return };
+    let gltf_dir = dir.join("gltf");
+    std::fs::create_dir_all(&gltf_dir).unwrap();
+    for (name, bytes) in hikari_core::test_scenes::gltf_textures::checker_gltf_files() {
+        std::fs::write(gltf_dir.join(name), bytes).unwrap();
+    }
+    let Some(result) = drive("drop", &dir, &[("HIKARI_GLB", &glb), ("HIKARI_GLTF_DIR", &gltf_dir)]) else { return };
     assert_eq!(result["afterGood"][0], "fixture.glb");
     assert_eq!(result["afterGood"][1], "");
     let (_, _, dropped) = read_mean(&dir.join("web-dropped.f32"));
@@ -153,6 +158,9 @@ fn dropped_files_open_or_say_why_not() {
     assert_eq!(shown, error, "the error shows on the page");
     assert_eq!(display, "block");
     assert_eq!(result["framesGoOn"], true);
+    // Three files dropped at once: the .gltf, its buffer and its texture.
+    assert_eq!(result["afterGltf"][0], "checker.gltf");
+    assert_eq!(result["afterGltf"][1], "", "the error went with the good scene");
 }
 
 /// A drag moves the camera, the panel's checkbox switches the indirect

@@ -128,6 +128,18 @@ impl EnvironmentMap {
     pub fn load(path: &Path) -> Result<Self, String> {
         let name = path.display();
         let image = image::open(path).map_err(|e| format!("{name}: cannot read the environment map: {e}"))?;
+        Self::from_image(image, &name.to_string())
+    }
+
+    /// An `.hdr` or `.exr` file's bytes (told apart by their magic bytes);
+    /// errors name the file as `name`.
+    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<Self, String> {
+        let image =
+            image::load_from_memory(bytes).map_err(|e| format!("{name}: cannot read the environment map: {e}"))?;
+        Self::from_image(image, name)
+    }
+
+    fn from_image(image: image::DynamicImage, name: &str) -> Result<Self, String> {
         let rgb = image.to_rgb32f();
         let (width, height) = rgb.dimensions();
         let texels = rgb.pixels().map(|p| Vec3::from(p.0)).collect();

@@ -314,6 +314,11 @@ pub mod gltf_textures {
     /// and CLAMP_TO_EDGE. They lie in z = 0, with v = 0 at the top (y = 1),
     /// as glTF's texture coordinates have the image's top-left at (0, 0).
     pub fn checker_glb() -> Vec<u8> {
+        let (b, roots) = checker();
+        b.to_glb(roots)
+    }
+
+    fn checker() -> (GltfBuilder, Vec<json::Index<json::Node>>) {
         let mut b = GltfBuilder::new();
         let image = b.image(&grey_checker([255; 4]), "image/png");
         let repeat = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
@@ -323,7 +328,27 @@ pub mod gltf_textures {
             let m = b.material(&PbrMaterial { specular: 0.0, base_color_texture: Some(t), ..Default::default() });
             roots.push(quad(&mut b, Vec3::new(x, 1.0, 0.0), Vec3::X, -Vec3::Y, scale, m));
         }
-        b.to_glb(roots)
+        (b, roots)
+    }
+
+    /// `checker_glb` as a `.gltf` with its buffer and image in files of
+    /// their own, as exporters write them: (name, bytes) of
+    /// `checker.gltf`, `checker.bin` and `checker texture.png` (its URI
+    /// %-escaped).
+    pub fn checker_gltf_files() -> Vec<(String, Vec<u8>)> {
+        let (b, roots) = checker();
+        let (mut root, bin) = b.finish(roots);
+        root.buffers[0].uri = Some("checker.bin".into());
+        let image = &mut root.images[0];
+        image.buffer_view = None;
+        image.mime_type = None;
+        image.uri = Some("checker%20texture.png".into());
+        let json = json::serialize::to_vec_pretty(&root).unwrap();
+        vec![
+            ("checker.gltf".into(), json),
+            ("checker.bin".into(), bin),
+            ("checker texture.png".into(), grey_checker([255; 4])),
+        ]
     }
 
     /// A black cut-out quad at y = 1 over a white floor, lit by a sun straight

@@ -204,10 +204,9 @@ impl Viewer {
                     Err(e) => self.show_error(e.to_string()),
                 },
                 Action::Files(files) => match scene_from_files(&files) {
-                    Ok(scene) => {
+                    Ok((name, scene)) => {
                         self.error = None;
                         page::clear_error();
-                        let name = files.iter().map(|f| f.name.as_str()).collect::<Vec<_>>().join(", ");
                         self.open_scene(name, scene);
                     }
                     Err(e) => self.show_error(format!("{e} (the last scene stays)")),
@@ -512,7 +511,7 @@ fn page_widgets(
         });
     });
     ui.horizontal(|ui| {
-        let open = ui.button("open .glb / .gltf…");
+        let open = ui.button("open .glb / .gltf / .toml…");
         if open.clicked() {
             page::open_file_dialog();
         }
@@ -523,7 +522,7 @@ fn page_widgets(
         rects.push(("open".into(), rect_of(&open)));
         rects.push(("save PNG".into(), rect_of(&save)));
     });
-    ui.label("or drop a .glb file onto the page");
+    ui.label("or drop a .glb (or a .gltf or .toml with its files) onto the page");
     if let Some(error) = error {
         ui.colored_label(egui::Color32::LIGHT_RED, error);
     }

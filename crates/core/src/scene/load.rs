@@ -4,6 +4,7 @@ use super::desc::{
     AnimationDesc, CameraDesc, EnvironmentDesc, LightDesc, MaterialDesc, MediumDesc, ObjectDesc, SceneDesc, V3,
 };
 use super::error::{SceneError, line_col};
+use super::files::SceneFiles;
 use super::limits::{self, MAX_COORD, MAX_EMISSION, MIN_LENGTH};
 use super::{Animation, Motion, Names, Scene, Surface, Target};
 use crate::camera::Camera;
@@ -94,7 +95,7 @@ impl Place<'_> {
     }
 }
 
-pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
+pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneError> {
     let desc: SceneDesc = toml::from_str(text).map_err(|e| SceneError {
         file: file.to_string(),
         position: e.span().map(|s| line_col(text, s.start)),
@@ -138,7 +139,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
                 names: &mut names,
                 texturing: &mut texturing,
             };
-            load_gltf_object(obj, file, &p, base_dir, &mut geometry, &mut parts)?;
+            load_gltf_object(obj, file, &p, files, &mut geometry, &mut parts)?;
             continue;
         }
         let Some(material_name) = &obj.material else { return Err(p.error("missing field `material`")) };
@@ -157,7 +158,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
             names.objects.push((n, surface));
         }
         let start = geometry.counts();
-        load_object(obj, &p, base_dir, surface, &mut geometry)?;
+        load_object(obj, &p, files, surface, &mut geometry)?;
         geometry.check_since(start, &p)?;
     }
 
@@ -183,7 +184,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
     }
     if let Some(env) = &desc.environment {
         let p = place(env.span(), "[environment]".into());
-        lights.push(load_environment(env.get_ref(), &p, base_dir)?);
+        lights.push(load_environment(env.get_ref(), &p, files)?);
         names.lights.push(None);
     }
     if lights.is_empty() {
@@ -202,8 +203,7 @@ pub fn parse(text: &str, file: &str, base_dir: Option<&Path>) -> Result<Scene, S
         let region = match &m.get_ref().region {
             None => None,
             Some(mesh) => {
-                let path = base_dir.map_or_else(|| Path::new(mesh).to_path_buf(), |d| d.join(mesh));
-                let triangles = load_obj(&path, &p)?.into_iter().map(|t| t.v).collect();
+                let triangles = load_obj(mesh, files, &p)?.into_iter().map(|t| t.v).collect();
                 let region = RegionMesh::new(triangles).map_err(|e| p.error(format!("region {mesh}: {e}")))?;
                 Some(region)
             }
@@ -278,7 +278,7 @@ fn load_gltf_object(
     o: &ObjectDesc,
     file: &str,
     p: &Place,
-    base_dir: Option<&Path>,
+    files: SceneFiles,
     geo: &mut GeometryBuilder,
     parts: &mut SceneParts,
 ) -> Result<(), SceneError> {
@@ -300,9 +300,20 @@ fn load_gltf_object(
         glam::Quat::from_rotation_y(degrees.to_radians()),
         translate,
     );
-    let path = base_dir.map_or_else(|| Path::new(file).to_path_buf(), |d| d.join(file));
-    let asset = super::gltf::load_asset(&path, world_from_file, None, &crate::progress::Silent)
-        .map_err(|e| p.error(e.to_string()))?;
+    let bytes = files.read(file, false).map_err(|e| p.error(format!("cannot read glTF file {file}: {e}")))?;
+    // The glTF file's own buffers and images are beside it.
+    let folder = match files {
+        SceneFiles::Folder(folder) => Some(folder.join(file).parent().map(Path::to_path_buf).unwrap_or_default()),
+        _ => None,
+    };
+    let own_files = folder.as_deref().map_or(files, SceneFiles::Folder);
+    let name = match files {
+        SceneFiles::Folder(folder) => folder.join(file).display().to_string(),
+        _ => file.to_string(),
+    };
+    let asset =
+        super::gltf::asset_from_bytes(&bytes, &name, own_files, world_from_file, None, &crate::progress::Silent)
+            .map_err(|e| p.error(e.to_string()))?;
     let first_material = parts.materials.len() as u32;
     parts.materials.extend(asset.materials);
     // The file's images after those of earlier objects.
@@ -514,7 +525,7 @@ impl GeometryBuilder {
 fn load_object(
     o: &ObjectDesc,
     p: &Place,
-    base_dir: Option<&Path>,
+    files: SceneFiles,
     surface: u32,
     geo: &mut GeometryBuilder,
 ) -> Result<(), SceneError> {
@@ -541,9 +552,8 @@ fn load_object(
             let scale = p.in_range("scale", o.scale.unwrap_or(1.0), (MIN_LENGTH, MAX_COORD))?;
             let translate = p.coord("translate", o.translate.unwrap_or([0.0; 3]))?;
             let rot = rotation(o.rotate_y)?;
-            let path = base_dir.map_or_else(|| Path::new(mesh).to_path_buf(), |d| d.join(mesh));
             let start = geo.triangles.len();
-            for tri in load_obj(&path, p)? {
+            for tri in load_obj(mesh, files, p)? {
                 let v = tri.v.map(|x| rot * (x * scale) + translate);
                 let normals = tri.normals.map(|TriangleNormals(n)| TriangleNormals(n.map(|x| (rot * x).normalize())));
                 let tri = Triangle { v, normals };
@@ -614,14 +624,19 @@ fn has_normal(t: &Triangle) -> bool {
 /// Reads a Wavefront OBJ file into triangles (non-degenerate ones only), its
 /// vertex normals made unit. Positions and normals are checked line by line
 /// first, so that an error can name the OBJ line.
-fn load_obj(path: &Path, p: &Place) -> Result<Vec<Triangle>, SceneError> {
-    let name = path.display();
+fn load_obj(mesh: &str, files: SceneFiles, p: &Place) -> Result<Vec<Triangle>, SceneError> {
+    let name = match files {
+        SceneFiles::Folder(folder) => folder.join(mesh).display().to_string(),
+        _ => mesh.to_string(),
+    };
     // Built-in scenes read their meshes from the copies embedded in the binary.
-    let embedded = p.file.starts_with("builtin:").then(|| super::builtin::mesh(&path.to_string_lossy())).flatten();
+    let embedded = p.file.starts_with("builtin:").then(|| super::builtin::mesh(mesh)).flatten();
     let text = match embedded {
         Some(text) => text.to_string(),
-        None if !path.is_file() => return Err(p.error(format!("mesh file {name} not found"))),
-        None => std::fs::read_to_string(path).map_err(|e| p.error(format!("cannot read mesh {name}: {e}")))?,
+        None => {
+            let bytes = files.read(mesh, false).map_err(|e| p.error(format!("mesh {mesh}: {e}")))?;
+            String::from_utf8(bytes).map_err(|e| p.error(format!("cannot read mesh {name}: not UTF-8 text: {e}")))?
+        }
     };
     check_obj_lines(&text, &name.to_string(), p)?;
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
@@ -805,12 +820,13 @@ fn light_from_desc(l: &LightDesc, p: &Place) -> Result<Light, SceneError> {
 }
 
 /// The `[environment]` table: a uniform sky or a map (read relative to
-/// `base_dir`), its disc fitted later.
-fn load_environment(e: &EnvironmentDesc, p: &Place, base_dir: Option<&Path>) -> Result<Light, SceneError> {
+/// the scene's `files`), its disc fitted later.
+fn load_environment(e: &EnvironmentDesc, p: &Place, files: SceneFiles) -> Result<Light, SceneError> {
     let map = match &e.map {
         Some(file) => {
-            let path = base_dir.map_or_else(|| Path::new(file).to_path_buf(), |d| d.join(file));
-            Some(std::sync::Arc::new(crate::envmap::EnvironmentMap::load(&path).map_err(|e| p.error(e))?))
+            let bytes = files.read(file, false).map_err(|e| p.error(format!("environment map {file}: {e}")))?;
+            let map = crate::envmap::EnvironmentMap::from_bytes(&bytes, file).map_err(|e| p.error(e))?;
+            Some(std::sync::Arc::new(map))
         }
         None => None,
     };
@@ -857,7 +873,7 @@ intensity = [1.0, 1.0, 1.0]
 "#;
 
     fn err(text: &str) -> SceneError {
-        match parse(text, "test.toml", None) {
+        match parse(text, "test.toml", SceneFiles::beside(None)) {
             Ok(_) => panic!("scene was accepted:\n{text}"),
             Err(e) => e,
         }
@@ -865,7 +881,7 @@ intensity = [1.0, 1.0, 1.0]
 
     #[test]
     fn base_scene_loads() {
-        let s = parse(BASE, "test.toml", None).unwrap();
+        let s = parse(BASE, "test.toml", SceneFiles::beside(None)).unwrap();
         assert_eq!(s.accel.sphere_count(), 1);
         assert_eq!(s.lights.len(), 1);
     }
@@ -934,7 +950,7 @@ intensity = [1.0, 1.0, 1.0]
     fn directional_lights_load_with_fitted_discs() {
         let sun = "type = \"directional\"\ndirection = [0.0, -2.0, 0.0]\nirradiance = [3.0, 2.0, 1.0]";
         let point = format!("type = \"point\"\n{POINT}");
-        let s = parse(&BASE.replace(&point, sun), "test.toml", None).unwrap();
+        let s = parse(&BASE.replace(&point, sun), "test.toml", SceneFiles::beside(None)).unwrap();
         let Light::Directional { direction, irradiance, disc } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
         assert_eq!((direction, irradiance), (Vec3::NEG_Y, Vec3::new(3.0, 2.0, 1.0)));
         assert!(disc.center.length() < 1e-6 && (disc.radius / 3f32.sqrt() - 1.0).abs() < 0.01, "{disc:?}");
@@ -953,13 +969,18 @@ intensity = [1.0, 1.0, 1.0]
     fn an_environment_is_a_light() {
         let text = BASE.split("[[light]]").next().unwrap().to_string();
         let sky = |radiance: &str| format!("{text}[environment]\nradiance = {radiance}\n");
-        let s = parse(&sky("[0.5, 1.0, 2.0]"), "test.toml", None).unwrap();
+        let s = parse(&sky("[0.5, 1.0, 2.0]"), "test.toml", SceneFiles::beside(None)).unwrap();
         let Light::Environment { radiance, disc, .. } = s.lights[0] else { panic!("{:?}", s.lights[0]) };
         assert_eq!(radiance, Vec3::new(0.5, 1.0, 2.0));
         assert!((disc.radius / 3f32.sqrt() - 1.0).abs() < 0.01, "{disc:?}");
         assert_eq!(s.names.lights, vec![None]);
         // With a [[light]] too: both, the sky last.
-        let s = parse(&format!("{BASE}\n[environment]\nradiance = [1.0, 1.0, 1.0]\n"), "test.toml", None).unwrap();
+        let s = parse(
+            &format!("{BASE}\n[environment]\nradiance = [1.0, 1.0, 1.0]\n"),
+            "test.toml",
+            SceneFiles::beside(None),
+        )
+        .unwrap();
         assert!(matches!(s.lights[..], [Light::Point { .. }, Light::Environment { .. }]));
         for (radiance, words) in
             [("[-1.0, 1.0, 1.0]", "negative"), ("[0.0, 0.0, 0.0]", "nothing"), ("[1e7, 1.0, 1.0]", "above")]
@@ -982,7 +1003,7 @@ intensity = [1.0, 1.0, 1.0]
         .unwrap();
         let text = BASE
             .replace("shape = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0", "mesh = \"tri.obj\"\nscale = 2.0");
-        let s = parse(&text, "mem.toml", Some(&dir)).unwrap();
+        let s = parse(&text, "mem.toml", SceneFiles::Folder(&dir)).unwrap();
         assert_eq!(s.accel.triangle_count(), 1);
         let hit = s.accel.intersect(&crate::geometry::Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z)).unwrap();
         assert!((hit.point - Vec3::new(0.2, 0.2, 0.0)).length() < 1e-5);
@@ -994,7 +1015,7 @@ intensity = [1.0, 1.0, 1.0]
     #[test]
     fn media_load_and_bad_media_are_rejected() {
         let fog = "\n[[medium]]\nsigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.2, 0.3, 0.4]\nphase = \"hg\"\ng = 0.5\n";
-        let s = parse(&format!("{BASE}{fog}"), "test.toml", None).unwrap();
+        let s = parse(&format!("{BASE}{fog}"), "test.toml", SceneFiles::beside(None)).unwrap();
         let m = s.media.entries()[0].medium;
         assert_eq!(m.phase, Phase::HenyeyGreenstein { g: 0.5 });
         assert_eq!(m.sigma_s, Vec3::new(0.2, 0.3, 0.4));
@@ -1027,11 +1048,11 @@ intensity = [1.0, 1.0, 1.0]
         std::fs::write(dir.join("closed.obj"), format!("{obj}{}\n", faces.join("\n"))).unwrap();
         std::fs::write(dir.join("open.obj"), format!("{obj}{}\n", faces[1..].join("\n"))).unwrap();
         let fog = |region: &str| format!("{BASE}\n[[medium]]\nsigma_s = [0.5, 0.5, 0.5]\nregion = \"{region}\"\n");
-        let s = parse(&fog("closed.obj"), "test.toml", Some(&dir)).unwrap();
+        let s = parse(&fog("closed.obj"), "test.toml", SceneFiles::Folder(&dir)).unwrap();
         assert!(
             s.media.has_regions() && s.media.mask_at(Vec3::splat(0.5)) == 1 && s.media.mask_at(Vec3::splat(2.0)) == 0
         );
-        let e = parse(&fog("open.obj"), "test.toml", Some(&dir)).err().unwrap();
+        let e = parse(&fog("open.obj"), "test.toml", SceneFiles::Folder(&dir)).err().unwrap();
         assert!(e.message.contains("open.obj") && e.message.contains("not closed") && e.position.is_some(), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
         let hg = |g: f32| format!("\n[[medium]]\nsigma_s = [0.1, 0.1, 0.1]\nphase = \"hg\"\ng = {g}\n");
@@ -1111,7 +1132,7 @@ intensity = [1.0, 1.0, 1.0]
         rejects(&sphere, &rotated, obj, &["rotate_y"]);
         let glass = |ior: &str| format!("name = \"white\"\ntype = \"glass\"\nior = {ior}");
         let white = "name = \"white\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]";
-        assert!(parse(&BASE.replace(white, &glass("1.5")), "t.toml", None).is_ok());
+        assert!(parse(&BASE.replace(white, &glass("1.5")), "t.toml", SceneFiles::None).is_ok());
         rejects(white, &glass("0.001"), "[[material]] #1", &["ior"]);
         rejects(white, &glass("1000.0"), "[[material]] #1", &["ior"]);
     }
@@ -1133,7 +1154,7 @@ intensity = [1.0, 1.0, 1.0]
         rejects(&point, &spot.replace("[0.0, -1.0, 0.0]", "[0.0, 0.0, 0.0]"), light, &["direction", "zero"]);
         // A ramp thinner than f32 resolves still has a positive power.
         let thin = format!("{spot}\ncutoff_angle = 20.0\nfalloff_start_angle = 19.999999");
-        let s = parse(&BASE.replace(&point, &thin), "test.toml", None).unwrap();
+        let s = parse(&BASE.replace(&point, &thin), "test.toml", SceneFiles::beside(None)).unwrap();
         assert!(crate::material::mean(s.lights[0].power()) > 0.0);
     }
 
@@ -1143,7 +1164,7 @@ intensity = [1.0, 1.0, 1.0]
         rejects("fov_y = 40.0", "fov_y = 179.9", "[camera]", &["fov_y"]);
         rejects("resolution = [16, 16]", "resolution = [100000, 100000]", "[camera]", &["at most 16384"]);
         rejects("resolution = [16, 16]", "resolution = [16384, 16384]", "[camera]", &["pixels"]);
-        assert!(parse(&BASE.replace("[16, 16]", "[8192, 8192]"), "t.toml", None).is_ok());
+        assert!(parse(&BASE.replace("[16, 16]", "[8192, 8192]"), "t.toml", SceneFiles::None).is_ok());
         // Beyond u32: the TOML reader's own located error.
         let e = err(&BASE.replace("[16, 16]", "[16, 99999999999]"));
         assert!(e.position.is_some(), "{e}");
@@ -1158,7 +1179,7 @@ intensity = [1.0, 1.0, 1.0]
             let e = err(&fog(sigma));
             assert!(e.context == "[[medium]] #1" && e.message.contains(words) && e.position.is_some(), "{e}");
         }
-        assert!(parse(&fog("[1e6, 0.0, 1e-6]"), "t.toml", None).is_ok());
+        assert!(parse(&fog("[1e6, 0.0, 1e-6]"), "t.toml", SceneFiles::None).is_ok());
     }
 
     /// Writes `files` into a fresh folder and loads `BASE` with its sphere
@@ -1169,7 +1190,11 @@ intensity = [1.0, 1.0, 1.0]
         for (name, text) in files {
             std::fs::write(dir.join(name), text).unwrap();
         }
-        let result = parse(&BASE.replace(&format!("shape = \"sphere\"\n{SPHERE}"), object), "test.toml", Some(&dir));
+        let result = parse(
+            &BASE.replace(&format!("shape = \"sphere\"\n{SPHERE}"), object),
+            "test.toml",
+            SceneFiles::Folder(&dir),
+        );
         let _ = std::fs::remove_dir_all(&dir);
         result
     }

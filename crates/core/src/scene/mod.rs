@@ -7,6 +7,7 @@ mod animation;
 pub mod builtin;
 mod desc;
 mod error;
+pub mod files;
 pub mod gltf;
 pub mod keyframes;
 pub mod limits;
@@ -74,7 +75,7 @@ impl Scene {
         progress: &dyn crate::progress::Progress,
     ) -> Result<Scene, SceneError> {
         let mut scene = match builtin::source(spec) {
-            Some(text) => load::parse(text, &format!("builtin:{spec}"), None),
+            Some(text) => load::parse(text, &format!("builtin:{spec}"), files::SceneFiles::None),
             None if gltf::is_gltf(Path::new(spec)) => gltf::load_scene(Path::new(spec), options, progress),
             None => Self::from_file(Path::new(spec)),
         }?;
@@ -124,12 +125,18 @@ impl Scene {
                 format!("cannot read scene file: {e} (built-in scenes: {})", builtin::NAMES.join(", "))
             },
         })?;
-        load::parse(&text, &name, path.parent())
+        load::parse(&text, &name, files::SceneFiles::beside(path.parent()))
     }
 
     /// Parses scene text; relative mesh paths resolve against `base_dir`.
     pub fn from_toml(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Scene, SceneError> {
-        load::parse(text, name, base_dir)
+        load::parse(text, name, files::SceneFiles::beside(base_dir))
+    }
+
+    /// Parses scene text whose meshes, glTF files and sky image are read
+    /// from `files` (e.g. files dropped onto the web page with it).
+    pub fn from_toml_with_files(text: &str, name: &str, files: files::SceneFiles) -> Result<Scene, SceneError> {
+        load::parse(text, name, files)
     }
 
     /// The material of the surface hit, as the file gives it (its

@@ -14,6 +14,7 @@ mod materials;
 mod textures;
 
 use super::SceneError;
+use super::files::SceneFiles;
 use super::limits::MAX_COORD;
 use crate::geometry::{Triangle, TriangleNormals};
 use crate::light::Light;
@@ -137,29 +138,28 @@ pub fn load_asset(
 ) -> Result<Asset, SceneError> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| error(&file, "", format!("cannot read glTF file: {e}")))?;
-    let binary_name = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
-    if binary_name && !bytes.starts_with(b"glTF") {
-        return Err(error(&file, "", "not a binary glTF file: it does not start with the `glTF` magic bytes"));
-    }
-    asset_from_bytes(&bytes, &file, path.parent(), world_from_file, camera, progress)
+    asset_from_bytes(&bytes, &file, SceneFiles::beside(path.parent()), world_from_file, camera, progress)
 }
 
-/// [`load_asset`] of a file's bytes, named `file` in errors; buffers given
-/// as relative paths are read from `base` (none: such a file is an error).
+/// [`load_asset`] of a file's bytes, named `file` in errors; buffers and
+/// images given by relative URI are read from `files`.
 pub fn asset_from_bytes(
     bytes: &[u8],
     file: &str,
-    base: Option<&Path>,
+    files: SceneFiles,
     world_from_file: Affine3A,
     camera: Option<&str>,
     progress: &dyn Progress,
 ) -> Result<Asset, SceneError> {
     let file = file.to_string();
+    if file.to_ascii_lowercase().ends_with(".glb") && !bytes.starts_with(b"glTF") {
+        return Err(error(&file, "", "not a binary glTF file: it does not start with the `glTF` magic bytes"));
+    }
     let gltf = parse(bytes, &file)?;
-    let buffers = load_buffers(&gltf, base, &file)?;
+    let buffers = load_buffers(&gltf, files, &file)?;
     let mut notes = Vec::new();
     check_extensions(&gltf.document, &file, &mut notes)?;
-    let images = textures::load(&gltf.document, &buffers, base, &file)?;
+    let images = textures::load(&gltf.document, &buffers, files, &file)?;
     let materials::Converted { materials, emissions, textures } =
         materials::convert(&gltf.document, &images, &mut notes);
     let textured: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.is_textured())).collect();
@@ -304,8 +304,8 @@ fn check_indices(root: &gltf::json::Root, file: &str) -> Result<(), SceneError> 
 }
 
 /// Every buffer's bytes, from the `.glb`'s binary chunk, a data URI or a
-/// file beside the glTF file.
-fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>, file: &str) -> Result<Vec<gltf::buffer::Data>, SceneError> {
+/// file beside the glTF file (in `files`).
+fn load_buffers(gltf: &gltf::Gltf, files: SceneFiles, file: &str) -> Result<Vec<gltf::buffer::Data>, SceneError> {
     let mut blob = gltf.blob.clone();
     let mut out = Vec::new();
     for buffer in gltf.document.buffers() {
@@ -315,8 +315,15 @@ fn load_buffers(gltf: &gltf::Gltf, base: Option<&Path>, file: &str) -> Result<Ve
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => "its data URI".to_string(),
             gltf::buffer::Source::Uri(uri) => format!("\"{uri}\""),
         };
-        let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), base, &mut blob)
-            .map_err(|e| error(file, &at, format!("cannot read {what}: {e}")))?;
+        let data = match buffer.source() {
+            gltf::buffer::Source::Uri(uri) if !uri.starts_with("data:") => {
+                let mut bytes = files.read(uri, true).map_err(|e| error(file, &at, e))?;
+                bytes.resize(bytes.len().next_multiple_of(4), 0);
+                gltf::buffer::Data(bytes)
+            }
+            source => gltf::buffer::Data::from_source_and_blob(source, None, &mut blob)
+                .map_err(|e| error(file, &at, format!("cannot read {what}: {e}")))?,
+        };
         if data.len() < buffer.length() {
             return Err(error(
                 file,
@@ -676,11 +683,11 @@ pub fn load_scene(path: &Path, options: &LoadOptions, progress: &dyn Progress) -
 pub fn scene_from_bytes(
     bytes: &[u8],
     file: &str,
-    base: Option<&Path>,
+    files: SceneFiles,
     options: &LoadOptions,
     progress: &dyn Progress,
 ) -> Result<super::Scene, SceneError> {
-    let asset = asset_from_bytes(bytes, file, base, Affine3A::IDENTITY, options.camera.as_deref(), progress)?;
+    let asset = asset_from_bytes(bytes, file, files, Affine3A::IDENTITY, options.camera.as_deref(), progress)?;
     scene_from_asset(asset, file.to_string(), progress)
 }
 

@@ -419,3 +419,37 @@ fn node_animations_move_meshes_and_lights() {
     // The loop is 2 s long (its last key): 2.5 s is 0.5 s again.
     assert_eq!(first_vertex(&at(2.5), 1), Vec3::ZERO);
 }
+
+/// A `.gltf` whose buffer and image are files of their own loads from its
+/// folder and from the same files given by name (a web page's drop), the
+/// image's %-escaped URI decoded; a missing one is named.
+#[test]
+fn a_gltf_reads_its_buffer_and_image_from_its_folder_or_given_files() {
+    use crate::scene::files::{GivenFile, SceneFiles};
+    let files = crate::test_scenes::gltf_textures::checker_gltf_files();
+    let dir = folder("external");
+    for (name, bytes) in &files {
+        write(&dir, name, bytes);
+    }
+    let from_folder = crate::scene::Scene::load(dir.join("checker.gltf").to_str().unwrap()).unwrap();
+    let given: Vec<GivenFile> =
+        files.iter().map(|(name, bytes)| GivenFile { name: name.clone(), bytes: bytes.clone() }).collect();
+    let options = LoadOptions::default();
+    let silent = &crate::progress::Silent;
+    let from_given =
+        scene_from_bytes(&files[0].1, "checker.gltf", SceneFiles::Given(&given), &options, silent).unwrap();
+    for scene in [&from_folder, &from_given] {
+        assert_eq!(scene.accel.triangles().count(), 4);
+        let texturing = scene.texturing.as_ref().expect("the checker texture loaded");
+        assert_eq!(texturing.images.len(), 1);
+    }
+    let without_image = &given[..2];
+    let e = scene_from_bytes(&files[0].1, "checker.gltf", SceneFiles::Given(without_image), &options, silent)
+        .err()
+        .unwrap()
+        .to_string();
+    assert_says(&e, &["checker.gltf", "images[0]", "\"checker texture.png\"", "not among the files given"]);
+    let e =
+        scene_from_bytes(&files[0].1, "checker.gltf", SceneFiles::None, &options, silent).err().unwrap().to_string();
+    assert_says(&e, &["checker.gltf", "buffers[0]", "not read from a folder"]);
+}

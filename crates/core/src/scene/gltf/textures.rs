@@ -5,6 +5,7 @@
 
 use super::error;
 use crate::scene::SceneError;
+use crate::scene::files::SceneFiles;
 use crate::texture::{ColorSpace, Image, Sampler, TextureRef, Wrap};
 use std::collections::HashMap;
 use std::path::Path;
@@ -70,7 +71,7 @@ fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::Texture<'a>,
 pub fn load(
     doc: &gltf::Document,
     buffers: &[gltf::buffer::Data],
-    base: Option<&Path>,
+    files: SceneFiles,
     file: &str,
 ) -> Result<Images, SceneError> {
     let mut out = Images::default();
@@ -81,7 +82,7 @@ pub fn load(
             continue;
         }
         let at = format!("images[{}] (read by {used_at})", image.index());
-        let decoded = decode(doc, &image, buffers, base).map_err(|m| error(file, &at, m))?;
+        let decoded = decode(doc, &image, buffers, files).map_err(|m| error(file, &at, m))?;
         let texels =
             to_image(&decoded, space).ok_or_else(|| error(file, &at, "has a pixel format hikari cannot read"))?;
         out.index.insert(key, out.images.len() as u32);
@@ -90,12 +91,34 @@ pub fn load(
     Ok(out)
 }
 
+/// A decoded image as the `gltf` crate gives one (its `Data::new`, which
+/// it keeps private).
+fn image_data(image: image::DynamicImage) -> Option<gltf::image::Data> {
+    use gltf::image::Format;
+    use image::DynamicImage as D;
+    let format = match image {
+        D::ImageLuma8(_) => Format::R8,
+        D::ImageLumaA8(_) => Format::R8G8,
+        D::ImageRgb8(_) => Format::R8G8B8,
+        D::ImageRgba8(_) => Format::R8G8B8A8,
+        D::ImageLuma16(_) => Format::R16,
+        D::ImageLumaA16(_) => Format::R16G16,
+        D::ImageRgb16(_) => Format::R16G16B16,
+        D::ImageRgba16(_) => Format::R16G16B16A16,
+        D::ImageRgb32F(_) => Format::R32G32B32FLOAT,
+        D::ImageRgba32F(_) => Format::R32G32B32A32FLOAT,
+        _ => return None,
+    };
+    let (width, height) = (image.width(), image.height());
+    Some(gltf::image::Data { pixels: image.into_bytes(), format, width, height })
+}
+
 /// One image's pixels, after checking what the `gltf` crate would panic on.
 fn decode(
     doc: &gltf::Document,
     image: &gltf::image::Image,
     buffers: &[gltf::buffer::Data],
-    base: Option<&Path>,
+    files: SceneFiles,
 ) -> Result<gltf::image::Data, String> {
     let json = &doc.as_json().images[image.index()];
     let (what, base) = match (&json.buffer_view, &json.uri) {
@@ -108,15 +131,14 @@ fn decode(
             if view.offset().checked_add(view.length()).is_none_or(|end| end > length) {
                 return Err(format!("reads bufferViews[{}], beyond its buffer's {length} bytes", view.index()));
             }
-            (format!("the image in bufferViews[{}]", view.index()), base)
+            (format!("the image in bufferViews[{}]", view.index()), None)
         }
         // The crate reads data URIs only when given a folder, which they do not use.
         (None, Some(uri)) if uri.starts_with("data:") => ("its data URI".to_string(), Some(Path::new("."))),
         (None, Some(uri)) => {
-            if base.is_none() {
-                return Err(format!("refers to file \"{uri}\", but the glTF was not read from a folder"));
-            }
-            (format!("\"{uri}\""), base)
+            let bytes = files.read(uri, true)?;
+            let decoded = image::load_from_memory(&bytes).map_err(|e| format!("cannot read \"{uri}\": {e}"))?;
+            return image_data(decoded).ok_or_else(|| format!("\"{uri}\" has a pixel format hikari cannot read"));
         }
         (None, None) => return Err("has neither a uri nor a bufferView".into()),
     };
