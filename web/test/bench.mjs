@@ -1,7 +1,9 @@
 // Frame rate of hikari's web page in Debian's headless Chromium (WebGPU on
 // SwiftShader) for BENCHMARKS.md: `node web/test/bench.mjs [SCENE] [WxH]
 // [PHOTONS] [SECONDS]` serves web/dist, opens the page at that size and
-// prints the time to the first frame and the page's mean fps.
+// prints the time to the first frame and the page's mean fps. With
+// HIKARI_PASSES=1 the panel shows, and the last timed frame's passes are
+// printed too (a timed frame waits for each pass: fps reads lower).
 import { chromium } from "playwright-core";
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
@@ -32,12 +34,17 @@ const browser = await chromium.launch({
 });
 const page = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
 const started = Date.now();
-await page.goto(`http://127.0.0.1:${server.address().port}/?scene=${scene}&photons=${photons}&panel=0`);
+const panel = process.env.HIKARI_PASSES === "1" ? 1 : 0;
+await page.goto(`http://127.0.0.1:${server.address().port}/?scene=${scene}&photons=${photons}&panel=${panel}`);
 await page.waitForFunction(() => window.hikari && window.hikari.framesInMean() > 0, null, { timeout: 120000, polling: 20 });
 const firstFrame = Date.now() - started;
 await page.waitForTimeout(Number(seconds) * 1000);
 const [fps, adapter, error] = await page.evaluate(() => [window.hikari.fps(), window.hikari.adapter(), window.hikari.lastError()]);
 console.log(`${scene} ${size}, ${photons} photons a set: first frame ${firstFrame} ms after navigation, ` +
-  `${fps.toFixed(1)} fps over ${seconds} s on ${adapter}${error ? "; error: " + error : ""}`);
+  `${fps.toFixed(2)} fps over ${seconds} s on ${adapter}${error ? "; error: " + error : ""}`);
+if (panel) {
+  const timed = JSON.parse(await page.evaluate(() => window.hikari.passTimes()));
+  console.log(`passes (${timed.timed}): ` + timed.passes.map((p) => `${p.pass} ${p.ms.toFixed(1)} ms`).join(", "));
+}
 await browser.close();
 server.close();

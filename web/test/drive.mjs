@@ -53,8 +53,9 @@ function serve() {
   return new Promise((resolve) => server.listen(0, "127.0.0.1", () => resolve(server)));
 }
 
-async function open(browser, query, { width = 48, height = 36, log } = {}) {
-  const context = await browser.newContext({ viewport: { width, height }, deviceScaleFactor: 1, acceptDownloads: true });
+async function open(browser, query, { width = 48, height = 36, log, phone = false } = {}) {
+  const device = phone ? { deviceScaleFactor: 2, isMobile: true, hasTouch: true } : { deviceScaleFactor: 1 };
+  const context = await browser.newContext({ viewport: { width, height }, ...device, acceptDownloads: true });
   const page = await context.newPage();
   page.on("console", (m) => log.push({ type: m.type(), text: m.text() }));
   page.on("pageerror", (e) => log.push({ type: "pageerror", text: String(e) }));
@@ -182,12 +183,26 @@ try {
       for (let i = 0; i < before.rgba.length; i++) diff += Math.abs(before.rgba[i] - after.rgba[i]);
       result.dragChange = diff / before.rgba.length;
       result.termsBefore = await page.evaluate(() => window.hikari.terms());
-      const box = await page.evaluate(() => window.hikari.widgetRect("indirect"));
+      // Where a widget is once the panel's layout has settled (lines such
+      // as the noise estimate and the pass times appear after a few
+      // frames and push what is below them down).
+      const settledRect = async (name) => {
+        let last = await page.evaluate((n) => window.hikari.widgetRect(n), name);
+        for (let i = 0; i < 10; i++) {
+          const frames = await page.evaluate(() => window.hikari.framesInMean());
+          await until(page, (f) => window.hikari.framesInMean() !== f, 60, frames);
+          const now = await page.evaluate((n) => window.hikari.widgetRect(n), name);
+          if (JSON.stringify(now) === JSON.stringify(last)) return now;
+          last = now;
+        }
+        return last;
+      };
+      const box = await settledRect("indirect");
       result.checkbox = box;
       await page.mouse.click(box[0] + 6, (box[1] + box[3]) / 2);
       await until(page, () => !window.hikari.terms().includes("indirect"), 30);
       result.termsAfter = await page.evaluate(() => window.hikari.terms());
-      const save = await page.evaluate(() => window.hikari.widgetRect("save PNG"));
+      const save = await settledRect("save PNG");
       const [download] = await Promise.all([
         page.waitForEvent("download", { timeout: 60000 }),
         page.mouse.click((save[0] + save[2]) / 2, (save[1] + save[3]) / 2),
@@ -195,6 +210,23 @@ try {
       result.download = download.suggestedFilename();
       await download.saveAs(join(out, "saved.png"));
       await page.waitForTimeout(300);
+    } else if (scenario === "phone") {
+      // A phone-sized window (390×844 CSS pixels, 2 device pixels each,
+      // touch): the canvas fills it, the panel starts folded to its title,
+      // and a tap on the title opens it.
+      const { page } = await open(browser, "?photons=3000", { width: 390, height: 844, log, phone: true });
+      await until(page, hikariReady, 180);
+      result.canvas = await page.evaluate(() => {
+        const c = document.getElementById("hikari-canvas");
+        return [c.clientWidth, c.clientHeight, c.width, c.height];
+      });
+      result.folded = await page.evaluate(() => [window.hikari.widgetRect("panel"), window.hikari.widgetRect("save PNG")]);
+      const title = result.folded[0];
+      // The fold arrow at the title's left.
+      await page.touchscreen.tap(title[0] + 14, (title[1] + title[3]) / 2);
+      await until(page, () => window.hikari.widgetRect("save PNG").length === 4, 120);
+      result.opened = await page.evaluate(() => window.hikari.widgetRect("panel"));
+      result.error = await page.evaluate(() => window.hikari.lastError());
     } else {
       throw new Error(`unknown scenario ${scenario}`);
     }

@@ -187,6 +187,33 @@ fn the_mouse_and_the_panel_work() {
     assert!(console_problems(&result).is_empty(), "console: {:?}", console_problems(&result));
 }
 
+/// A `widgetRect` as the driver wrote it (a Float32Array: an object keyed
+/// "0" to "3", empty when the widget was not drawn).
+fn widget_rect(value: &serde_json::Value) -> Vec<f64> {
+    let entries = value.as_object().unwrap();
+    (0..entries.len()).map(|i| entries[&i.to_string()].as_f64().unwrap()).collect()
+}
+
+/// On a phone-sized window (390×844 CSS pixels, 2 device pixels each,
+/// touch) the canvas fills it and the panel starts folded to its title bar
+/// (it would cover the image); a tap on its arrow opens it.
+#[test]
+fn a_phone_sized_window_shows_the_image_and_a_folded_panel() {
+    let dir = scratch_dir("web-phone");
+    let Some(result) = drive("phone", &dir, &[]) else { return };
+    let canvas: Vec<u64> = result["canvas"].as_array().unwrap().iter().map(|v| v.as_u64().unwrap()).collect();
+    // It fills the window; it renders a pixel per CSS pixel (at 2 device
+    // pixels per CSS pixel, a quarter of the work).
+    assert_eq!(canvas, [390, 844, 390, 844], "CSS size then the canvas's pixels");
+    let folded = widget_rect(&result["folded"][0]);
+    assert!(widget_rect(&result["folded"][1]).is_empty(), "the panel's contents are drawn: {result}");
+    assert!(folded[3] - folded[1] < 40.0, "the folded panel is more than a title bar: {folded:?}");
+    let opened = widget_rect(&result["opened"]);
+    assert!(opened[3] - opened[1] > 200.0, "the tap did not open the panel: {opened:?}");
+    assert_eq!(result["error"], "");
+    assert!(console_problems(&result).is_empty(), "console: {:?}", console_problems(&result));
+}
+
 /// Without WebGPU the page says so in one line, and shows no canvas.
 #[test]
 fn without_webgpu_the_page_says_so() {

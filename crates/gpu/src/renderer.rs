@@ -150,6 +150,10 @@ pub struct GpuRenderer {
     shadow_pass: ShadowPass,
     /// The shadow pass's bind group of the scene (cut-outs).
     shadow_scene: wgpu::BindGroup,
+    /// Whether the shadow maps hold the scene as it is: they depend on the
+    /// geometry and lights alone, so frames of a scene that stands still
+    /// (progressive passes, camera moves) draw them once, not every frame.
+    shadows_drawn: std::cell::Cell<bool>,
     direct_pass: DirectPass,
     direct_binding: crate::direct::DirectBinding,
     specular_pass: SpecularPass,
@@ -383,6 +387,7 @@ impl GpuRenderer {
             ),
             direct_pass,
             shadow_scene: shadow_pass.bind_scene(device, &scene_buffers),
+            shadows_drawn: std::cell::Cell::new(false),
             shadow_pass,
             scene: scene_buffers,
             global_lod: lod_pass
@@ -484,6 +489,7 @@ impl GpuRenderer {
         self.caustic_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
         self.bounds = scene.accel.bounds();
         let lights = GpuLights::new(scene, self.settings.area_light_samples);
+        self.shadows_drawn.set(false);
         if !self.targets.shadow_maps.update(queue, &lights, self.bounds) {
             self.targets.shadow_maps =
                 self.shadow_pass.create_maps(device, &lights, self.settings.shadow_map_size, self.bounds);
@@ -798,7 +804,9 @@ impl GpuRenderer {
                 self.gbuffer_pass.record(queue, encoder, &self.scene, &self.gbuffer_binding, &params, &t.gbuffer);
             }
             Stage::Shadows => {
-                self.shadow_pass.record(encoder, &self.scene, &self.shadow_scene, &self.targets.shadow_maps)
+                if !self.shadows_drawn.replace(true) {
+                    self.shadow_pass.record(encoder, &self.scene, &self.shadow_scene, &self.targets.shadow_maps)
+                }
             }
             Stage::OpticalDepth => self.media.record(encoder),
             Stage::Direct => {

@@ -76,6 +76,9 @@ pub struct Panel {
     state: egui_winit::State,
     renderer: egui_wgpu::Renderer,
     pub visible: bool,
+    /// Whether the panel starts folded to its title bar (a phone-sized
+    /// window, where it would cover the image); a tap on the title opens it.
+    pub start_folded: bool,
     /// Where the last frame drew the term checkboxes, by term name, as
     /// [left, top, right, bottom] in points (CSS pixels in a browser):
     /// the web page's tests click them.
@@ -87,7 +90,7 @@ impl Panel {
         let ctx = egui::Context::default();
         let state = egui_winit::State::new(ctx.clone(), egui::ViewportId::ROOT, window, None, None, None);
         let renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
-        Panel { ctx, state, renderer, visible: true, widget_rects: Vec::new() }
+        Panel { ctx, state, renderer, visible: true, start_folded: false, widget_rects: Vec::new() }
     }
 
     /// Passes a window event to egui; true when egui used it (a click on
@@ -118,14 +121,19 @@ impl Panel {
         let mut front_end = Some(front_end);
         let rects = &mut self.widget_rects;
         rects.clear();
+        let open = !self.start_folded;
         let output = self.ctx.run_pass(input, |ctx| {
-            egui::Window::new("hikari").default_width(260.0).show(ctx, |ui| {
+            let shown = egui::Window::new("hikari").default_width(260.0).default_open(open).show(ctx, |ui| {
                 // The front end's own widgets first (the web page's scene menu).
                 if let Some(widgets) = front_end.take() {
                     widgets(ui);
                 }
                 layout(ui, controls, readouts, rects)
             });
+            // The whole panel, its title bar alone when folded.
+            if let Some(shown) = shown {
+                rects.push(("panel".into(), rect_of(&shown.response)));
+            }
         });
         let egui::FullOutput { platform_output, mut textures_delta, shapes, pixels_per_point, .. } = output;
         self.state.handle_platform_output(window, platform_output);

@@ -591,6 +591,9 @@ async fn frame(viewer: Shared) {
     }
 }
 
+/// Windows narrower than this (CSS pixels) open with the panel folded.
+const PHONE_WIDTH: f32 = 600.0;
+
 /// Opens WebGPU on the canvas.
 async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
     page::set_status("opening WebGPU…");
@@ -620,6 +623,8 @@ async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
     let mut panel = Panel::new(&window, &ctx.device, format);
     let mut v = viewer.borrow_mut();
     panel.visible = v.options.panel;
+    // On a phone-sized window the panel would hide the image: folded.
+    panel.start_folded = window.inner_size().to_logical::<f32>(window.scale_factor()).width < PHONE_WIDTH;
     v.readouts.adapter = ctx.describe();
     web_sys::console::log_1(&format!("hikari: {} on {}", v.scene_name, ctx.describe()).into());
     page::set_status(&format!("tracing photons of {} on {}…", v.scene_name, ctx.describe()));
