@@ -46,10 +46,13 @@ pub struct Segment {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Flight {
     /// An interaction at `distance` in the media of `mask`; the photon's
-    /// power is multiplied by `weight` (all ones in grey media).
-    Interaction { distance: f32, weight: Rgb, mask: u32 },
-    /// No interaction before the end of the ray; power × `weight`.
-    Passed { weight: Rgb },
+    /// power is multiplied by `weight` (all ones in grey media). `tau_bar`
+    /// is the optical depth in the mean channel up to it (the depth the
+    /// sampler drew), on which the flight's density depends.
+    Interaction { distance: f32, weight: Rgb, mask: u32, tau_bar: f32 },
+    /// No interaction before the end of the ray; power × `weight`;
+    /// `tau_bar` the mean-channel optical depth of the whole ray.
+    Passed { weight: Rgb, tau_bar: f32 },
 }
 
 impl Media {
@@ -226,12 +229,12 @@ impl Media {
                 let d = (target - tau_bar) / sigma_bar;
                 let tau_c = tau + sigma_t * d;
                 let weight = (-(tau_c - Rgb::splat(target))).exp() * sigma_t / sigma_bar;
-                return Flight::Interaction { distance: s.t0 + d, weight, mask: s.mask };
+                return Flight::Interaction { distance: s.t0 + d, weight, mask: s.mask, tau_bar: target };
             }
             tau_bar += sigma_bar * length;
             tau += sigma_t * length;
         }
-        Flight::Passed { weight: (-(tau - Rgb::splat(tau_bar))).exp() }
+        Flight::Passed { weight: (-(tau - Rgb::splat(tau_bar))).exp(), tau_bar }
     }
 
     /// The albedo roulette at an interaction in the media of `mask`
@@ -376,7 +379,7 @@ mod tests {
         let mut sum = 0.0f64;
         for _ in 0..n {
             match media.sample_flight(Vec3::ZERO, Vec3::X, f32::INFINITY, rng.next_f32()) {
-                Flight::Interaction { distance, weight, mask } => {
+                Flight::Interaction { distance, weight, mask, .. } => {
                     assert!((weight - Vec3::ONE).abs().max_element() < 1e-5 && mask == 1, "{weight} {mask}");
                     sum += distance as f64;
                 }
@@ -411,6 +414,32 @@ mod tests {
         assert!((in_overlap as f64 / n as f64 - want).abs() < 0.004, "{in_overlap} vs {want}");
     }
 
+    /// A flight's τ̄ is the mean-channel optical depth `optical_depth` gives
+    /// up to where it stopped, or over the whole ray when it passed (what
+    /// vertex connection and merging's densities take from it).
+    #[test]
+    fn a_flights_mean_optical_depth_is_the_segments() {
+        let media = two_slabs();
+        let o = Vec3::new(-1.0, 0.0, 0.0);
+        let mut rng = Rng::for_item(56, 0);
+        let (mut stopped, mut passed) = (0, 0);
+        for _ in 0..2_000 {
+            let (length, tau_bar) = match media.sample_flight(o, Vec3::X, 4.0, rng.next_f32()) {
+                Flight::Interaction { distance, tau_bar, .. } => {
+                    stopped += 1;
+                    (distance, tau_bar)
+                }
+                Flight::Passed { tau_bar, .. } => {
+                    passed += 1;
+                    (4.0, tau_bar)
+                }
+            };
+            let want = mean(media.optical_depth(o, Vec3::X, length));
+            assert!((tau_bar - want).abs() <= 1e-5 * want.max(1.0), "{tau_bar} vs {want} at {length}");
+        }
+        assert!(stopped > 100 && passed > 100, "{stopped} stopped, {passed} passed");
+    }
+
     /// With RGB coefficients the weighted flights stay unbiased: the expected
     /// weight of photons passing a slab is the per-channel transmittance.
     #[test]
@@ -426,7 +455,7 @@ mod tests {
         let n = 400_000;
         let mut passed = Vec3::ZERO;
         for _ in 0..n {
-            if let Flight::Passed { weight } = media.sample_flight(o, Vec3::X, 2.0, rng.next_f32()) {
+            if let Flight::Passed { weight, .. } = media.sample_flight(o, Vec3::X, 2.0, rng.next_f32()) {
                 passed += weight;
             }
         }

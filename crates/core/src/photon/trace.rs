@@ -165,8 +165,8 @@ impl PathTracer<'_> {
                 // eye ray would (`Scene::escape_distance`).
                 let t_max = hit.map_or_else(|| self.scene.escape_distance(ray.origin, ray.dir), |h| h.t);
                 match media.sample_flight(ray.origin, ray.dir, t_max, rng.next_f32()) {
-                    Flight::Passed { weight } => power *= weight,
-                    Flight::Interaction { distance, weight, mask } => {
+                    Flight::Passed { weight, .. } => power *= weight,
+                    Flight::Interaction { distance, weight, mask, .. } => {
                         let (lambda, albedo) = media.scattering(mask);
                         if rng.next_f32() >= lambda {
                             return; // absorbed

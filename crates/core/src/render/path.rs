@@ -60,8 +60,8 @@ pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, rng: &mut 
             let t_max = hit.map_or_else(|| scene.escape_distance(ray.origin, ray.dir), |h| h.t);
             l += beta * in_scattered_from_delta_lights(scene, &ray, t_max, rng);
             match media.sample_flight(ray.origin, ray.dir, t_max, rng.next_f32()) {
-                Flight::Passed { weight } => beta *= weight,
-                Flight::Interaction { distance, weight, mask } => {
+                Flight::Passed { weight, .. } => beta *= weight,
+                Flight::Interaction { distance, weight, mask, .. } => {
                     let (lambda, albedo) = media.scattering(mask);
                     if rng.next_f32() >= lambda {
                         break; // absorbed

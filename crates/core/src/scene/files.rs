@@ -45,7 +45,7 @@ impl<'a> SceneFiles<'a> {
             SceneFiles::Folder(folder) => {
                 let path = folder.join(reference);
                 if !path.is_file() {
-                    return Err(format!("file {} not found", path.display()));
+                    return Err(format!("cannot read {}: file not found", path.display()));
                 }
                 std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))
             }

@@ -45,21 +45,22 @@ pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
     // A ray leaving the scene crosses the fog a shadow ray toward the sky would.
     let t_max = hit.map_or_else(|| scene.escape_distance(ray.origin, ray.dir), |h| h.t);
     match media.sample_flight(ray.origin, ray.dir, t_max, rng.next_f32()) {
-        Flight::Interaction { distance, weight, mask } => {
+        // The sampler's own τ̄: no second walk over the region crossings.
+        Flight::Interaction { distance, weight, mask, tau_bar } => {
             let (sigma_t, sigma_s) = (media.sigma_t(mask), media.sigma_s(mask));
             let albedo = Rgb::select(sigma_t.cmpgt(Rgb::ZERO), sigma_s / sigma_t, Rgb::ZERO);
             Step {
                 event: Event::Medium { point: ray.at(distance), mask },
                 distance,
                 weight: weight * albedo,
-                passes: (-mean(media.optical_depth(ray.origin, ray.dir, distance))).exp(),
+                passes: (-tau_bar).exp(),
             }
         }
-        Flight::Passed { weight } => Step {
+        Flight::Passed { weight, tau_bar } => Step {
             event: hit.map_or(Event::Escaped, Event::Surface),
             distance: t_max,
             weight,
-            passes: (-mean(media.optical_depth(ray.origin, ray.dir, t_max))).exp(),
+            passes: (-tau_bar).exp(),
         },
     }
 }
