@@ -76,6 +76,7 @@ pub struct Viewer {
     pub readouts: Readouts,
     clock: AnimationClock,
     stats: FrameStats,
+    /// When the last rendered frame was presented (frame rate, clock).
     last_frame: Option<Instant>,
     started: Option<Instant>,
     pub gpu: Option<Gpu>,
@@ -419,12 +420,16 @@ impl Viewer {
         ctx.queue.present(texture);
         ctx.check()?;
         self.actions.extend(asked);
+        // Frame rate counts rendered frames: a frame that only presents the
+        // mean again (its photon set not traced yet) is not one.
         let now = Instant::now();
-        if let Some(last) = self.last_frame {
-            self.stats.push((now - last).as_secs_f64());
+        if rendered {
+            if let Some(last) = self.last_frame {
+                self.stats.push((now - last).as_secs_f64());
+            }
+            self.last_frame = Some(now);
         }
         self.started.get_or_insert(now);
-        self.last_frame = Some(now);
         if self.stats.frames() > 0 {
             self.readouts.fps = self.stats.mean_fps();
         }
