@@ -654,7 +654,8 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             "vcm ({:?}): one light and one camera subpath per pixel a pass, first merging radius {radius:.4}{in_media}, α = {}",
             settings.strategies, args.alpha
         );
-        let mut passes = VcmPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
+        let mut passes =
+            VcmPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0, workspace: Default::default() };
         let done = passes::run(&mut passes, &plan)?;
         return finish(done, &mut passes, &plan, "vcm", |p| p.nonfinite);
     }

@@ -95,11 +95,13 @@ pub struct VcmPasses<'a> {
     pub settings: vcm::VcmSettings,
     pub mean: ImageMean,
     pub nonfinite: u64,
+    pub workspace: vcm::Workspace,
 }
 
 impl PassRenderer for VcmPasses<'_> {
     fn render_pass(&mut self, pass: u32) -> Result<()> {
-        let (image, nonfinite) = vcm::render_pass(self.scene, &self.settings, pass).map_err(anyhow::Error::msg)?;
+        let (image, nonfinite) =
+            vcm::render_pass_in(&mut self.workspace, self.scene, &self.settings, pass).map_err(anyhow::Error::msg)?;
         self.nonfinite += nonfinite;
         self.mean.add(&image);
         Ok(())

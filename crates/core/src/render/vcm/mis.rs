@@ -225,6 +225,13 @@ pub fn connection(camera: &SubpathMis, light: &SubpathMis, d: &Connection) -> f3
     1.0 / (w_light + 1.0 + w_camera)
 }
 
+/// An upper bound on the weight of any merge at a camera vertex with sums
+/// `camera` (eta: [`Factors::eta`] there, not 0): [`merge`]'s weight
+/// without the terms that depend on the light vertex and the directions.
+pub fn merge_bound(camera: &SubpathMis, eta: f32, f: &Factors) -> f32 {
+    1.0 / (1.0 + camera.d_vcm * f.connect / eta)
+}
+
 /// Weight of merging a camera vertex with a light vertex at (nearly) the
 /// same point: `camera_dir_pdf_w` the camera vertex's BSDF choosing the
 /// light vertex's incoming direction (its continuation), `camera_rev_pdf_w`

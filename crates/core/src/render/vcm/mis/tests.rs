@@ -248,3 +248,25 @@ fn with_medium_vertices_the_weights_are_veachs_heuristic() {
     check(true, false, true);
     check(false, true, true);
 }
+
+/// The bound that merging's roulette reads is one: no merge on a random
+/// path (with or without media, connections on or off) weighs more.
+#[test]
+fn merge_bound_bounds_every_merge() {
+    let mut rng = Rng::for_item(12, 0);
+    for (connect, media) in [(true, false), (true, true), (false, false)] {
+        for k in 2..=5 {
+            for _ in 0..200 {
+                let p = Path::random(k, media, &mut rng);
+                let f = Factors::new(0.01 + 0.2 * rng.next_f32(), 0.01 + 0.2 * rng.next_f32(), 4096.0, connect, true);
+                let (light, camera) = subpaths(&p, &f);
+                for i in 1..k {
+                    let eta = p.eta(&f, i);
+                    let w = super::merge(&camera[i], &light[i], p.pdf(i, i - 1), p.pdf(i, i + 1), eta, &f);
+                    let bound = super::merge_bound(&camera[i], eta, &f);
+                    assert!(w <= bound * (1.0 + 1e-5), "k = {k}, vertex {i}: weight {w} above the bound {bound}");
+                }
+            }
+        }
+    }
+}
