@@ -113,6 +113,11 @@ try {
       await until(page, (n) => window.hikari.framesInMean() >= n, 300, frames);
       result.frames = await page.evaluate(() => window.hikari.framesInMean());
       result.tracer = await page.evaluate(() => window.hikari.tracer());
+      // The status line ("drawing the first image…") is gone once it is drawn.
+      result.status = await page.evaluate(() => {
+        const s = document.getElementById("status");
+        return s && getComputedStyle(s).display !== "none" ? s.textContent : "";
+      });
       await writeMean(`web-${frames}.f32`, await readMean(page));
       result.error = await page.evaluate(() => window.hikari.lastError());
     } else if (scenario === "drop") {

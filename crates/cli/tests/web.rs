@@ -110,6 +110,7 @@ fn page_against_native_render(name: &str, scene: Option<&str>, frames: &str) {
     assert_eq!(result["frames"].to_string(), frames);
     assert_eq!(result["error"], "");
     assert_eq!(result["tracer"], "GPU", "the page traced its photons on the CPU");
+    assert_eq!(result["status"], "", "the status line stays after the frames were drawn");
     let (width, height, web) = read_mean(&dir.join(format!("web-{frames}.f32")));
     assert_eq!((width, height), (48, 36));
     // The same renderer natively on the same driver: Chromium's own

@@ -184,7 +184,9 @@ impl GpuContext {
     /// One line naming the adapter, for logs and summaries.
     pub fn describe(&self) -> String {
         let i = &self.adapter_info;
-        format!("{} ({:?}, {:?}){}", i.name, i.backend, i.device_type, bus_suffix(i).replacen(",", "", 1))
+        // Browsers may withhold the name (headless Chromium's SwiftShader does).
+        let name = if i.name.is_empty() { "an unnamed adapter" } else { &i.name };
+        format!("{name} ({:?}, {:?}){}", i.backend, i.device_type, bus_suffix(i).replacen(",", "", 1))
     }
 
     /// Runs `f` under error scopes for validation, out-of-memory and internal
