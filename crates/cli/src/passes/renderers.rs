@@ -1,15 +1,14 @@
-//! The three renderers, pass by pass. Pass i traces with seed + i − 1 (the
-//! photon renderers) or samples pixels with it (the path tracer), so pass 1
-//! is the single-pass render and every pass is independent of the others.
+//! The renderers, pass by pass. Pass i traces with seed + i − 1 (the
+//! photon renderers) or draws the next samples of the pixels' Sobol streams
+//! (the path tracer, `PathSettings::pass`), so pass 1 is the single-pass
+//! render and every pass depends on the seed and its number alone.
 
 use super::PassRenderer;
 use crate::tracing::PhotonTracer;
 use anyhow::Result;
 use hikari_core::photon::TracedPhotons;
 use hikari_core::progress::Silent;
-use hikari_core::progressive::{
-    ImageMean, Schedules, pass_jitter, pass_seed, pass_trace_settings, photon_cpu_estimate_pass,
-};
+use hikari_core::progressive::{ImageMean, Schedules, pass_jitter, pass_trace_settings, photon_cpu_estimate_pass};
 use hikari_core::render::{Image, path, photon_cpu, vcm};
 use hikari_core::scene::Scene;
 use hikari_gpu::accumulate::AccumulatePass;
@@ -64,7 +63,7 @@ pub struct PathPasses<'a> {
 
 impl PassRenderer for PathPasses<'_> {
     fn render_pass(&mut self, pass: u32) -> Result<()> {
-        let settings = path::PathSettings { seed: pass_seed(self.settings.seed, pass), ..self.settings.clone() };
+        let settings = path::PathSettings { pass, ..self.settings.clone() };
         let (image, nonfinite) = path::render(self.scene, &settings, &Silent);
         self.nonfinite += nonfinite;
         self.mean.add(&image);

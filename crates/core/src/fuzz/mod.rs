@@ -49,7 +49,7 @@ pub fn cpu_renderers() -> Vec<Renderer<'static>> {
         Renderer {
             name: "path",
             render: Box::new(|scene: &Scene| {
-                path::render(scene, &path::PathSettings { spp: 1, seed: 1, max_depth: 16 }, &Silent)
+                path::render(scene, &path::PathSettings { spp: 1, seed: 1, max_depth: 16, pass: 1 }, &Silent)
             }),
         },
     ]

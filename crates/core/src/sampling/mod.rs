@@ -8,12 +8,35 @@
 pub(crate) mod chi2;
 mod equiangular;
 mod rng;
+mod sobol;
 
 pub use equiangular::Equiangular;
 pub use rng::Rng;
+pub use sobol::SobolSampler;
 
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+
+/// A source of uniform numbers in [0, 1) for one path: independent ones
+/// ([`Rng`]) or a quasi-random sample ([`SobolSampler`]).
+pub trait Sampler {
+    fn next_f32(&mut self) -> f32;
+
+    fn next_2d(&mut self) -> Vec2 {
+        let x = self.next_f32();
+        Vec2::new(x, self.next_f32())
+    }
+}
+
+impl Sampler for Rng {
+    fn next_f32(&mut self) -> f32 {
+        Rng::next_f32(self)
+    }
+
+    fn next_2d(&mut self) -> Vec2 {
+        Rng::next_2d(self)
+    }
+}
 
 /// An orthonormal basis whose third axis is `n` (Duff et al. 2017, branchless).
 pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {

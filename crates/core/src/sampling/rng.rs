@@ -15,7 +15,7 @@ pub struct Rng {
 const MULTIPLIER: u64 = 6364136223846793005;
 
 /// SplitMix64 finaliser: spreads nearby counters over the whole state space.
-fn mix64(mut z: u64) -> u64 {
+pub(crate) fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58476d1ce4e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d049bb133111eb);
     z ^ (z >> 31)
