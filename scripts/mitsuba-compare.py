@@ -39,6 +39,9 @@ import numpy as np
 # JIT-compiled to vector code by LLVM (Debian's libllvm19).
 mi.set_variant(os.environ.get("MITSUBA_VARIANT", "llvm_ad_rgb"))
 T = mi.ScalarTransform4f
+# MITSUBA_SAMPLER=multijitter (or stratified, orthogonal, ldsampler) for
+# Mitsuba's stratified samplers; independent, its default, otherwise.
+SAMPLER = os.environ.get("MITSUBA_SAMPLER", "independent")
 
 
 def mitsuba_scene(toml_path, size, rfilter):
@@ -54,7 +57,7 @@ def mitsuba_scene(toml_path, size, rfilter):
             "fov": cam["fov_y"],
             "fov_axis": "y",
             "to_world": T().look_at(origin=cam["position"], target=cam["look_at"], up=cam["up"]),
-            "sampler": {"type": "independent"},
+            "sampler": {"type": SAMPLER},
             "film": {
                 "type": "hdrfilm",
                 "width": size,
@@ -107,7 +110,7 @@ def mitsuba_scene(toml_path, size, rfilter):
 class Mitsuba:
     def __init__(self, toml_path, size, rfilter):
         self.scene = mitsuba_scene(toml_path, size, rfilter)
-        self.name = f"Mitsuba 3 {mi.__version__} {mi.variant()} path ({rfilter} filter)"
+        self.name = f"Mitsuba 3 {mi.__version__} {mi.variant()} path ({rfilter} filter, {SAMPLER} sampler)"
 
     def render(self, spp, seed):
         start = time.perf_counter()
