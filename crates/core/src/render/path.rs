@@ -325,7 +325,7 @@ pub fn render(scene: &Scene, settings: &PathSettings, progress: &dyn Progress) -
     let spp = settings.spp.max(1);
     let passes_before = u64::from(settings.pass.max(1) - 1);
     let (half, first) = (passes_before % 2, passes_before / 2 * u64::from(spp));
-    let streams = crate::sampling::Rng::seed_constants(settings.seed ^ 0x5eed_0f_9a7e).0;
+    let streams = crate::sampling::Rng::seed_constants(settings.seed ^ 0x005e_ed0f_9a7e).0;
     render_rows(camera, progress, |x, y| {
         let stream = streams.wrapping_add((u64::from(y) * u64::from(camera.width) + u64::from(x)) * 2 + half);
         finite_mean(spp, |s| {

@@ -1,6 +1,6 @@
 //! Randomised quasi-Monte Carlo samples for the path tracer: Owen-scrambled
 //! Sobol points (Burley 2020, "Practical Hash-based Owen Scrambling", the
-//! `sobol_burley` crate), padded in sets of four dimensions.
+//! `sobol_burley` crate), padded in pairs of dimensions.
 //!
 //! Why: a pixel's samples drawn independently leave clumps and gaps in each
 //! decision's square (the pixel's area, the first bounce's direction, the
@@ -13,8 +13,10 @@
 //! depends on what it meets. The k-th pair it asks for is the first two
 //! dimensions of the Sobol sequence (a (0,2)-sequence: every 2^m points
 //! fill every 2^a × 2^b grid of 2^m cells once) under a scramble seeded by
-//! (stream, k); single numbers come four at a time from dimensions 0–3 of
-//! sets of their own (each a (0,1)-sequence). Different sets are
+//! (stream, k); single numbers come two at a time from the two dimensions
+//! of sets of their own (each a (0,1)-sequence). Only the first requests
+//! get Sobol numbers (`SOBOL_PAIRS`, `SOBOL_SINGLE_SETS`); the rest of a
+//! long path takes PCG numbers. Different sets are
 //! independently randomised (Burley's padding; pbrt-v4's `PaddedSobolSampler`
 //! does the same). Every sample is uniform in the unit cube whatever the
 //! index, so estimates stay unbiased; distinct streams are independent
@@ -37,7 +39,8 @@ const BLOCK_BITS: u32 = 16;
 /// (relative error 17.5% → 14.4% at 256 spp), Sobol numbers for every
 /// request no more (14.4%).
 const SOBOL_PAIRS: u32 = 3;
-const SOBOL_SINGLES: u32 = 2;
+/// Sets of two single numbers each.
+const SOBOL_SINGLE_SETS: u32 = 2;
 
 /// Sample `index` of the Sobol stream `stream`: one path's numbers.
 #[derive(Clone, Debug)]
@@ -83,7 +86,7 @@ impl Sampler for SobolSampler {
     fn next_f32(&mut self) -> f32 {
         let (set, lane) = (self.singles / 2, self.singles % 2);
         self.singles += 1;
-        if set >= SOBOL_SINGLES {
+        if set >= SOBOL_SINGLE_SETS {
             return self.tail.next_f32();
         }
         if lane == 0 {
@@ -193,7 +196,7 @@ mod tests {
     #[test]
     fn pairs_and_singles_are_stratified() {
         for (stream, first) in [(3u64, 0u64), (4, 1 << 16)] {
-            for request in [0usize, 1, 2, SOBOL_PAIRS.min(SOBOL_SINGLES) as usize - 1] {
+            for request in [0usize, 1, 2, SOBOL_PAIRS.min(2 * SOBOL_SINGLE_SETS) as usize - 1] {
                 let (mut cells, mut bins) = ([0u32; 256], [0u32; 256]);
                 for i in 0..256 {
                     let mut s = SobolSampler::new(stream, first + i);
