@@ -230,6 +230,14 @@ try {
       // The fold arrow at the title's left.
       await page.touchscreen.tap(title[0] + 14, (title[1] + title[3]) / 2);
       await until(page, () => window.hikari.widgetRect("save PNG").length === 4, 120);
+      // egui unfolds the panel over a few frames: its contents exist before
+      // it reaches its full height. Wait for that height (the test asserts
+      // it); a panel that never grows is still recorded and fails there.
+      const tall = () => {
+        const r = window.hikari.widgetRect("panel");
+        return r.length === 4 && r[3] - r[1] > 200;
+      };
+      await until(page, tall, 30).catch(() => {});
       result.opened = await page.evaluate(() => window.hikari.widgetRect("panel"));
       result.error = await page.evaluate(() => window.hikari.lastError());
     } else {
