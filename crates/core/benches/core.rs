@@ -4,6 +4,7 @@
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec2;
 use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, k_nearest_radiance, volume_radiance_along};
+use hikari_core::geometry::{Ray, packet::LANES};
 use hikari_core::photon::{PhotonMap, TraceSettings, VolumePhotonMap, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
@@ -20,7 +21,7 @@ fn ray_casting(c: &mut Criterion) {
             let ray = scene.camera.ray(Vec2::new(rng.next_f32() * 512.0, rng.next_f32() * 512.0));
             let hit = scene.accel.intersect(&ray)?;
             let n = if ray.dir.dot(hit.geometric_normal) < 0.0 { hit.geometric_normal } else { -hit.geometric_normal };
-            Some(hikari_core::geometry::Ray::new(hit.point, local_to_world(cosine_hemisphere(rng.next_2d()), n)))
+            Some(Ray::new(hit.point, local_to_world(cosine_hemisphere(rng.next_2d()), n)))
         })
         .collect();
     let mut group = c.benchmark_group("ray_casting");
@@ -31,6 +32,23 @@ fn ray_casting(c: &mut Criterion) {
     group.bench_function("occlusion_cornell_box", |b| {
         b.iter(|| rays.iter().filter(|r| scene.accel.occluded(r)).count())
     });
+    // The same rays eight at a time (`geometry::packet`; ray by ray where
+    // the CPU has no AVX2).
+    let packets: Vec<[Option<Ray>; LANES]> =
+        rays.chunks(LANES).map(|c| std::array::from_fn(|l| c.get(l).copied())).collect();
+    group.bench_function("closest_hit_cornell_box_packets", |b| {
+        b.iter(|| {
+            packets
+                .iter()
+                .map(|p| {
+                    let mut h = [None; LANES];
+                    scene.accel.intersect_packet(p, &mut h);
+                    h.iter().flatten().count()
+                })
+                .sum::<usize>()
+        })
+    });
+
     group.finish();
 }
 

@@ -4,6 +4,7 @@
 mod accel;
 mod bvh_build;
 mod flat_bvh;
+pub mod packet;
 mod shapes;
 
 pub use accel::{Accel, Hit};

@@ -54,17 +54,30 @@ pub(crate) fn render_rows(
     progress: &dyn Progress,
     pixel: impl Fn(u32, u32) -> (Rgb, u64) + Sync,
 ) -> (Image, u64) {
+    render_row_batches(camera, progress, |y, row| {
+        let mut bad = 0;
+        for (x, out) in row.iter_mut().enumerate() {
+            let (value, dropped) = pixel(x as u32, y);
+            *out = value;
+            bad += dropped;
+        }
+        bad
+    })
+}
+
+/// [`render_rows`] for renderers that fill a whole row at once: `row(y,
+/// pixels)` writes row y and returns the non-finite samples it dropped.
+pub(crate) fn render_row_batches(
+    camera: &Camera,
+    progress: &dyn Progress,
+    row: impl Fn(u32, &mut [Rgb]) -> u64 + Sync,
+) -> (Image, u64) {
     let (w, h) = (camera.width as usize, camera.height as usize);
     let nonfinite = AtomicU64::new(0);
     let mut pixels = vec![Rgb::ZERO; w * h];
     progress.begin("rendering", h as u64);
-    pixels.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-        let mut bad = 0;
-        for (x, out) in row.iter_mut().enumerate() {
-            let (value, dropped) = pixel(x as u32, y as u32);
-            *out = value;
-            bad += dropped;
-        }
+    pixels.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+        let bad = row(y as u32, out);
         if bad > 0 {
             nonfinite.fetch_add(bad, Ordering::Relaxed);
         }

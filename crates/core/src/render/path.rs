@@ -13,9 +13,10 @@
 //! falloff: at free-flight points, in thin fog, most samples land far from
 //! the light and the rare ones close to it are fireflies.
 
-use super::{Image, finite_mean, render_rows};
+use super::{Image, finite_mean, render_row_batches};
 use crate::bsdf::ShadingFrame;
 use crate::geometry::Ray;
+use crate::geometry::packet::LANES;
 use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
 use crate::medium::{Flight, Phase};
 use crate::progress::Progress;
@@ -53,134 +54,216 @@ enum Previous {
     Diffuse { point: Vec3, pdf: f32 },
 }
 
-pub fn radiance(scene: &Scene, mut ray: Ray, settings: &PathSettings, sampler: &mut impl Sampler) -> Rgb {
-    let mut l = Rgb::ZERO;
-    let mut beta = Rgb::ONE;
-    let mut previous = Previous::Specular;
-    for bounce in 0..settings.max_depth {
-        let hit = scene.accel.intersect(&ray);
-        let media = &scene.media;
-        if !media.is_empty() {
-            // A ray leaving the scene ends where a shadow ray toward the sky
-            // would, so sky sampling and phase sampling see the same fog.
-            let t_max = hit.map_or_else(|| scene.escape_distance(ray.origin, ray.dir), |h| h.t);
-            l += beta * in_scattered_from_delta_lights(scene, &ray, t_max, sampler);
-            match media.sample_flight(ray.origin, ray.dir, t_max, sampler.next_f32()) {
-                Flight::Passed { weight, .. } => beta *= weight,
-                Flight::Interaction { distance, weight, mask, .. } => {
-                    let (lambda, albedo) = media.scattering(mask);
-                    if sampler.next_f32() >= lambda {
-                        break; // absorbed
-                    }
-                    beta *= weight * albedo;
-                    let x = ray.at(distance);
-                    // One medium scatters, chosen ∝ σ_s: its phase function
-                    // serves both light sampling and the next direction.
-                    let phase = media.choose_scatterer(mask, sampler.next_f32()).medium.phase;
-                    l += beta * medium_next_event(scene, &phase, x, ray.dir, sampler);
-                    // Light reaching x along −wi continues along ray.dir
-                    // backwards: μ = wi · ray.dir, sampled from the phase function.
-                    let wi = phase.sample(ray.dir, sampler.next_2d());
-                    previous = Previous::Diffuse { point: x, pdf: phase.eval(wi.dot(ray.dir)) };
-                    ray = Ray::new(x, wi);
-                    continue;
-                }
-            }
-        }
-        let Some(hit) = hit else {
-            l += beta * sky(scene, &ray, previous);
-            break;
-        };
-        let material = scene.material_at(&hit);
-        // Emitted light, MIS-weighted against the light sampling of the last
-        // vertex. An emissive mesh's surface then reflects like any other.
-        if let Some(light) = scene.emitter(&hit) {
-            let le = scene.emitted_radiance(&hit, ray.dir).unwrap_or_default();
-            let weight = match previous {
-                Previous::Specular => 1.0,
-                Previous::Diffuse { point, pdf } => {
-                    power_heuristic(pdf, light.incident_pdf(point, hit.point, hit.geometric_normal))
-                }
-            };
-            l += beta * le * weight;
-            if matches!(material, Material::Emitter) {
-                break;
-            }
-        }
-        let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
-        // Normal textures bend the shading normal here (only the path tracer reads them).
-        let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(&hit) * facing);
-        let next_dir = match material {
-            Material::Emitter => break,
-            Material::Glass { ior } => {
-                let split = dielectric_split(ray.dir, hit.geometric_normal, ior);
-                previous = Previous::Specular;
-                match split.refracted {
-                    Some(t) if sampler.next_f32() >= split.reflectance => t,
-                    _ => split.reflected,
-                }
-            }
-            Material::Pbr(bsdf) => {
-                let frame = ShadingFrame::new(ns);
-                let wo = frame.to_local(-ray.dir);
-                // Light sampling finds nothing through a mirror alone.
-                if bsdf.has_diffuse() || !bsdf.is_delta() {
-                    let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
-                    let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
-                    l += beta * next_event(scene, hit.point, ns, brdf, pdf, sampler);
-                }
-                let Some(s) = bsdf.sample(wo, sampler.next_f32(), sampler.next_2d()) else { break };
-                beta *= s.weight;
-                previous =
-                    if s.is_delta { Previous::Specular } else { Previous::Diffuse { point: hit.point, pdf: s.pdf } };
-                frame.to_world(s.wi)
-            }
-            Material::Diffuse { .. } | Material::Mirror { .. } => {
-                let (albedo, specular) = (material.diffuse_albedo(), material.mirror_reflectance());
-                let (p_d, p_s) = (mean(albedo), mean(specular));
-                if p_d + p_s <= 0.0 {
-                    break; // black
-                }
-                // Diffuse or mirror, chosen ∝ their reflectances but never
-                // absorbed here (the photon tracer's roulette at the albedo
-                // ends 30–75% of paths at their first bounce); the
-                // throughput's roulette below ends paths instead.
-                let p_diffuse = p_d / (p_d + p_s);
-                if p_d > 0.0 {
-                    let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
-                    l += beta * next_event(scene, hit.point, ns, |_| albedo / PI, pdf, sampler);
-                }
-                if p_s == 0.0 || sampler.next_f32() < p_diffuse {
-                    beta *= albedo / p_diffuse;
-                    let dir = local_to_world(cosine_hemisphere(sampler.next_2d()), ns);
-                    previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
-                    dir
-                } else {
-                    beta *= specular / (1.0 - p_diffuse);
-                    previous = Previous::Specular;
-                    reflect(ray.dir, ns)
-                }
-            }
-        };
-        // Russian roulette on the throughput from the fifth vertex on
-        // (Mitsuba's `rr_depth = 5`): a path survives with probability
-        // max(β), at most 0.95, and carries 1/that if it does. Starting at
-        // the third (pbrt's rule) made paths 1.25× cheaper but 1.32× as
-        // noisy in variance on the Cornell box: 7% less efficient.
-        if bounce >= 4 {
-            let survive = beta.max_element().min(0.95);
-            if sampler.next_f32() >= survive {
-                break;
-            }
-            beta /= survive;
-        }
-        let transmits = matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
-        if next_dir.dot(ng) <= 0.0 && !transmits {
-            break;
-        }
-        ray = Ray::new(hit.point, next_dir);
+/// A path between two vertices: the light it has gathered, its
+/// throughput, how its last vertex chose the ray it now follows, and which
+/// vertex comes next.
+struct PathState {
+    ray: Ray,
+    l: Rgb,
+    beta: Rgb,
+    previous: Previous,
+    bounce: u32,
+}
+
+impl PathState {
+    fn new(ray: Ray) -> Self {
+        PathState { ray, l: Rgb::ZERO, beta: Rgb::ONE, previous: Previous::Specular, bounce: 0 }
     }
-    l
+
+    /// Moves on to the next vertex: false where the path is cut.
+    fn next_vertex(&mut self, settings: &PathSettings) -> bool {
+        self.bounce += 1;
+        self.bounce < settings.max_depth
+    }
+}
+
+/// The radiance arriving along `ray`: one path.
+pub fn radiance(scene: &Scene, ray: Ray, settings: &PathSettings, sampler: &mut impl Sampler) -> Rgb {
+    let mut path = PathState::new(ray);
+    if settings.max_depth > 0 {
+        loop {
+            let hit = scene.accel.intersect(&path.ray);
+            if !advance(scene, settings, &mut path, hit, sampler) {
+                break;
+            }
+        }
+    }
+    path.l
+}
+
+/// Continues `st` at `hit`, the closest hit of its ray (None where it
+/// leaves the scene): adds the light found on the way and there, and sets
+/// the next ray. False where the path ends. Paths traced one at a time
+/// ([`radiance`]) and eight at a time ([`trace_in_packets`]) are this
+/// same step, so they give the same numbers.
+fn advance(
+    scene: &Scene,
+    settings: &PathSettings,
+    st: &mut PathState,
+    hit: Option<crate::geometry::Hit>,
+    sampler: &mut impl Sampler,
+) -> bool {
+    let media = &scene.media;
+    if !media.is_empty() {
+        // A ray leaving the scene ends where a shadow ray toward the sky
+        // would, so sky sampling and phase sampling see the same fog.
+        let t_max = hit.map_or_else(|| scene.escape_distance(st.ray.origin, st.ray.dir), |h| h.t);
+        st.l += st.beta * in_scattered_from_delta_lights(scene, &st.ray, t_max, sampler);
+        match media.sample_flight(st.ray.origin, st.ray.dir, t_max, sampler.next_f32()) {
+            Flight::Passed { weight, .. } => st.beta *= weight,
+            Flight::Interaction { distance, weight, mask, .. } => {
+                let (lambda, albedo) = media.scattering(mask);
+                if sampler.next_f32() >= lambda {
+                    return false; // absorbed
+                }
+                st.beta *= weight * albedo;
+                let x = st.ray.at(distance);
+                // One medium scatters, chosen ∝ σ_s: its phase function
+                // serves both light sampling and the next direction.
+                let phase = media.choose_scatterer(mask, sampler.next_f32()).medium.phase;
+                st.l += st.beta * medium_next_event(scene, &phase, x, st.ray.dir, sampler);
+                // Light reaching x along −wi continues along ray.dir
+                // backwards: μ = wi · ray.dir, sampled from the phase function.
+                let wi = phase.sample(st.ray.dir, sampler.next_2d());
+                st.previous = Previous::Diffuse { point: x, pdf: phase.eval(wi.dot(st.ray.dir)) };
+                st.ray = Ray::new(x, wi);
+                return st.next_vertex(settings);
+            }
+        }
+    }
+    let Some(hit) = hit else {
+        st.l += st.beta * sky(scene, &st.ray, st.previous);
+        return false;
+    };
+    let material = scene.material_at(&hit);
+    // Emitted light, MIS-weighted against the light sampling of the last
+    // vertex. An emissive mesh's surface then reflects like any other.
+    if let Some(light) = scene.emitter(&hit) {
+        let le = scene.emitted_radiance(&hit, st.ray.dir).unwrap_or_default();
+        let weight = match st.previous {
+            Previous::Specular => 1.0,
+            Previous::Diffuse { point, pdf } => {
+                power_heuristic(pdf, light.incident_pdf(point, hit.point, hit.geometric_normal))
+            }
+        };
+        st.l += st.beta * le * weight;
+        if matches!(material, Material::Emitter) {
+            return false;
+        }
+    }
+    let facing = if st.ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+    // Normal textures bend the shading normal here (only the path tracer reads them).
+    let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(&hit) * facing);
+    let next_dir = match material {
+        Material::Emitter => return false,
+        Material::Glass { ior } => {
+            let split = dielectric_split(st.ray.dir, hit.geometric_normal, ior);
+            st.previous = Previous::Specular;
+            match split.refracted {
+                Some(t) if sampler.next_f32() >= split.reflectance => t,
+                _ => split.reflected,
+            }
+        }
+        Material::Pbr(bsdf) => {
+            let frame = ShadingFrame::new(ns);
+            let wo = frame.to_local(-st.ray.dir);
+            // Light sampling finds nothing through a mirror alone.
+            if bsdf.has_diffuse() || !bsdf.is_delta() {
+                let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
+                let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
+                st.l += st.beta * next_event(scene, hit.point, ns, brdf, pdf, sampler);
+            }
+            let Some(s) = bsdf.sample(wo, sampler.next_f32(), sampler.next_2d()) else { return false };
+            st.beta *= s.weight;
+            st.previous =
+                if s.is_delta { Previous::Specular } else { Previous::Diffuse { point: hit.point, pdf: s.pdf } };
+            frame.to_world(s.wi)
+        }
+        Material::Diffuse { .. } | Material::Mirror { .. } => {
+            let (albedo, specular) = (material.diffuse_albedo(), material.mirror_reflectance());
+            let (p_d, p_s) = (mean(albedo), mean(specular));
+            if p_d + p_s <= 0.0 {
+                return false; // black
+            }
+            // Diffuse or mirror, chosen ∝ their reflectances but never
+            // absorbed here (the photon tracer's roulette at the albedo
+            // ends 30–75% of paths at their first bounce); the
+            // throughput's roulette below ends paths instead.
+            let p_diffuse = p_d / (p_d + p_s);
+            if p_d > 0.0 {
+                let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
+                st.l += st.beta * next_event(scene, hit.point, ns, |_| albedo / PI, pdf, sampler);
+            }
+            if p_s == 0.0 || sampler.next_f32() < p_diffuse {
+                st.beta *= albedo / p_diffuse;
+                let dir = local_to_world(cosine_hemisphere(sampler.next_2d()), ns);
+                st.previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
+                dir
+            } else {
+                st.beta *= specular / (1.0 - p_diffuse);
+                st.previous = Previous::Specular;
+                reflect(st.ray.dir, ns)
+            }
+        }
+    };
+    // Russian roulette on the throughput from the fifth vertex on
+    // (Mitsuba's `rr_depth = 5`): a path survives with probability
+    // max(β), at most 0.95, and carries 1/that if it does. Starting at
+    // the third (pbrt's rule) made paths 1.25× cheaper but 1.32× as
+    // noisy in variance on the Cornell box: 7% less efficient.
+    if st.bounce >= 4 {
+        let survive = st.beta.max_element().min(0.95);
+        if sampler.next_f32() >= survive {
+            return false;
+        }
+        st.beta /= survive;
+    }
+    let transmits = matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
+    if next_dir.dot(ng) <= 0.0 && !transmits {
+        return false;
+    }
+    st.ray = Ray::new(hit.point, next_dir);
+    st.next_vertex(settings)
+}
+
+/// Runs paths `0..out.len()` eight at a time, their closest hits found in
+/// packets (`Accel::intersect_packet`; shadow rays stay single: in packets
+/// they saved little). `start(k)` makes path k's camera ray and sampler;
+/// `out[k]` receives its radiance. A lane whose path ends takes the next.
+fn trace_in_packets<S: Sampler>(
+    scene: &Scene,
+    settings: &PathSettings,
+    out: &mut [Rgb],
+    start: impl Fn(usize) -> (Ray, S),
+) {
+    if settings.max_depth == 0 {
+        out.fill(Rgb::ZERO);
+        return;
+    }
+    let mut lanes: [Option<(usize, PathState, S)>; LANES] = std::array::from_fn(|_| None);
+    let (mut rays, mut hits) = ([None; LANES], [None; LANES]);
+    let mut next = 0;
+    loop {
+        for (lane, ray) in lanes.iter_mut().zip(&mut rays) {
+            if lane.is_none() && next < out.len() {
+                let (camera_ray, sampler) = start(next);
+                *lane = Some((next, PathState::new(camera_ray), sampler));
+                next += 1;
+            }
+            *ray = lane.as_ref().map(|(_, path, _)| path.ray);
+        }
+        if lanes.iter().all(Option::is_none) {
+            return;
+        }
+        scene.accel.intersect_packet(&rays, &mut hits);
+        for (lane, hit) in lanes.iter_mut().zip(hits) {
+            let Some((k, path, sampler)) = lane else { continue };
+            if !advance(scene, settings, path, hit, sampler) {
+                out[*k] = path.l;
+                *lane = None;
+            }
+        }
+    }
 }
 
 /// The sky seen by a ray that leaves the scene, each environment
@@ -326,13 +409,26 @@ pub fn render(scene: &Scene, settings: &PathSettings, progress: &dyn Progress) -
     let passes_before = u64::from(settings.pass.max(1) - 1);
     let (half, first) = (passes_before % 2, passes_before / 2 * u64::from(spp));
     let streams = crate::sampling::Rng::seed_constants(settings.seed ^ 0x005e_ed0f_9a7e).0;
-    render_rows(camera, progress, |x, y| {
-        let stream = streams.wrapping_add((u64::from(y) * u64::from(camera.width) + u64::from(x)) * 2 + half);
-        finite_mean(spp, |s| {
-            let mut sampler = SobolSampler::new(stream, first + u64::from(s));
+    // A row's paths (pixel by pixel, each pixel's samples in order) run
+    // eight at a time; each pixel is then the mean of its samples in order,
+    // the same numbers as one path after another.
+    render_row_batches(camera, progress, |y, row| {
+        let n = spp as usize;
+        let mut samples = vec![Rgb::ZERO; row.len() * n];
+        trace_in_packets(scene, settings, &mut samples, |k| {
+            let x = (k / n) as u32;
+            let stream = streams.wrapping_add((u64::from(y) * u64::from(camera.width) + u64::from(x)) * 2 + half);
+            let mut sampler = SobolSampler::new(stream, first + (k % n) as u64);
             let offset = sampler.next_2d();
-            radiance(scene, camera.ray(glam::Vec2::new(x as f32, y as f32) + offset), settings, &mut sampler)
-        })
+            (camera.ray(glam::Vec2::new(x as f32, y as f32) + offset), sampler)
+        });
+        let mut dropped = 0;
+        for (x, pixel) in row.iter_mut().enumerate() {
+            let (value, bad) = finite_mean(spp, |s| samples[x * n + s as usize]);
+            *pixel = value;
+            dropped += bad;
+        }
+        dropped
     })
 }
 
@@ -374,6 +470,41 @@ pub(crate) mod tests {
             assert!((estimate.x / integral.x - 1.0).abs() < 0.01, "pixel {pixel:?}: {estimate} vs {integral}");
         }
         assert!(checked >= 3, "only {checked} rays cross the lit cone");
+    }
+
+    /// Paths traced eight at a time with packets of closest-hit rays give
+    /// each pixel the numbers that paths traced one at a time give it.
+    #[test]
+    fn paths_in_packets_match_paths_one_at_a_time() {
+        for name in ["cornell-box", "cornell-caustic", "fog-stage"] {
+            let mut scene = Scene::load(name).unwrap();
+            scene.camera = scene.camera.with_resolution(16, 12).unwrap();
+            let settings = PathSettings { spp: 3, seed: 5, pass: 4, ..Default::default() };
+            let (image, _) = render(&scene, &settings, &crate::progress::Silent);
+            // What `render` did before packets: pass 4 is the odd-numbered
+            // stream's second set of 3 samples.
+            let streams = crate::sampling::Rng::seed_constants(settings.seed ^ 0x005e_ed0f_9a7e).0;
+            let mut differ = 0;
+            for (i, pixel) in image.pixels.iter().enumerate() {
+                let (x, y) = ((i % 16) as u32, (i / 16) as u32);
+                let stream = streams.wrapping_add(u64::from(y * 16 + x) * 2 + 1);
+                let (alone, _) = finite_mean(3, |s| {
+                    let mut sampler = SobolSampler::new(stream, 3 + u64::from(s));
+                    let offset = sampler.next_2d();
+                    radiance(
+                        &scene,
+                        scene.camera.ray(glam::Vec2::new(x as f32, y as f32) + offset),
+                        &settings,
+                        &mut sampler,
+                    )
+                });
+                if alone != *pixel {
+                    differ += 1;
+                    eprintln!("{name} ({x}, {y}): {alone} alone, {pixel} in packets");
+                }
+            }
+            assert_eq!(differ, 0, "{name}");
+        }
     }
 
     fn settings(spp: u32, seed: u64) -> PathSettings {

@@ -134,6 +134,16 @@ fn a_cutout_lets_light_through_where_alpha_is_below_the_cutoff() {
         // Shadow rays alone: from the floor up to the sun.
         let up = Ray::new(Vec3::new(x, 0.0, z), Vec3::Y);
         assert_eq!(scene.accel.occluded(&up), !open, "({u}, {v})");
+        // And in packets (the path tracer's closest hits), lane by lane.
+        let lanes = [Some(up), None, Some(look(x, z)), Some(up), None, None, None, Some(up)];
+        let mut hits = [None; 8];
+        scene.accel.intersect_packet(&lanes, &mut hits);
+        let found = hits.map(|h| h.is_some());
+        assert_eq!(found, [!open, false, true, !open, false, false, false, !open], "({u}, {v})");
+        assert_eq!(
+            hits[2].map(|h| h.point.y.to_bits()),
+            scene.accel.intersect(&look(x, z)).map(|h| h.point.y.to_bits())
+        );
     }
     // Over a grid of the quad the lit fraction is exactly ½ (bilinear alpha
     // below ½ on half of it, by the checker's symmetry).
