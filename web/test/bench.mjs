@@ -4,6 +4,7 @@
 // prints the time to the first frame and the page's mean fps. With
 // HIKARI_PASSES=1 the panel shows, and the last timed frame's passes are
 // printed too (a timed frame waits for each pass: fps reads lower).
+// HIKARI_TRACE=gpu|cpu|auto sets the page's trace= option.
 import { chromium } from "playwright-core";
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
@@ -35,13 +36,19 @@ const browser = await chromium.launch({
 const page = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
 const started = Date.now();
 const panel = process.env.HIKARI_PASSES === "1" ? 1 : 0;
-await page.goto(`http://127.0.0.1:${server.address().port}/?scene=${scene}&photons=${photons}&panel=${panel}`);
+const trace = process.env.HIKARI_TRACE ? `&trace=${process.env.HIKARI_TRACE}` : "";
+await page.goto(`http://127.0.0.1:${server.address().port}/?scene=${scene}&photons=${photons}&panel=${panel}${trace}`);
 await page.waitForFunction(() => window.hikari && window.hikari.framesInMean() > 0, null, { timeout: 120000, polling: 20 });
 const firstFrame = Date.now() - started;
+const framesBefore = await page.evaluate(() => window.hikari.framesInMean());
 await page.waitForTimeout(Number(seconds) * 1000);
-const [fps, adapter, error] = await page.evaluate(() => [window.hikari.fps(), window.hikari.adapter(), window.hikari.lastError()]);
+const [fps, adapter, error, framesAfter] = await page.evaluate(() =>
+  [window.hikari.fps(), window.hikari.adapter(), window.hikari.lastError(), window.hikari.framesInMean()]);
+// Frames added to the mean over the window: each renders a new photon set.
+const added = (framesAfter - framesBefore) / Number(seconds);
 console.log(`${scene} ${size}, ${photons} photons a set: first frame ${firstFrame} ms after navigation, ` +
-  `${fps.toFixed(2)} fps over ${seconds} s on ${adapter}${error ? "; error: " + error : ""}`);
+  `${added.toFixed(3)} frames/s added to the mean (panel: ${fps.toFixed(2)} fps) over ${seconds} s ` +
+  `on ${adapter}${error ? "; error: " + error : ""}`);
 if (panel) {
   const timed = JSON.parse(await page.evaluate(() => window.hikari.passTimes()));
   console.log(`passes (${timed.timed}): ` + timed.passes.map((p) => `${p.pass} ${p.ms.toFixed(1)} ms`).join(", "));

@@ -103,10 +103,12 @@ try {
     browser = await chromium.launch({ executablePath: chromiumPath, args: [...quietFlags, ...webgpuFlags] });
     if (scenario === "converge") {
       // The default scene, 3000 photons a set, 30 frames: the mean and
-      // how long the first frame took.
+      // how long the first frame took (HIKARI_SCENE, HIKARI_FRAMES and
+      // HIKARI_TRACE change them).
       const frames = Number(process.env.HIKARI_FRAMES || 30);
       const scene = process.env.HIKARI_SCENE ? `&scene=${process.env.HIKARI_SCENE}` : "";
-      const { page, started } = await open(browser, `?photons=3000&frames=${frames}&panel=0${scene}`, { log });
+      const trace = process.env.HIKARI_TRACE ? `&trace=${process.env.HIKARI_TRACE}` : "";
+      const { page, started } = await open(browser, `?photons=3000&frames=${frames}&panel=0${scene}${trace}`, { log });
       await until(page, hikariReady, 120);
       result.firstFrameMs = Date.now() - started;
       result.adapter = await page.evaluate(() => window.hikari.adapter());

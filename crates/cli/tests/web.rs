@@ -80,12 +80,13 @@ fn exr(path: &Path) -> Vec<[f32; 3]> {
 /// The page opens on the default scene by itself, names its adapter, and
 /// after 30 frames its mean is `hikari render --passes 30` of the same
 /// scene, photons and seeds on the same driver (SwiftShader, natively
-/// through Vulkan; the photons traced by the same compute shader).
-/// No errors reach the console meanwhile.
+/// through Vulkan; the photons traced by the same compute shader, which
+/// `trace=gpu` asks for on this software adapter). No errors reach the
+/// console meanwhile.
 #[test]
 fn the_page_converges_to_the_native_render() {
     let frames = std::env::var("HIKARI_FRAMES").unwrap_or("30".into());
-    page_against_native_render("web-converge", None, &frames);
+    page_against_native_render("web-converge", None, &frames, "gpu");
 }
 
 /// Glass on the page: the mirror/glass pass and the caustic map run in the
@@ -93,23 +94,37 @@ fn the_page_converges_to_the_native_render() {
 /// buffers) and give the native render's frames.
 #[test]
 fn glass_and_caustics_render_on_the_page_as_natively() {
-    page_against_native_render("web-glass", Some("cornell-caustic"), "4");
+    page_against_native_render("web-glass", Some("cornell-caustic"), "4", "gpu");
+}
+
+/// On a software adapter the page traces its photons on its own thread,
+/// as `hikari render --trace auto` does natively (the emulated GPU is the
+/// slower tracer there), and its frames are the native CPU tracer's: the
+/// tracer gives the same photons on one thread as on many.
+#[test]
+fn on_a_software_adapter_the_page_traces_on_the_cpu() {
+    page_against_native_render("web-cpu-trace", None, "4", "cpu");
 }
 
 /// The page's mean after `frames` frames of `scene` (None: the default)
-/// against `hikari render` of the same on the same driver.
-fn page_against_native_render(name: &str, scene: Option<&str>, frames: &str) {
+/// against `hikari render --trace TRACE` of the same on the same driver;
+/// the page is asked for the GPU tracer with trace=gpu and left to choose
+/// for "cpu" (SwiftShader is a software adapter).
+fn page_against_native_render(name: &str, scene: Option<&str>, frames: &str, trace: &str) {
     let dir = scratch_dir(name);
     let mut env = vec![("HIKARI_FRAMES", Path::new(frames))];
     if let Some(scene) = scene {
         env.push(("HIKARI_SCENE", Path::new(scene)));
+    }
+    if trace == "gpu" {
+        env.push(("HIKARI_TRACE", Path::new("gpu")));
     }
     let Some(result) = drive("converge", &dir, &env) else { return };
     eprintln!("adapter: {}; first frame after {} ms", result["adapter"], result["firstFrameMs"]);
     assert!(result["adapter"].as_str().unwrap().contains("BrowserWebGpu"), "{}", result["adapter"]);
     assert_eq!(result["frames"].to_string(), frames);
     assert_eq!(result["error"], "");
-    assert_eq!(result["tracer"], "GPU", "the page traced its photons on the CPU");
+    assert_eq!(result["tracer"], trace.to_uppercase(), "where the page traced its photons");
     assert_eq!(result["status"], "", "the status line stays after the frames were drawn");
     let (width, height, web) = read_mean(&dir.join(format!("web-{frames}.f32")));
     assert_eq!((width, height), (48, 36));
@@ -119,7 +134,7 @@ fn page_against_native_render(name: &str, scene: Option<&str>, frames: &str) {
     let out = Command::new(env!("CARGO_BIN_EXE_hikari"))
         .args(["render", "-q", scene.unwrap_or("cornell-box"), "--renderer", "gpu"])
         .args(["--resolution", "48x36", "--photons", "3000"])
-        .args(["--passes", frames, "--trace", "gpu", "-o", "native.exr"])
+        .args(["--passes", frames, "--trace", trace, "-o", "native.exr"])
         .env("VK_ICD_FILENAMES", SWIFTSHADER_ICD)
         .env_remove("WGPU_BACKEND")
         .current_dir(&dir)

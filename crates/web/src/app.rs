@@ -188,7 +188,7 @@ impl Viewer {
         self.requested = None;
         self.clock = AnimationClock::new(0.0, None);
         if let Some(gpu) = &self.gpu {
-            self.tracing = Some(Tracing::new(gpu.ctx.clone(), self.base.clone()));
+            self.tracing = Some(Tracing::new(gpu.ctx.clone(), self.base.clone(), self.options.trace));
         }
         self.rebuild = true;
     }
@@ -259,7 +259,7 @@ impl Viewer {
         self.readouts.time = self.base.is_animated().then(|| self.clock.time());
         let Some(gpu) = &mut self.gpu else { return Ok(None) };
         if self.tracing.is_none() {
-            self.tracing = Some(Tracing::new(gpu.ctx.clone(), self.base.clone()));
+            self.tracing = Some(Tracing::new(gpu.ctx.clone(), self.base.clone(), self.options.trace));
         }
         if self.input.fly(&mut self.orbit) {
             // Applied below, as any camera move.

@@ -24,6 +24,19 @@ pub struct PageOptions {
     pub frames: Option<u32>,
     pub panel: bool,
     pub exposure: f32,
+    /// Where photon sets are traced (`trace=`).
+    pub trace: TraceChoice,
+}
+
+/// Where the page traces photons, as `hikari view --trace`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TraceChoice {
+    /// The compute shader on a hardware adapter, the page's thread on a
+    /// software one (SwiftShader), where the "GPU" is the CPU emulating one.
+    #[default]
+    Auto,
+    Gpu,
+    Cpu,
 }
 
 impl Default for PageOptions {
@@ -35,6 +48,7 @@ impl Default for PageOptions {
             frames: None,
             panel: true,
             exposure: 0.0,
+            trace: TraceChoice::Auto,
         }
     }
 }
@@ -81,9 +95,17 @@ impl PageOptions {
                         .filter(|e| e.abs() <= 64.0)
                         .ok_or_else(|| bad("must be a number of stops from -64 to 64"))?
                 }
+                "trace" => {
+                    options.trace = match value.as_str() {
+                        "auto" => TraceChoice::Auto,
+                        "gpu" => TraceChoice::Gpu,
+                        "cpu" => TraceChoice::Cpu,
+                        _ => return Err(bad("must be auto, gpu or cpu")),
+                    }
+                }
                 _ => {
                     return Err(format!(
-                        "page address: unknown option `{key}` (scene, photons, seed, frames, panel, exposure)"
+                        "page address: unknown option `{key}` (scene, photons, seed, frames, panel, exposure, trace)"
                     ));
                 }
             }
@@ -128,7 +150,8 @@ mod tests {
 
     #[test]
     fn every_option_is_read() {
-        let o = PageOptions::parse("?scene=fog-stage&photons=3000&seed=7&frames=30&panel=0&exposure=-1.5").unwrap();
+        let o = PageOptions::parse("?scene=fog-stage&photons=3000&seed=7&frames=30&panel=0&exposure=-1.5&trace=cpu")
+            .unwrap();
         assert_eq!(
             o,
             PageOptions {
@@ -137,7 +160,8 @@ mod tests {
                 seed: 7,
                 frames: Some(30),
                 panel: false,
-                exposure: -1.5
+                exposure: -1.5,
+                trace: TraceChoice::Cpu,
             }
         );
     }
@@ -151,6 +175,7 @@ mod tests {
             ("frames=0", "frames=0: must be a whole number above 0"),
             ("panel=maybe", "panel=maybe: must be 0 or 1"),
             ("exposure=99", "exposure=99: must be a number of stops"),
+            ("trace=fpga", "trace=fpga: must be auto, gpu or cpu"),
             ("colour=red", "unknown option `colour`"),
         ] {
             let error = PageOptions::parse(query).unwrap_err();

@@ -10,6 +10,7 @@
 //! at most `CPU_PHOTONS` paths so that a frame stalls only briefly; the
 //! panel says so.
 
+use crate::options::TraceChoice;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::scene::{Pose, Scene};
@@ -44,11 +45,23 @@ pub struct Tracing {
 }
 
 impl Tracing {
-    /// A tracer for poses of `base`, on the GPU where it can run.
-    pub fn new(ctx: GpuContext, base: Arc<Scene>) -> Self {
-        let (tracer, gpu_failed) = match GpuTracer::new(&ctx, &base) {
-            Ok(tracer) => (Some((tracer, base.rest_pose(), base.clone())), None),
-            Err(e) => (None, Some(format!("the GPU tracer cannot run here ({e})"))),
+    /// A tracer for poses of `base`: on the GPU where `choice` and the
+    /// adapter allow it.
+    pub fn new(ctx: GpuContext, base: Arc<Scene>, choice: TraceChoice) -> Self {
+        let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
+        let on_cpu = match choice {
+            TraceChoice::Cpu => Some("trace=cpu in the page address".to_string()),
+            TraceChoice::Auto if software => {
+                Some("a software adapter, where the CPU traces faster than the emulated GPU".to_string())
+            }
+            _ => None,
+        };
+        let (tracer, gpu_failed) = match on_cpu {
+            Some(why) => (None, Some(why)),
+            None => match GpuTracer::new(&ctx, &base) {
+                Ok(tracer) => (Some((tracer, base.rest_pose(), base.clone())), None),
+                Err(e) => (None, Some(format!("the GPU tracer cannot run here ({e})"))),
+            },
         };
         Tracing { ctx, base, tracer, gpu_failed, in_flight: false, finished: Rc::default(), next_id: 0, received: 0 }
     }
