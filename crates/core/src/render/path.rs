@@ -91,7 +91,7 @@ pub fn radiance(scene: &Scene, ray: Ray, settings: &PathSettings, sampler: &mut 
     path.l
 }
 
-/// Continues `st` at `hit`, the closest hit of its ray (None where it
+/// Continues `path` at `hit`, the closest hit of its ray (None where it
 /// leaves the scene): adds the light found on the way and there, and sets
 /// the next ray. False where the path ends. Paths traced one at a time
 /// ([`radiance`]) and eight at a time ([`trace_in_packets`]) are this
@@ -99,7 +99,7 @@ pub fn radiance(scene: &Scene, ray: Ray, settings: &PathSettings, sampler: &mut 
 fn advance(
     scene: &Scene,
     settings: &PathSettings,
-    st: &mut PathState,
+    path: &mut PathState,
     hit: Option<crate::geometry::Hit>,
     sampler: &mut impl Sampler,
 ) -> bool {
@@ -107,58 +107,58 @@ fn advance(
     if !media.is_empty() {
         // A ray leaving the scene ends where a shadow ray toward the sky
         // would, so sky sampling and phase sampling see the same fog.
-        let t_max = hit.map_or_else(|| scene.escape_distance(st.ray.origin, st.ray.dir), |h| h.t);
-        st.l += st.beta * in_scattered_from_delta_lights(scene, &st.ray, t_max, sampler);
-        match media.sample_flight(st.ray.origin, st.ray.dir, t_max, sampler.next_f32()) {
-            Flight::Passed { weight, .. } => st.beta *= weight,
+        let t_max = hit.map_or_else(|| scene.escape_distance(path.ray.origin, path.ray.dir), |h| h.t);
+        path.l += path.beta * in_scattered_from_delta_lights(scene, &path.ray, t_max, sampler);
+        match media.sample_flight(path.ray.origin, path.ray.dir, t_max, sampler.next_f32()) {
+            Flight::Passed { weight, .. } => path.beta *= weight,
             Flight::Interaction { distance, weight, mask, .. } => {
                 let (lambda, albedo) = media.scattering(mask);
                 if sampler.next_f32() >= lambda {
                     return false; // absorbed
                 }
-                st.beta *= weight * albedo;
-                let x = st.ray.at(distance);
+                path.beta *= weight * albedo;
+                let x = path.ray.at(distance);
                 // One medium scatters, chosen ∝ σ_s: its phase function
                 // serves both light sampling and the next direction.
                 let phase = media.choose_scatterer(mask, sampler.next_f32()).medium.phase;
-                st.l += st.beta * medium_next_event(scene, &phase, x, st.ray.dir, sampler);
+                path.l += path.beta * medium_next_event(scene, &phase, x, path.ray.dir, sampler);
                 // Light reaching x along −wi continues along ray.dir
                 // backwards: μ = wi · ray.dir, sampled from the phase function.
-                let wi = phase.sample(st.ray.dir, sampler.next_2d());
-                st.previous = Previous::Diffuse { point: x, pdf: phase.eval(wi.dot(st.ray.dir)) };
-                st.ray = Ray::new(x, wi);
-                return st.next_vertex(settings);
+                let wi = phase.sample(path.ray.dir, sampler.next_2d());
+                path.previous = Previous::Diffuse { point: x, pdf: phase.eval(wi.dot(path.ray.dir)) };
+                path.ray = Ray::new(x, wi);
+                return path.next_vertex(settings);
             }
         }
     }
     let Some(hit) = hit else {
-        st.l += st.beta * sky(scene, &st.ray, st.previous);
+        path.l += path.beta * sky(scene, &path.ray, path.previous);
         return false;
     };
     let material = scene.material_at(&hit);
     // Emitted light, MIS-weighted against the light sampling of the last
     // vertex. An emissive mesh's surface then reflects like any other.
     if let Some(light) = scene.emitter(&hit) {
-        let le = scene.emitted_radiance(&hit, st.ray.dir).unwrap_or_default();
-        let weight = match st.previous {
+        let le = scene.emitted_radiance(&hit, path.ray.dir).unwrap_or_default();
+        let weight = match path.previous {
             Previous::Specular => 1.0,
             Previous::Diffuse { point, pdf } => {
                 power_heuristic(pdf, light.incident_pdf(point, hit.point, hit.geometric_normal))
             }
         };
-        st.l += st.beta * le * weight;
+        path.l += path.beta * le * weight;
         if matches!(material, Material::Emitter) {
             return false;
         }
     }
-    let facing = if st.ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+    let facing = if path.ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
     // Normal textures bend the shading normal here (only the path tracer reads them).
     let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(&hit) * facing);
     let next_dir = match material {
         Material::Emitter => return false,
         Material::Glass { ior } => {
-            let split = dielectric_split(st.ray.dir, hit.geometric_normal, ior);
-            st.previous = Previous::Specular;
+            let split = dielectric_split(path.ray.dir, hit.geometric_normal, ior);
+            path.previous = Previous::Specular;
             match split.refracted {
                 Some(t) if sampler.next_f32() >= split.reflectance => t,
                 _ => split.reflected,
@@ -166,16 +166,16 @@ fn advance(
         }
         Material::Pbr(bsdf) => {
             let frame = ShadingFrame::new(ns);
-            let wo = frame.to_local(-st.ray.dir);
+            let wo = frame.to_local(-path.ray.dir);
             // Light sampling finds nothing through a mirror alone.
             if bsdf.has_diffuse() || !bsdf.is_delta() {
                 let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
                 let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
-                st.l += st.beta * next_event(scene, hit.point, ns, brdf, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ns, brdf, pdf, sampler);
             }
             let Some(s) = bsdf.sample(wo, sampler.next_f32(), sampler.next_2d()) else { return false };
-            st.beta *= s.weight;
-            st.previous =
+            path.beta *= s.weight;
+            path.previous =
                 if s.is_delta { Previous::Specular } else { Previous::Diffuse { point: hit.point, pdf: s.pdf } };
             frame.to_world(s.wi)
         }
@@ -192,17 +192,17 @@ fn advance(
             let p_diffuse = p_d / (p_d + p_s);
             if p_d > 0.0 {
                 let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
-                st.l += st.beta * next_event(scene, hit.point, ns, |_| albedo / PI, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ns, |_| albedo / PI, pdf, sampler);
             }
             if p_s == 0.0 || sampler.next_f32() < p_diffuse {
-                st.beta *= albedo / p_diffuse;
+                path.beta *= albedo / p_diffuse;
                 let dir = local_to_world(cosine_hemisphere(sampler.next_2d()), ns);
-                st.previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
+                path.previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
                 dir
             } else {
-                st.beta *= specular / (1.0 - p_diffuse);
-                st.previous = Previous::Specular;
-                reflect(st.ray.dir, ns)
+                path.beta *= specular / (1.0 - p_diffuse);
+                path.previous = Previous::Specular;
+                reflect(path.ray.dir, ns)
             }
         }
     };
@@ -211,19 +211,19 @@ fn advance(
     // max(β), at most 0.95, and carries 1/that if it does. Starting at
     // the third (pbrt's rule) made paths 1.25× cheaper but 1.32× as
     // noisy in variance on the Cornell box: 7% less efficient.
-    if st.bounce >= 4 {
-        let survive = st.beta.max_element().min(0.95);
+    if path.bounce >= 4 {
+        let survive = path.beta.max_element().min(0.95);
         if sampler.next_f32() >= survive {
             return false;
         }
-        st.beta /= survive;
+        path.beta /= survive;
     }
     let transmits = matches!(material, Material::Glass { .. }) && next_dir.dot(ng) < 0.0;
     if next_dir.dot(ng) <= 0.0 && !transmits {
         return false;
     }
-    st.ray = Ray::new(hit.point, next_dir);
-    st.next_vertex(settings)
+    path.ray = Ray::new(hit.point, next_dir);
+    path.next_vertex(settings)
 }
 
 /// Runs paths `0..out.len()` eight at a time, their closest hits found in
