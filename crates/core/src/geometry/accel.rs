@@ -90,6 +90,24 @@ impl PackedPrim {
     }
 }
 
+/// The bounds of every primitive, in the joint index space (triangles,
+/// then spheres): what both BVHs are built over.
+fn prim_bounds(triangles: &[Triangle], spheres: &[Sphere]) -> Vec<PrimBounds> {
+    let mut bounds: Vec<PrimBounds> = triangles
+        .iter()
+        .map(|t| {
+            let pts: Vec<Vec3A> = t.v.iter().map(|&v| v.into()).collect();
+            PrimBounds(Aabb::from_points(&pts))
+        })
+        .collect();
+    bounds.extend(spheres.iter().map(|s| {
+        let r = Vec3A::splat(s.radius);
+        let c: Vec3A = s.center.into();
+        PrimBounds(Aabb::new(c - r, c + r))
+    }));
+    bounds
+}
+
 impl Boundable for PrimBounds {
     fn aabb(&self) -> Aabb {
         self.0
@@ -129,18 +147,7 @@ impl Accel {
     ) -> Self {
         assert_eq!(triangles.len(), triangle_surfaces.len());
         assert_eq!(spheres.len(), sphere_surfaces.len());
-        let mut bounds: Vec<PrimBounds> = triangles
-            .iter()
-            .map(|t| {
-                let pts: Vec<Vec3A> = t.v.iter().map(|&v| v.into()).collect();
-                PrimBounds(Aabb::from_points(&pts))
-            })
-            .collect();
-        bounds.extend(spheres.iter().map(|s| {
-            let r = Vec3A::splat(s.radius);
-            let c: Vec3A = s.center.into();
-            PrimBounds(Aabb::new(c - r, c + r))
-        }));
+        let bounds = prim_bounds(&triangles, &spheres);
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         for b in &bounds {
             lo = lo.min(b.0.min.into());
@@ -328,19 +335,7 @@ impl Accel {
                 for p in &self.packed {
                     by_index[(p.prim & INDEX_BITS) as usize] = *p;
                 }
-                let bounds: Vec<Aabb> = by_index
-                    .iter()
-                    .map(|p| {
-                        if p.prim & SPHERE_BIT != 0 {
-                            let (c, r): (Vec3A, Vec3A) = (p.a.into(), Vec3A::splat(p.b.x));
-                            Aabb::new(c - r, c + r)
-                        } else {
-                            let v0: Vec3A = p.a.into();
-                            Aabb::from_points(&[v0, v0 + Vec3A::from(p.b), v0 + Vec3A::from(p.c)])
-                        }
-                    })
-                    .collect();
-                PacketBvh::build(&by_index, &bounds)
+                PacketBvh::build(&by_index, &prim_bounds(&self.triangles, &self.spheres))
             })
             .as_ref()
     }

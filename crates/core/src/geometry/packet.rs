@@ -27,7 +27,7 @@
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 
 use super::accel::{PackedPrim, PrimBounds};
-use obvhs::{BvhBuildParams, aabb::Aabb};
+use obvhs::BvhBuildParams;
 
 /// Rays per packet.
 pub const LANES: usize = 8;
@@ -61,12 +61,11 @@ impl PacketBvh {
     /// A BVH over `prims` (in the joint index space, with their bounds), or
     /// None where packets cannot run: no AVX2, no primitives, or a tree
     /// deeper than the traversal stack.
-    pub fn build(prims: &[PackedPrim], bounds: &[Aabb]) -> Option<PacketBvh> {
+    pub fn build(prims: &[PackedPrim], bounds: &[PrimBounds]) -> Option<PacketBvh> {
         if !avx2_available() || prims.is_empty() {
             return None;
         }
-        let bounds: Vec<PrimBounds> = bounds.iter().map(|&b| PrimBounds(b)).collect();
-        let bvh = super::bvh_build::build_bvh2(&bounds, BvhBuildParams::medium_build());
+        let bvh = super::bvh_build::build_bvh2(bounds, BvhBuildParams::medium_build());
         if super::bvh_build::depth(&bvh) + 2 > STACK {
             return None;
         }
