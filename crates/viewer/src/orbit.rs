@@ -54,8 +54,25 @@ impl Orbit {
 
     /// The camera for an image of `width × height`.
     pub fn camera(&self, width: u32, height: u32) -> Camera {
-        Camera::new(self.position(), self.target, self.up, self.fov_y, width, height)
+        Camera::new(self.position(), self.target, self.up, self.fov_y_for(width, height), width, height)
             .expect("an orbit keeps the eye off the target and off the up axis")
+    }
+
+    /// The vertical field of view (degrees) for an image of `width ×
+    /// height`: the scene camera's, unless the image is narrower than the
+    /// scene's own (a phone held upright); then it widens so the image
+    /// still spans the scene camera's horizontal view, which would
+    /// otherwise be cut at the sides (tan(fov/2) grows by the ratio of
+    /// the aspects).
+    fn fov_y_for(&self, width: u32, height: u32) -> f32 {
+        let aspect = width.max(1) as f32 / height.max(1) as f32;
+        let home_aspect = self.home.aspect();
+        if aspect >= home_aspect {
+            return self.fov_y;
+        }
+        let tan_half = (self.fov_y.to_radians() * 0.5).tan() * home_aspect / aspect;
+        let widest = hikari_core::scene::limits::FOV_Y.1 - 1.0;
+        (2.0 * tan_half.atan()).to_degrees().min(widest)
     }
 
     /// A drag of (dx, dy) pixels turns the eye around the target.
@@ -109,7 +126,7 @@ impl Orbit {
             v(self.position()),
             v(self.target),
             v(self.up),
-            self.fov_y
+            self.fov_y_for(width, height)
         )
     }
 }
@@ -126,6 +143,29 @@ mod tests {
 
     fn camera() -> Camera {
         Camera::new(Vec3::new(0.3, 0.4, 3.5), Vec3::new(0.0, 0.1, 0.0), Vec3::Y, 40.0, 64, 48).unwrap()
+    }
+
+    /// A window narrower than the scene's image (a phone upright) still
+    /// spans the scene camera's horizontal view: the rays through its left
+    /// and right edges are the scene camera's; a wider window keeps the
+    /// vertical field of view.
+    #[test]
+    fn a_narrow_window_keeps_the_scenes_width_in_view() {
+        let scene = camera();
+        let orbit = Orbit::new(&scene);
+        let edge = |c: &Camera, x: f32| c.ray(glam::Vec2::new(x, c.height as f32 * 0.5)).dir;
+        for (w, h) in [(39, 84), (48, 48), (30, 90)] {
+            let narrow = orbit.camera(w, h);
+            assert!(narrow.fov_y > scene.fov_y, "{w}x{h}");
+            for (x_narrow, x_scene) in [(0.0, 0.0), (w as f32, scene.width as f32)] {
+                let (a, b) = (edge(&narrow, x_narrow), edge(&scene, x_scene));
+                assert!((a - b).length() < 1e-5, "{w}x{h}: {a} vs {b}");
+            }
+        }
+        for (w, h) in [(64, 48), (128, 48)] {
+            assert_eq!(orbit.camera(w, h).fov_y, scene.fov_y);
+        }
+        assert!(orbit.toml(39, 84).contains(&format!("fov_y = {}", orbit.camera(39, 84).fov_y)));
     }
 
     #[test]

@@ -170,9 +170,25 @@ impl Panel {
     }
 }
 
+/// A rate per second with two significant digits below 10, so that the
+/// slow rates of a software adapter (a frame every few seconds) read as
+/// such and not as "0.0".
+fn rate(per_second: f64) -> String {
+    let decimals = if per_second >= 10.0 {
+        0
+    } else if per_second >= 1.0 {
+        1
+    } else if per_second >= 0.1 {
+        2
+    } else {
+        3
+    };
+    format!("{per_second:.decimals$}")
+}
+
 fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts, rects: &mut Vec<(String, [f32; 4])>) {
     ui.label(&r.adapter);
-    ui.label(format!("{:.1} fps; mean of {} frames ({} photon sets)", r.fps, r.frames_in_mean, r.photon_sets));
+    ui.label(format!("{} fps; mean of {} frames ({} photon sets)", rate(r.fps), r.frames_in_mean, r.photon_sets));
     if let Some(noise) = r.noise {
         ui.label(format!("noise ≈ {:.1}% (of the mean, from odd and even frames)", 100.0 * noise));
     }
@@ -183,7 +199,7 @@ fn layout(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts, rects: &mut Vec<(St
     if let Some([g, c, v]) = r.drawn {
         ui.label(format!("drawn: {g} global, {c} caustic, {v} volume"));
     }
-    ui.label(format!("tracing: {:.1} sets/s, {:.1} ms per set", r.sets_per_second, r.trace_ms));
+    ui.label(format!("tracing: {} sets/s, {:.1} ms per set", rate(r.sets_per_second), r.trace_ms));
     if let Some(ms) = r.edit_latency_ms {
         ui.label(format!("scene edit to screen: {ms:.0} ms (mean)"));
     }
@@ -330,5 +346,20 @@ fn scene_edits(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
                 }
             }
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rate;
+
+    /// Slow rates keep two significant digits; fast ones drop the noise.
+    #[test]
+    fn rates_read_with_their_leading_digits() {
+        assert_eq!(rate(0.067), "0.067");
+        assert_eq!(rate(0.25), "0.25");
+        assert_eq!(rate(1.92), "1.9");
+        assert_eq!(rate(59.6), "60");
+        assert_eq!(rate(0.0), "0.000");
     }
 }
