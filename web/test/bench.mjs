@@ -4,7 +4,8 @@
 // prints the time to the first frame and the page's mean fps. With
 // HIKARI_PASSES=1 the panel shows, and the last timed frame's passes are
 // printed too (a timed frame waits for each pass: fps reads lower).
-// HIKARI_TRACE=gpu|cpu|auto sets the page's trace= option.
+// HIKARI_TRACE=gpu|cpu|auto sets the page's trace= option; HIKARI_FLAGS adds
+// Chromium flags (space-separated).
 import { chromium } from "playwright-core";
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
@@ -31,7 +32,7 @@ const browser = await chromium.launch({
   executablePath: process.env.HIKARI_CHROMIUM || "/usr/bin/chromium",
   args: ["--no-sandbox", "--no-first-run", "--disable-background-networking", "--use-angle=swiftshader",
          "--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader",
-         "--use-webgpu-adapter=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist"],
+         "--use-webgpu-adapter=swiftshader", "--enable-unsafe-swiftshader", "--ignore-gpu-blocklist", ...(process.env.HIKARI_FLAGS ? process.env.HIKARI_FLAGS.split(" ") : [])],
 });
 const page = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
 const started = Date.now();

@@ -24,6 +24,7 @@ page.on("console", (m) => console.log("console:", m.type(), m.text()));
 const t0 = Date.now();
 await page.goto(`http://127.0.0.1:${server.address().port}/${query}`);
 await page.waitForTimeout(+wait);
-await page.screenshot({ path: out });
+// A screenshot waits for a frame, which takes seconds on a software adapter.
+await page.screenshot({ path: out, timeout: 180000 });
 console.log("shot", out, Date.now() - t0, "ms");
 await browser.close(); server.close();

@@ -172,8 +172,11 @@ impl Panel {
 
 /// A rate per second with two significant digits below 10, so that the
 /// slow rates of a software adapter (a frame every few seconds) read as
-/// such and not as "0.0".
+/// such and not as "0.0"; a dash until there is one (the first frames).
 fn rate(per_second: f64) -> String {
+    if per_second <= 0.0 {
+        return "–".into();
+    }
     let decimals = if per_second >= 10.0 {
         0
     } else if per_second >= 1.0 {
@@ -360,6 +363,6 @@ mod tests {
         assert_eq!(rate(0.25), "0.25");
         assert_eq!(rate(1.92), "1.9");
         assert_eq!(rate(59.6), "60");
-        assert_eq!(rate(0.0), "0.000");
+        assert_eq!(rate(0.0), "–");
     }
 }

@@ -386,6 +386,25 @@ impl Viewer {
                 self.readouts.noise = None;
             }
         }
+        // The rates, before the panel shows them. Frame rate counts rendered
+        // frames: a frame that only presents the mean again (its photon set
+        // not traced yet) is not one.
+        let now = Instant::now();
+        if rendered {
+            if let Some(last) = self.last_frame {
+                self.stats.push((now - last).as_secs_f64());
+            }
+            self.last_frame = Some(now);
+        }
+        self.started.get_or_insert(now);
+        if self.stats.frames() > 0 {
+            self.readouts.fps = self.stats.mean_fps();
+        }
+        // Photon sets traced a second since the first frame, as the native
+        // viewer counts them.
+        let elapsed = self.started.map_or(0.0, |s| (now - s).as_secs_f64());
+        let received = self.tracing.as_ref().map_or(0, |t| t.received);
+        self.readouts.sets_per_second = if elapsed > 0.0 { received as f64 / elapsed } else { 0.0 };
         let Some(texture) = next_frame(&gpu.surface, &ctx.device, &gpu.config)? else { return Ok(()) };
         let target = texture.texture.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -420,19 +439,6 @@ impl Viewer {
         ctx.queue.present(texture);
         ctx.check()?;
         self.actions.extend(asked);
-        // Frame rate counts rendered frames: a frame that only presents the
-        // mean again (its photon set not traced yet) is not one.
-        let now = Instant::now();
-        if rendered {
-            if let Some(last) = self.last_frame {
-                self.stats.push((now - last).as_secs_f64());
-            }
-            self.last_frame = Some(now);
-        }
-        self.started.get_or_insert(now);
-        if self.stats.frames() > 0 {
-            self.readouts.fps = self.stats.mean_fps();
-        }
         Ok(())
     }
 
