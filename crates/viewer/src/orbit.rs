@@ -96,12 +96,14 @@ impl Orbit {
         self.target += f * forward + r * right + u * up;
     }
 
-    /// A drag of (dx, dy) pixels moves target and eye across the view, by
-    /// about the distance a point at the target moves on screen.
-    pub fn pan(&mut self, dx: f32, dy: f32, height: u32) {
-        let camera = self.camera(height.max(1), height.max(1));
+    /// A drag of (dx, dy) pixels over a `size` = [width, height] image
+    /// moves target and eye across the view, by about the distance a
+    /// point at the target moves on screen.
+    pub fn pan(&mut self, dx: f32, dy: f32, size: [u32; 2]) {
+        let [width, height] = size.map(|n| n.max(1));
+        let camera = self.camera(width, height);
         let (_, right, up, tan_half_fov) = camera.basis();
-        let per_pixel = 2.0 * self.distance * tan_half_fov / height.max(1) as f32;
+        let per_pixel = 2.0 * self.distance * tan_half_fov / height as f32;
         self.target += (-dx * right + dy * up) * per_pixel;
     }
 
@@ -221,10 +223,24 @@ mod tests {
         orbit.zoom(2.0);
         assert!((orbit.distance - d * 0.81).abs() < 1e-5);
         let target = orbit.target;
-        orbit.pan(10.0, 0.0, 48);
+        orbit.pan(10.0, 0.0, [64, 48]);
         let right = orbit.camera(64, 48).basis().1;
         // Dragging right moves the scene right: the target moves left.
         assert!((orbit.target - target).dot(right) < 0.0);
+    }
+
+    /// A pan drags the point at the target with the cursor, in a window
+    /// as wide as the scene's image and in one narrower (wider field).
+    #[test]
+    fn a_pan_moves_the_target_with_the_cursor() {
+        for size in [[64, 48], [30, 90]] {
+            let mut orbit = Orbit::new(&camera());
+            let target = orbit.target;
+            orbit.pan(7.0, -3.0, size);
+            let seen = orbit.camera(size[0], size[1]).raster(target).unwrap();
+            let centre = glam::Vec2::new(size[0] as f32, size[1] as f32) * 0.5;
+            assert!((seen - centre - glam::Vec2::new(7.0, -3.0)).length() < 1e-3, "{size:?}: {seen}");
+        }
     }
 
     #[test]

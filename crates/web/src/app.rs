@@ -708,8 +708,8 @@ impl ApplicationHandler for Page {
                 }
             }
             other => {
-                let height = gpu.config.height;
-                v.input.event(&mut v.orbit, &other, height);
+                let size = [gpu.config.width, gpu.config.height];
+                v.input.event(&mut v.orbit, &other, size);
             }
         }
     }

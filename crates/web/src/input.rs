@@ -35,9 +35,9 @@ impl CameraInput {
         }
     }
 
-    /// Applies `event` to `orbit`; true when the camera moved. `height` is
+    /// Applies `event` to `orbit`; true when the camera moved. `size` is
     /// the canvas's, in pixels (pans follow the cursor).
-    pub fn event(&mut self, orbit: &mut Orbit, event: &WindowEvent, height: u32) -> bool {
+    pub fn event(&mut self, orbit: &mut Orbit, event: &WindowEvent, size: [u32; 2]) -> bool {
         match event {
             WindowEvent::ModifiersChanged(m) => {
                 self.shift = m.state().shift_key();
@@ -52,8 +52,8 @@ impl CameraInput {
                 let d = at - self.cursor;
                 self.cursor = at;
                 match self.dragging {
-                    Some(MouseButton::Left) if self.shift => orbit.pan(d.x, d.y, height),
-                    Some(MouseButton::Middle) => orbit.pan(d.x, d.y, height),
+                    Some(MouseButton::Left) if self.shift => orbit.pan(d.x, d.y, size),
+                    Some(MouseButton::Middle) => orbit.pan(d.x, d.y, size),
                     Some(MouseButton::Left) => orbit.rotate(d.x, d.y),
                     Some(MouseButton::Right) => orbit.look(d.x, d.y),
                     _ => return false,
@@ -85,12 +85,12 @@ impl CameraInput {
                 }
                 moved
             }
-            WindowEvent::Touch(touch) => self.touch(orbit, touch, height),
+            WindowEvent::Touch(touch) => self.touch(orbit, touch, size),
             _ => false,
         }
     }
 
-    fn touch(&mut self, orbit: &mut Orbit, touch: &Touch, height: u32) -> bool {
+    fn touch(&mut self, orbit: &mut Orbit, touch: &Touch, size: [u32; 2]) -> bool {
         let at = Vec2::new(touch.location.x as f32, touch.location.y as f32);
         let before = self.touches.clone();
         match touch.phase {
@@ -117,7 +117,7 @@ impl CameraInput {
                     orbit.pinch(spread1 / spread0);
                 }
                 let d = (*a1 + *b1 - *a0 - *b0) * 0.5;
-                orbit.pan(d.x, d.y, height);
+                orbit.pan(d.x, d.y, size);
                 true
             }
             _ => false,

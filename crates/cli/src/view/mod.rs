@@ -803,10 +803,10 @@ impl ApplicationHandler for Viewer {
             WindowEvent::CursorMoved { position, .. } => {
                 let (dx, dy) = ((position.x - self.cursor.x) as f32, (position.y - self.cursor.y) as f32);
                 self.cursor = position;
-                let height = self.session.as_ref().map_or(1, |s| s.config.height);
+                let size = self.session.as_ref().map_or([1, 1], |s| [s.config.width, s.config.height]);
                 match self.dragging {
-                    Some(MouseButton::Left) if self.shift => self.orbit.pan(dx, dy, height),
-                    Some(MouseButton::Middle) => self.orbit.pan(dx, dy, height),
+                    Some(MouseButton::Left) if self.shift => self.orbit.pan(dx, dy, size),
+                    Some(MouseButton::Middle) => self.orbit.pan(dx, dy, size),
                     Some(MouseButton::Left) => self.orbit.rotate(dx, dy),
                     Some(MouseButton::Right) => self.orbit.look(dx, dy),
                     _ => return,
