@@ -76,7 +76,7 @@ pub struct Viewer {
     pub readouts: Readouts,
     clock: AnimationClock,
     stats: FrameStats,
-    /// When the last rendered frame was presented (frame rate, clock).
+    /// When the last rendered frame was finished (frame rate, clock).
     last_frame: Option<Instant>,
     started: Option<Instant>,
     pub gpu: Option<Gpu>,
