@@ -31,18 +31,19 @@ valgrind --tool=cachegrind --branch-sim=yes --cache-sim=no --cachegrind-out-file
 python3 - "$OUT/counts" $((SIZE * SIZE * SPP)) "$TOP" "$SCENE" <<'EOF'
 import collections, sys
 path, paths, top, scene = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
-events, per_function, function = None, collections.defaultdict(lambda: [0] * 5), None
+events, per_function, function = [], {}, None
 for line in open(path):
     if line.startswith("events:"):
         events = line.split()[1:]
     elif line.startswith("fn="):
         function = line[3:].strip()
+        per_function.setdefault(function, [0] * len(events))
     elif line[:1].isdigit():
-        counts = [int(x) for x in line.split()[1:]] + [0] * 5
-        for i in range(5):
-            per_function[function][i] += counts[i]
+        # A line number, then the counts of each event (trailing zeros left out).
+        for i, count in enumerate(line.split()[1:]):
+            per_function[function][i] += int(count)
 ir, bcm, bim = events.index("Ir"), events.index("Bcm"), events.index("Bim")
-total = [sum(v[i] for v in per_function.values()) for i in range(5)]
+total = [sum(v[i] for v in per_function.values()) for i in range(len(events))]
 instructions, mispredicts = total[ir] / paths, (total[bcm] + total[bim]) / paths
 print(f"{scene}: {paths} paths; per path {instructions:.0f} instructions, {mispredicts:.2f} mispredicted "
       f"branches, about {instructions / 3 + 17 * mispredicts:.0f} cycles")
