@@ -6,6 +6,8 @@ mod bvh_build;
 mod flat_bvh;
 pub mod packet;
 mod shapes;
+mod simd8;
+mod wide;
 
 pub use accel::{Accel, Hit};
 pub(crate) use bvh_build::build_cwbvh;

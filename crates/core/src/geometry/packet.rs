@@ -2,25 +2,28 @@
 //! the path tracer's closest hits (`render::path` runs eight paths side
 //! by side).
 //!
-//! A single ray through `Accel`'s CWBVH pays for each node's decoding and
-//! each triangle's loads on its own; eight rays that go through the tree
-//! together pay for them once, each node's box and each triangle tested
-//! against all eight in one set of 8-wide instructions. On the Cornell box
-//! with incoherent bounce rays this finds a closest hit in about 37 ns a
-//! ray in the bare loop, against 57–63 ns through the CWBVH
-//! (BENCHMARKS.md, "Eight rays at once").
+//! A single ray pays for each node's loads and each triangle's on its own;
+//! eight rays that go through the tree together pay for them once, each
+//! node's box and each triangle tested against all eight in one set of
+//! 8-wide instructions. On the Cornell box with incoherent bounce rays this
+//! found a closest hit in about 37 ns a ray in the bare loop, against
+//! 57–63 ns through the CWBVH (BENCHMARKS.md, "Eight rays at once"); the
+//! single-ray `wide` BVH that replaced the CWBVH does not beat it either
+//! (cachegrind, path tracer on the Cornell box: 2,311 instructions and 16
+//! mispredicted branches a path for closest hits one ray at a time,
+//! against 1,889 and 9 in packets).
 //!
 //! The triangle test is `PackedPrim::intersect`'s Möller–Trumbore,
-//! operation for operation, so a lane finds the same t, bit for bit, as a
-//! single ray (checked by a test); spheres and alpha cut-outs take the
-//! single-ray test lane by lane. Only x86-64 with AVX2 (checked at run
-//! time) runs packets; elsewhere, and for a BVH deeper than the traversal
-//! stack, each lane is cast on its own through the CWBVH. The two differ
-//! only at the rarest edges: a ray leaving a surface right at a corner of
-//! the box meets the other wall within 1e-4 of its origin, which the
-//! CWBVH's quantised boxes miss and this traversal finds (34 of 1.6 M
-//! camera and bounce rays in the Cornell box), and of two primitives at
-//! exactly the same distance either may be reported.
+//! operation for operation (`simd8::triangle`), so a lane finds the same t,
+//! bit for bit, as a single ray (checked by a test); spheres and alpha
+//! cut-outs take the single-ray test lane by lane. Only x86-64 with AVX2
+//! (checked at run time) runs packets; elsewhere, and for a BVH deeper than
+//! the traversal stack, each lane is cast on its own (`Accel::intersect`).
+//! Packets and the CWBVH differ only at the rarest edges: a ray leaving a
+//! surface right at a corner of the box meets the other wall within 1e-4
+//! of its origin, which the CWBVH's quantised boxes miss and this traversal
+//! finds (34 of 1.6 M camera and bounce rays in the Cornell box), and of
+//! two primitives at exactly the same distance either may be reported.
 
 // Elsewhere than on x86-64 the traversal is compiled out and nothing builds
 // a packet BVH.
@@ -136,6 +139,7 @@ pub(super) mod avx2 {
     use super::{LANES, LaneHits, PacketBvh, STACK};
     use crate::geometry::Ray;
     use crate::geometry::accel::{INDEX_BITS, MASKED_BIT, SPHERE_BIT};
+    use crate::geometry::simd8;
     use std::arch::x86_64::*;
 
     /// The rays of a packet, one register per component; inactive lanes
@@ -161,8 +165,6 @@ pub(super) mod avx2 {
         let mut t_max = [0.0f32; LANES];
         let mut active = [0.0f32; LANES];
         let mut sum = [0.0f32; 3];
-        // Zero components become ±1e-20 so the slab test never sees 0·∞.
-        let safe = |d: f32| if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d };
         for (lane, ray) in rays.iter().enumerate() {
             let Some(r) = ray else {
                 for component in &mut c[3..] {
@@ -175,7 +177,7 @@ pub(super) mod avx2 {
                 c[k][lane] = v[k];
             }
             for k in 0..3 {
-                c[6 + k][lane] = safe(v[3 + k]);
+                c[6 + k][lane] = simd8::slab_safe(v[3 + k]);
                 sum[k] += v[3 + k];
             }
             t_max[lane] = r.t_max;
@@ -199,65 +201,24 @@ pub(super) mod avx2 {
         (lanes, t_max)
     }
 
-    /// Lanes whose ray meets the node's box before `t_max`. The far
-    /// distance is widened by 2 ulps' worth so rounding never culls a box
-    /// a ray grazes (flat boxes of axis-aligned walls).
+    /// Lanes whose ray meets the node's box before `t_max`.
     #[target_feature(enable = "avx2")]
     #[inline]
     fn slab(r: &Lanes, min: [f32; 3], max: [f32; 3], t_max: __m256) -> __m256 {
-        let s = _mm256_set1_ps;
-        let t0x = _mm256_mul_ps(_mm256_sub_ps(s(min[0]), r.ox), r.ix);
-        let t1x = _mm256_mul_ps(_mm256_sub_ps(s(max[0]), r.ox), r.ix);
-        let t0y = _mm256_mul_ps(_mm256_sub_ps(s(min[1]), r.oy), r.iy);
-        let t1y = _mm256_mul_ps(_mm256_sub_ps(s(max[1]), r.oy), r.iy);
-        let t0z = _mm256_mul_ps(_mm256_sub_ps(s(min[2]), r.oz), r.iz);
-        let t1z = _mm256_mul_ps(_mm256_sub_ps(s(max[2]), r.oz), r.iz);
-        let near = _mm256_max_ps(
-            _mm256_max_ps(_mm256_min_ps(t0x, t1x), _mm256_min_ps(t0y, t1y)),
-            _mm256_max_ps(_mm256_min_ps(t0z, t1z), _mm256_setzero_ps()),
-        );
-        let far = _mm256_min_ps(
-            _mm256_mul_ps(
-                _mm256_min_ps(_mm256_min_ps(_mm256_max_ps(t0x, t1x), _mm256_max_ps(t0y, t1y)), _mm256_max_ps(t0z, t1z)),
-                s(1.0 + 4.0 * f32::EPSILON),
-            ),
-            t_max,
-        );
-        _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far), r.active)
+        let (_, hit) =
+            simd8::slab(simd8::splat3(min), simd8::splat3(max), [r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz], t_max);
+        _mm256_and_ps(hit, r.active)
     }
 
-    /// Möller–Trumbore against all lanes, as `PackedPrim::intersect` does
-    /// it for one ray (same operations in the same order): (hit mask, t, b1, b2).
+    /// Möller–Trumbore against all lanes (`simd8::triangle`, the same t
+    /// to the bit as `PackedPrim::intersect`): (hit mask, t, b1, b2).
     #[target_feature(enable = "avx2")]
     #[inline]
     fn triangle(r: &Lanes, a: [f32; 3], e1: [f32; 3], e2: [f32; 3], eps: f32, t_max: __m256) -> [__m256; 4] {
-        let s = _mm256_set1_ps;
-        let (mul, sub, add) = (_mm256_mul_ps, _mm256_sub_ps, _mm256_add_ps);
-        let (e1x, e1y, e1z) = (s(e1[0]), s(e1[1]), s(e1[2]));
-        let (e2x, e2y, e2z) = (s(e2[0]), s(e2[1]), s(e2[2]));
-        // p = dir × e2, in glam's order: (y·z' − y'·z, z·x' − z'·x, x·y' − x'·y).
-        let px = sub(mul(r.dy, e2z), mul(e2y, r.dz));
-        let py = sub(mul(r.dz, e2x), mul(e2z, r.dx));
-        let pz = sub(mul(r.dx, e2y), mul(e2x, r.dy));
-        let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
-        let inv = _mm256_div_ps(s(1.0), det);
-        let sx = sub(r.ox, s(a[0]));
-        let sy = sub(r.oy, s(a[1]));
-        let sz = sub(r.oz, s(a[2]));
-        let b1 = mul(add(add(mul(sx, px), mul(sy, py)), mul(sz, pz)), inv);
-        // q = s × e1
-        let qx = sub(mul(sy, e1z), mul(e1y, sz));
-        let qy = sub(mul(sz, e1x), mul(e1z, sx));
-        let qz = sub(mul(sx, e1y), mul(e1x, sy));
-        let b2 = mul(add(add(mul(r.dx, qx), mul(r.dy, qy)), mul(r.dz, qz)), inv);
-        let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv);
-        let zero = _mm256_setzero_ps();
-        let inside = _mm256_and_ps(
-            _mm256_and_ps(_mm256_cmp_ps::<_CMP_GE_OQ>(b1, zero), _mm256_cmp_ps::<_CMP_GE_OQ>(b2, zero)),
-            _mm256_cmp_ps::<_CMP_LE_OQ>(add(b1, b2), s(1.0)),
-        );
-        let within = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(t, s(eps)), _mm256_cmp_ps::<_CMP_LT_OQ>(t, t_max));
-        [_mm256_and_ps(_mm256_and_ps(inside, within), r.active), t, b1, b2]
+        let (origin, dir) = ([r.ox, r.oy, r.oz], [r.dx, r.dy, r.dz]);
+        let [ok, t, b1, b2] =
+            simd8::triangle(origin, dir, simd8::splat3(a), simd8::splat3(e1), simd8::splat3(e2), eps, t_max);
+        [_mm256_and_ps(ok, r.active), t, b1, b2]
     }
 
     /// The order to push an inner node's children: (pushed first, pushed
