@@ -15,7 +15,7 @@ const SIZE: u32 = 64;
 
 /// Fraction of each light that a point sees, by shadow rays (64 per area
 /// light and sky).
-fn visibility(scene: &Scene, x: Vec3) -> Vec<f32> {
+fn visibility(scene: &Scene, x: Vec3, normal: Vec3) -> Vec<f32> {
     let mut rng = Rng::for_item(99, 0);
     scene
         .lights
@@ -25,6 +25,13 @@ fn visibility(scene: &Scene, x: Vec3) -> Vec<f32> {
             let (mut seen, mut total) = (0, 0);
             for _ in 0..count {
                 let Some(s) = light.sample_incident(x, rng.next_2d()) else { continue };
+                // Samples of the sky that graze the floor (at the horizon)
+                // carry almost no light, and whether such a ray meets its
+                // own floor, from a point a rounding error below it, is no
+                // edge of light: left out.
+                if light.distant_disc().is_some() && s.wi.dot(normal).abs() < 0.01 {
+                    continue;
+                }
                 total += 1;
                 // As direct_diffuse casts it: from the point itself (the BVH skips t < epsilon).
                 let mut ray = hikari_core::geometry::Ray::new(x, s.wi);
@@ -48,7 +55,7 @@ fn comparison_mask(scene: &Scene, gpu_albedo: &[glam::Vec4]) -> Vec<bool> {
             let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             if let Some(hit) = scene.accel.intersect(&ray) {
                 if scene.material(&hit).is_diffuse() && gpu_albedo[(y * size + x) as usize].w == 0.0 {
-                    vis[(y * size + x) as usize] = Some(visibility(scene, hit.point));
+                    vis[(y * size + x) as usize] = Some(visibility(scene, hit.point, hit.geometric_normal));
                 }
             }
         }

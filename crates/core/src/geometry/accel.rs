@@ -1,13 +1,12 @@
 //! The scene BVH over triangles and analytic spheres, answering
-//! closest-hit and occlusion queries: on x86-64 with AVX2 single rays go
-//! through `wide`'s eight-wide float BVH and packets of eight through
-//! `packet`'s binary one; elsewhere both go through obvhs's compressed wide
-//! BVH (CWBVH), ray by ray.
+//! closest-hit and occlusion queries: on x86-64 with AVX2 through `wide`'s
+//! eight-wide float BVH, one ray at a time or eight (`packet`); elsewhere
+//! through obvhs's compressed wide BVH (CWBVH), ray by ray.
 //!
 //! Primitives are addressed by one index space: triangles first, then spheres.
 //! Each primitive carries the id of the surface (object) it belongs to.
 
-use super::packet::{LANES, PacketBvh};
+use super::packet::LANES;
 use super::wide::WideBvh;
 use super::{Ray, Sphere, Triangle};
 use crate::texture::Texturing;
@@ -135,11 +134,9 @@ pub struct Accel {
     bounds_max: Vec3,
     /// The textures of cut-outs, when the scene has any (`set_alpha_mask`).
     alpha: Option<Arc<Texturing>>,
-    /// The binary BVH of packet queries, built on the first one (None
-    /// where packets cannot run: `PacketBvh::build`).
-    packet: OnceLock<Option<PacketBvh>>,
-    /// The wide BVH of single-ray queries, built on the first one (None
-    /// where it cannot run: `WideBvh::build`; the CWBVH answers then).
+    /// The wide BVH of single-ray and packet queries, built on the first
+    /// one (None where it cannot run: `WideBvh::build`; the CWBVH answers
+    /// then, ray by ray).
     wide: OnceLock<Option<WideBvh>>,
 }
 
@@ -206,7 +203,6 @@ impl Accel {
             bounds_min: lo,
             bounds_max: hi,
             alpha: None,
-            packet: OnceLock::new(),
             wide: OnceLock::new(),
         }
     }
@@ -226,7 +222,6 @@ impl Accel {
             p.prim = if masked { p.prim | MASKED_BIT } else { p.prim & !MASKED_BIT };
         }
         self.alpha = texturing;
-        self.packet = OnceLock::new();
         self.wide = OnceLock::new();
     }
 
@@ -375,24 +370,16 @@ impl Accel {
         by_index
     }
 
-    /// The packet BVH, built on first use.
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    fn packet_bvh(&self) -> Option<&PacketBvh> {
-        self.packet
-            .get_or_init(|| PacketBvh::build(&self.by_index(), &prim_bounds(&self.triangles, &self.spheres)))
-            .as_ref()
-    }
-
     /// Closest hits of up to `LANES` rays at once, written to `hits` (None
     /// lanes are skipped and their entries left as they were): the same
     /// hits as [`Accel::intersect`] lane by lane, cheaper where the CPU runs
     /// packets (`geometry::packet`).
     pub fn intersect_packet(&self, rays: &[Option<Ray>; LANES], hits: &mut [Option<Hit>; LANES]) {
         #[cfg(target_arch = "x86_64")]
-        if let Some(bvh) = self.packet_bvh() {
+        if let Some(bvh) = self.wide_bvh() {
             let eps = self.epsilon;
             let single = |k: usize, ray: &Ray| self.counted_hit(&bvh.prims[k], ray);
-            // SAFETY: a PacketBvh exists only where the CPU has AVX2.
+            // SAFETY: a WideBvh exists only where the CPU has AVX2.
             let lanes = unsafe { super::packet::avx2::closest(bvh, rays, eps, single) };
             for (l, ray) in rays.iter().enumerate() {
                 let Some(ray) = ray else { continue };
@@ -489,7 +476,7 @@ mod tests {
     /// Packets find what single rays find: the same t to the bit, the same
     /// surface, with lanes left empty and rays of finite length among them.
     fn packets_match_single_rays(accel: &Accel, rays: &[Ray]) {
-        assert_eq!(accel.packet_bvh().is_some(), super::super::packet::avx2_available());
+        assert_eq!(accel.wide_bvh().is_some(), super::super::packet::avx2_available());
         for (n, chunk) in rays.chunks(LANES).enumerate() {
             // Every fifth packet has a hole; every third ray ends just
             // before or after its hit.

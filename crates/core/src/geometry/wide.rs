@@ -22,14 +22,14 @@ use obvhs::BvhBuildParams;
 use obvhs::bvh2::Bvh2;
 
 /// Children per node, triangles per block.
-const WIDTH: usize = 8;
+pub(super) const WIDTH: usize = 8;
 
 /// A child that is a leaf: the low bits are its first block.
-const LEAF: u32 = 1 << 31;
+pub(super) const LEAF: u32 = 1 << 31;
 
 /// Children a traversal can hold pending: a tree whose depth could need
 /// more is not built.
-const STACK: usize = 256;
+pub(super) const STACK: usize = 256;
 
 /// Primitives per leaf of the binary BVH the wide one is made from: one
 /// block.
@@ -39,12 +39,12 @@ const LEAF_PRIMS: u32 = 8;
 #[repr(C, align(32))]
 #[derive(Clone, Copy)]
 pub(super) struct WideNode {
-    lo: [[f32; WIDTH]; 3],
-    hi: [[f32; WIDTH]; 3],
+    pub(super) lo: [[f32; WIDTH]; 3],
+    pub(super) hi: [[f32; WIDTH]; 3],
     /// An inner child's node index, or `LEAF` | a leaf's first block.
-    child: [u32; WIDTH],
+    pub(super) child: [u32; WIDTH],
     /// Bit i is set where slot i holds a child.
-    valid: u8,
+    pub(super) valid: u8,
 }
 
 /// Up to eight primitives of a leaf: triangles as (v0, e1, e2), component
@@ -53,23 +53,23 @@ pub(super) struct WideNode {
 #[repr(C, align(32))]
 #[derive(Clone, Copy)]
 pub(super) struct Block {
-    a: [[f32; WIDTH]; 3],
-    e1: [[f32; WIDTH]; 3],
-    e2: [[f32; WIDTH]; 3],
+    pub(super) a: [[f32; WIDTH]; 3],
+    pub(super) e1: [[f32; WIDTH]; 3],
+    pub(super) e2: [[f32; WIDTH]; 3],
     /// Each lane's primitive, an index in `WideBvh::prims`.
-    prim: [u32; WIDTH],
+    pub(super) prim: [u32; WIDTH],
     /// Lanes whose primitive is a sphere or a cut-out.
-    single: u8,
+    pub(super) single: u8,
     /// Whether the next block belongs to the same leaf.
-    continues: bool,
+    pub(super) continues: bool,
 }
 
 /// The wide BVH: nodes (the root first), leaf blocks, and the primitives
 /// in block order.
 #[derive(Clone)]
 pub(super) struct WideBvh {
-    nodes: Vec<WideNode>,
-    blocks: Vec<Block>,
+    pub(super) nodes: Vec<WideNode>,
+    pub(super) blocks: Vec<Block>,
     pub prims: Vec<PackedPrim>,
 }
 
