@@ -125,8 +125,7 @@ pub struct Accel {
     surface_of: Vec<u32>,
     /// Hit-record data per primitive, in the joint index space.
     info: Vec<PrimInfo>,
-    bvh: Option<CwBvh>,
-    /// `packed[i]` is primitive `bvh.primitive_indices[i]`.
+    /// Every primitive as the traversals test it, in the joint index space.
     packed: Vec<PackedPrim>,
     /// Self-intersection offset along rays leaving a surface.
     pub epsilon: f32,
@@ -138,10 +137,23 @@ pub struct Accel {
     /// one (None where it cannot run: `WideBvh::build`; the CWBVH answers
     /// then, ray by ray).
     wide: OnceLock<Option<WideBvh>>,
+    /// The CWBVH, built only where the wide BVH cannot run (or a test
+    /// compares the two): a scene whose objects move is rebuilt every
+    /// frame, and building both would cost twice.
+    cwbvh: OnceLock<Option<Cwbvh>>,
+}
+
+/// obvhs's CWBVH with the primitives in its leaf order: `packed[i]` is
+/// primitive `bvh.primitive_indices[i]`.
+#[derive(Clone)]
+struct Cwbvh {
+    bvh: CwBvh,
+    packed: Vec<PackedPrim>,
 }
 
 impl Accel {
-    /// Builds the BVH. `triangle_surfaces[i]` / `sphere_surfaces[i]` give the
+    /// The primitives, ready for a BVH built on the first query (`wide`,
+    /// else the CWBVH). `triangle_surfaces[i]` / `sphere_surfaces[i]` give the
     /// surface id of each primitive.
     pub fn build(
         triangles: Vec<Triangle>,
@@ -158,7 +170,6 @@ impl Accel {
             hi = hi.max(b.0.max.into());
         }
         let scale = if bounds.is_empty() { 1.0 } else { (hi - lo).max_element().max(1e-3) };
-        let bvh = (!bounds.is_empty()).then(|| super::bvh_build::build_cwbvh(&bounds, BvhBuildParams::medium_build()));
         let mut surface_of = triangle_surfaces;
         surface_of.extend(sphere_surfaces);
         let n_tri = triangles.len();
@@ -169,41 +180,34 @@ impl Accel {
             .zip(&surface_of)
             .map(|((normal, smooth), &surface)| PrimInfo { normal, smooth, surface })
             .collect();
-        let packed = bvh
-            .as_ref()
-            .map(|b| {
-                b.primitive_indices
-                    .iter()
-                    .map(|&i| {
-                        let i = i as usize;
-                        if i < n_tri {
-                            let v = triangles[i].v;
-                            PackedPrim { a: v[0], b: v[1] - v[0], c: v[2] - v[0], prim: i as u32 }
-                        } else {
-                            let s = spheres[i - n_tri];
-                            PackedPrim {
-                                a: s.center,
-                                b: Vec3::new(s.radius, 0.0, 0.0),
-                                c: Vec3::ZERO,
-                                prim: i as u32 | SPHERE_BIT,
-                            }
-                        }
-                    })
-                    .collect()
+        let packed = (0..bounds.len())
+            .map(|i| {
+                if i < n_tri {
+                    let v = triangles[i].v;
+                    PackedPrim { a: v[0], b: v[1] - v[0], c: v[2] - v[0], prim: i as u32 }
+                } else {
+                    let s = spheres[i - n_tri];
+                    PackedPrim {
+                        a: s.center,
+                        b: Vec3::new(s.radius, 0.0, 0.0),
+                        c: Vec3::ZERO,
+                        prim: i as u32 | SPHERE_BIT,
+                    }
+                }
             })
-            .unwrap_or_default();
+            .collect();
         Accel {
             triangles,
             spheres,
             surface_of,
             info,
-            bvh,
             packed,
             epsilon: super::ray_epsilon(scale),
             bounds_min: lo,
             bounds_max: hi,
             alpha: None,
             wide: OnceLock::new(),
+            cwbvh: OnceLock::new(),
         }
     }
 
@@ -223,6 +227,7 @@ impl Accel {
         }
         self.alpha = texturing;
         self.wide = OnceLock::new();
+        self.cwbvh = OnceLock::new();
     }
 
     /// The texturing set by [`Accel::set_alpha_mask`], if the scene has cut-outs.
@@ -244,6 +249,7 @@ impl Accel {
     /// Primitive `p`'s hit (t, b1, b2) in (epsilon, ray.t_max) where it
     /// counts ([`Accel::counts`]): the single-ray test of packed primitives.
     #[inline(always)]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     fn counted_hit(&self, p: &PackedPrim, ray: &Ray) -> Option<(f32, f32, f32)> {
         let (t, b1, b2) = p.intersect(ray, self.epsilon);
         (t < ray.t_max && self.counts(p.prim, b1, b2)).then_some((t, b1, b2))
@@ -297,7 +303,7 @@ impl Accel {
 
     /// [`Accel::intersect`] through the CWBVH (where the wide BVH cannot run).
     fn intersect_cwbvh(&self, ray: &Ray) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
+        let Cwbvh { bvh, packed } = self.cwbvh()?;
         let eps = self.epsilon;
         let node_ray = super::obvhs_ray(ray.origin, ray.dir, ray.t_max);
         // The primitive test is written into obvhs's traversal loop (its
@@ -308,7 +314,7 @@ impl Accel {
         let mut state = bvh.new_traversal(node_ray.direction);
         let mut node;
         obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_test_ray, state.oct_inv4), {
-            let packed = &self.packed[state.primitive_id as usize];
+            let packed = &packed[state.primitive_id as usize];
             let (t, b1, b2) = packed.intersect(&prim_ray, eps);
             if t < prim_ray.t_max && self.counts(packed.prim, b1, b2) {
                 best = (packed.prim & INDEX_BITS, b1, b2);
@@ -354,20 +360,22 @@ impl Accel {
     /// The wide BVH, built on first use.
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     fn wide_bvh(&self) -> Option<&WideBvh> {
-        self.wide
-            .get_or_init(|| WideBvh::build(&self.by_index(), &prim_bounds(&self.triangles, &self.spheres)))
-            .as_ref()
+        self.wide.get_or_init(|| WideBvh::build(&self.packed, &prim_bounds(&self.triangles, &self.spheres))).as_ref()
     }
 
-    /// The packed primitives in the joint index space (they are stored in
-    /// the CWBVH's leaf order).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    fn by_index(&self) -> Vec<PackedPrim> {
-        let mut by_index = self.packed.clone();
-        for p in &self.packed {
-            by_index[(p.prim & INDEX_BITS) as usize] = *p;
-        }
-        by_index
+    /// The CWBVH, built on first use (None for an empty scene).
+    fn cwbvh(&self) -> Option<&Cwbvh> {
+        self.cwbvh
+            .get_or_init(|| {
+                let bounds = prim_bounds(&self.triangles, &self.spheres);
+                if bounds.is_empty() {
+                    return None;
+                }
+                let bvh = super::bvh_build::build_cwbvh(&bounds, BvhBuildParams::medium_build());
+                let packed = bvh.primitive_indices.iter().map(|&i| self.packed[i as usize]).collect();
+                Some(Cwbvh { bvh, packed })
+            })
+            .as_ref()
     }
 
     /// Closest hits of up to `LANES` rays at once, written to `hits` (None
@@ -412,7 +420,7 @@ impl Accel {
 
     /// [`Accel::occluded`] through the CWBVH.
     fn occluded_cwbvh(&self, ray: &Ray) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else {
+        let Some(Cwbvh { bvh, packed }) = self.cwbvh() else {
             return false;
         };
         let eps = self.epsilon;
@@ -422,7 +430,7 @@ impl Accel {
         let mut blocked = false;
         'search: {
             obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_ray, state.oct_inv4), {
-                let packed = &self.packed[state.primitive_id as usize];
+                let packed = &packed[state.primitive_id as usize];
                 let (t, b1, b2) = packed.intersect(ray, eps);
                 if t < ray.t_max && self.counts(packed.prim, b1, b2) {
                     blocked = true;
