@@ -83,6 +83,26 @@ pub struct Panel {
     /// [left, top, right, bottom] in points (CSS pixels in a browser):
     /// the web page's tests click them.
     pub widget_rects: Vec<(String, [f32; 4])>,
+    /// egui's clock at the last frame's input (seconds), for
+    /// `allow_clicks_across_frames`.
+    last_input_time: Option<f64>,
+}
+
+/// egui's own limit on how long a click may be held (seconds).
+const MAX_CLICK_HOLD: f64 = 0.8;
+
+/// egui stamps a press and a release with the time of the frame that
+/// takes them, so a click whose press and release fall on two sides of a
+/// frame boundary seems held for a whole frame. On a software adapter a
+/// frame takes seconds, past egui's 0.8 s, and such a click was dropped
+/// (a checkbox that ignores clicks now and then). The limit grows by the
+/// time between the last two frames' input.
+fn allow_clicks_across_frames(ctx: &egui::Context, last_input_time: Option<f64>, now: Option<f64>) {
+    let frame_gap = match (last_input_time, now) {
+        (Some(last), Some(now)) if now > last => now - last,
+        _ => 0.0,
+    };
+    ctx.options_mut(|o| o.input_options.max_click_duration = MAX_CLICK_HOLD + frame_gap);
 }
 
 impl Panel {
@@ -90,7 +110,15 @@ impl Panel {
         let ctx = egui::Context::default();
         let state = egui_winit::State::new(ctx.clone(), egui::ViewportId::ROOT, window, None, None, None);
         let renderer = egui_wgpu::Renderer::new(device, format, egui_wgpu::RendererOptions::default());
-        Panel { ctx, state, renderer, visible: true, start_folded: false, widget_rects: Vec::new() }
+        Panel {
+            ctx,
+            state,
+            renderer,
+            visible: true,
+            start_folded: false,
+            widget_rects: Vec::new(),
+            last_input_time: None,
+        }
     }
 
     /// Passes a window event to egui; true when egui used it (a click on
@@ -118,6 +146,8 @@ impl Panel {
             return;
         }
         let input = self.state.take_egui_input(window);
+        allow_clicks_across_frames(&self.ctx, self.last_input_time, input.time);
+        self.last_input_time = input.time;
         let mut front_end = Some(front_end);
         let rects = &mut self.widget_rects;
         rects.clear();
@@ -354,7 +384,53 @@ fn scene_edits(ui: &mut egui::Ui, c: &mut Controls, r: &Readouts) {
 
 #[cfg(test)]
 mod tests {
-    use super::rate;
+    use super::{allow_clicks_across_frames, rate};
+
+    /// One frame of a panel holding one checkbox, with `events` as its
+    /// input at `time` seconds; where the box was drawn.
+    fn checkbox_frame(ctx: &egui::Context, ticked: &mut bool, time: f64, events: Vec<egui::Event>) -> egui::Pos2 {
+        let input = egui::RawInput {
+            time: Some(time),
+            events,
+            screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(200.0, 100.0))),
+            ..Default::default()
+        };
+        let mut centre = egui::Pos2::ZERO;
+        let mut output = ctx.run_ui(input, |ui| centre = ui.checkbox(ticked, "term").rect.center());
+        // Nothing is drawn here; egui asks that dropping its textures be said.
+        output.textures_delta.clear();
+        centre
+    }
+
+    fn button(pos: egui::Pos2, pressed: bool) -> egui::Event {
+        egui::Event::PointerButton { pos, button: egui::PointerButton::Primary, pressed, modifiers: Default::default() }
+    }
+
+    /// A click pressed in one slow frame (3 s apart) and released in the
+    /// next ticks the box with the limit stretched, and not without it
+    /// (the second half shows the test can fail).
+    #[test]
+    fn a_click_split_across_slow_frames_still_clicks() {
+        for stretched in [true, false] {
+            let ctx = egui::Context::default();
+            let mut ticked = false;
+            let mut last = None;
+            let mut at = egui::Pos2::ZERO;
+            for (frame, time) in [0.0, 3.0, 6.0].into_iter().enumerate() {
+                if stretched {
+                    allow_clicks_across_frames(&ctx, last, Some(time));
+                }
+                last = Some(time);
+                let events = match frame {
+                    0 => vec![],
+                    1 => vec![egui::Event::PointerMoved(at), button(at, true)],
+                    _ => vec![button(at, false)],
+                };
+                at = checkbox_frame(&ctx, &mut ticked, time, events);
+            }
+            assert_eq!(ticked, stretched, "stretched limit: {stretched}");
+        }
+    }
 
     /// Slow rates keep two significant digits; fast ones drop the noise.
     #[test]
