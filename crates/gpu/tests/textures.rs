@@ -102,7 +102,7 @@ fn a_checker_texture_shows_on_the_gpu_as_on_the_cpu() {
         for x in 0..width {
             let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let Some(hit) = scene.accel.intersect(&ray) else { continue };
-            let Material::Diffuse { albedo: want, .. } = scene.material_at(&hit) else { panic!("Lambertian quads") };
+            let Material::Diffuse { albedo: want, .. } = *scene.material_at(&hit) else { panic!("Lambertian quads") };
             let i = (y * width + x) as usize;
             let got = albedo[i].truncate();
             let err = (got - want).abs().max_element();
@@ -218,7 +218,7 @@ fn metallic_roughness_textures_reach_the_gbuffer() {
         for x in 0..size {
             let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let Some(hit) = scene.accel.intersect(&ray) else { continue };
-            let Material::Pbr(want) = scene.material_at(&hit) else { panic!("a glossy quad") };
+            let Material::Pbr(want) = *scene.material_at(&hit) else { panic!("a glossy quad") };
             let bits = emission[(y * size + x) as usize].w as u32;
             let (metallic, roughness) = ((bits / 4096) as f32 / 4095.0, (bits % 4096) as f32 / 4095.0);
             let step = 0.5 / 4095.0 + 1e-6;

@@ -329,8 +329,11 @@ impl Accel {
     }
 
     /// The hit of `ray` at `t` on primitive `prim` (joint index space) at
-    /// barycentrics (b1, b2).
-    #[inline]
+    /// barycentrics (b1, b2). Never inlined: it then writes the hit into
+    /// its place field by field; inlined into the path tracer's step, the
+    /// hit went through a temporary copied with wider loads than its
+    /// stores, which stalled (7% of the step, perf).
+    #[inline(never)]
     fn hit_record(&self, ray: &Ray, t: f32, prim: usize, b1: f32, b2: f32) -> Hit {
         let point = ray.at(t);
         let info = self.info[prim];
@@ -381,8 +384,14 @@ impl Accel {
     /// Closest hits of up to `LANES` rays at once, written to `hits` (None
     /// lanes are skipped and their entries left as they were): the same
     /// hits as [`Accel::intersect`] lane by lane, cheaper where the CPU runs
-    /// packets (`geometry::packet`).
-    pub fn intersect_packet(&self, rays: &[Option<Ray>; LANES], hits: &mut [Option<Hit>; LANES]) {
+    /// packets (`geometry::packet`). The rays may be borrowed (`&Ray`), so
+    /// a caller need not copy rays it has just written: a wide load of a
+    /// fresh copy stalls on its narrower stores.
+    pub fn intersect_packet<R: std::borrow::Borrow<Ray>>(
+        &self,
+        rays: &[Option<R>; LANES],
+        hits: &mut [Option<Hit>; LANES],
+    ) {
         #[cfg(target_arch = "x86_64")]
         if let Some(bvh) = self.wide_bvh() {
             let eps = self.epsilon;
@@ -390,7 +399,7 @@ impl Accel {
             // SAFETY: a WideBvh exists only where the CPU has AVX2.
             let lanes = unsafe { super::packet::avx2::closest(bvh, rays, eps, single) };
             for (l, ray) in rays.iter().enumerate() {
-                let Some(ray) = ray else { continue };
+                let Some(ray) = ray.as_ref().map(R::borrow) else { continue };
                 let k = lanes.prim[l];
                 hits[l] = (k != u32::MAX).then(|| {
                     let prim = (bvh.prims[k as usize].prim & INDEX_BITS) as usize;
@@ -401,7 +410,7 @@ impl Accel {
         }
         for (ray, hit) in rays.iter().zip(hits) {
             if let Some(ray) = ray {
-                *hit = self.intersect(ray);
+                *hit = self.intersect(ray.borrow());
             }
         }
     }

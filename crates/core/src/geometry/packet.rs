@@ -62,6 +62,7 @@ pub(super) mod avx2 {
     use crate::geometry::simd8;
     use crate::geometry::wide::{LEAF, STACK, WIDTH, WideBvh};
     use std::arch::x86_64::*;
+    use std::borrow::Borrow;
 
     /// The rays of a packet, one register per component; inactive lanes
     /// have an all-zero `active` lane and never report a hit.
@@ -79,12 +80,12 @@ pub(super) mod avx2 {
     }
 
     #[target_feature(enable = "avx2")]
-    fn load(rays: &[Option<Ray>; LANES]) -> (Lanes, [f32; LANES]) {
-        let mut c = [[0.0f32; LANES]; 9];
+    fn load<R: Borrow<Ray>>(rays: &[Option<R>; LANES]) -> (Lanes, [f32; LANES]) {
+        let mut c = [[0.0f32; LANES]; 6];
         let mut t_max = [0.0f32; LANES];
         let mut active = [0.0f32; LANES];
         for (lane, ray) in rays.iter().enumerate() {
-            let Some(r) = ray else {
+            let Some(r) = ray.as_ref().map(R::borrow) else {
                 for component in &mut c[3..] {
                     component[lane] = 1.0;
                 }
@@ -93,9 +94,6 @@ pub(super) mod avx2 {
             let v = [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z];
             for k in 0..6 {
                 c[k][lane] = v[k];
-            }
-            for k in 0..3 {
-                c[6 + k][lane] = simd8::slab_safe(v[3 + k]);
             }
             t_max[lane] = r.t_max;
             active[lane] = f32::from_bits(u32::MAX);
@@ -109,9 +107,9 @@ pub(super) mod avx2 {
             dx: ld(&c[3]),
             dy: ld(&c[4]),
             dz: ld(&c[5]),
-            ix: _mm256_div_ps(_mm256_set1_ps(1.0), ld(&c[6])),
-            iy: _mm256_div_ps(_mm256_set1_ps(1.0), ld(&c[7])),
-            iz: _mm256_div_ps(_mm256_set1_ps(1.0), ld(&c[8])),
+            ix: simd8::inverse_direction(ld(&c[3])),
+            iy: simd8::inverse_direction(ld(&c[4])),
+            iz: simd8::inverse_direction(ld(&c[5])),
             active: ld(&active),
         };
         (lanes, t_max)
@@ -144,9 +142,9 @@ pub(super) mod avx2 {
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    pub unsafe fn closest(
+    pub unsafe fn closest<R: Borrow<Ray>>(
         bvh: &WideBvh,
-        rays: &[Option<Ray>; LANES],
+        rays: &[Option<R>; LANES],
         eps: f32,
         single: impl Fn(usize, &Ray) -> Option<(f32, f32, f32)>,
     ) -> LaneHits {
@@ -197,7 +195,7 @@ pub(super) mod avx2 {
                                 _mm256_storeu_ps(b2.as_mut_ptr(), b2s);
                             }
                             for (l, ray) in rays.iter().enumerate() {
-                                let Some(ray) = ray else { continue };
+                                let Some(ray) = ray.as_ref().map(R::borrow) else { continue };
                                 let ray = Ray { t_max: t[l], ..*ray };
                                 if let Some((th, u, v)) = single(k as usize, &ray) {
                                     (t[l], lane_prim[l], b1[l], b2[l]) = (th, k, u, v);

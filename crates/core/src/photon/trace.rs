@@ -183,7 +183,7 @@ impl PathTracer<'_> {
                 }
             }
             let Some(hit) = hit else { return };
-            let material = &self.scene.material_at(&hit);
+            let material = &*self.scene.material_at(&hit);
             // Normals on the side the photon arrives from.
             let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
             let (ng, ns) = (hit.geometric_normal * facing, hit.shading_normal * facing);

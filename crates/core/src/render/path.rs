@@ -83,7 +83,7 @@ pub fn radiance(scene: &Scene, ray: Ray, settings: &PathSettings, sampler: &mut 
     if settings.max_depth > 0 {
         loop {
             let hit = scene.accel.intersect(&path.ray);
-            if !advance(scene, settings, &mut path, hit, sampler) {
+            if !advance(scene, settings, &mut path, hit.as_ref(), sampler) {
                 break;
             }
         }
@@ -100,7 +100,7 @@ fn advance(
     scene: &Scene,
     settings: &PathSettings,
     path: &mut PathState,
-    hit: Option<crate::geometry::Hit>,
+    hit: Option<&crate::geometry::Hit>,
     sampler: &mut impl Sampler,
 ) -> bool {
     let media = &scene.media;
@@ -135,11 +135,11 @@ fn advance(
         path.l += path.beta * sky(scene, &path.ray, path.previous);
         return false;
     };
-    let material = scene.material_at(&hit);
+    let material = &*scene.material_at(hit);
     // Emitted light, MIS-weighted against the light sampling of the last
     // vertex. An emissive mesh's surface then reflects like any other.
-    if let Some(light) = scene.emitter(&hit) {
-        let le = scene.emitted_radiance(&hit, path.ray.dir).unwrap_or_default();
+    if let Some(light) = scene.emitter(hit) {
+        let le = scene.emitted_radiance(hit, path.ray.dir).unwrap_or_default();
         let weight = match path.previous {
             Previous::Specular => 1.0,
             Previous::Diffuse { point, pdf } => {
@@ -153,11 +153,11 @@ fn advance(
     }
     let facing = if path.ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
     // Normal textures bend the shading normal here (only the path tracer reads them).
-    let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(&hit) * facing);
+    let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(hit) * facing);
     let next_dir = match material {
         Material::Emitter => return false,
         Material::Glass { ior } => {
-            let split = dielectric_split(path.ray.dir, hit.geometric_normal, ior);
+            let split = dielectric_split(path.ray.dir, hit.geometric_normal, *ior);
             path.previous = Previous::Specular;
             match split.refracted {
                 Some(t) if sampler.next_f32() >= split.reflectance => t,
@@ -241,24 +241,26 @@ fn trace_in_packets<S: Sampler>(
         return;
     }
     let mut lanes: [Option<(usize, PathState, S)>; LANES] = std::array::from_fn(|_| None);
-    let (mut rays, mut hits) = ([None; LANES], [None; LANES]);
+    let mut hits = [None; LANES];
     let mut next = 0;
     loop {
-        for (lane, ray) in lanes.iter_mut().zip(&mut rays) {
+        for lane in &mut lanes {
             if lane.is_none() && next < out.len() {
                 let (camera_ray, sampler) = start(next);
                 *lane = Some((next, PathState::new(camera_ray), sampler));
                 next += 1;
             }
-            *ray = lane.as_ref().map(|(_, path, _)| path.ray);
         }
         if lanes.iter().all(Option::is_none) {
             return;
         }
+        // The rays where the step wrote them, borrowed, not copied (a copy
+        // read back at once stalled on its stores: 10% of the step, perf).
+        let rays: [Option<&Ray>; LANES] = std::array::from_fn(|l| lanes[l].as_ref().map(|(_, path, _)| &path.ray));
         scene.accel.intersect_packet(&rays, &mut hits);
-        for (lane, hit) in lanes.iter_mut().zip(hits) {
+        for (lane, hit) in lanes.iter_mut().zip(&hits) {
             let Some((k, path, sampler)) = lane else { continue };
-            if !advance(scene, settings, path, hit, sampler) {
+            if !advance(scene, settings, path, hit.as_ref(), sampler) {
                 out[*k] = path.l;
                 *lane = None;
             }

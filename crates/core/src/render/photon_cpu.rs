@@ -218,7 +218,7 @@ impl<'a> PhotonCpuRenderer<'a> {
             _ => Rgb::ZERO,
         };
         // The material with its textures, looked up once for this point.
-        let material = self.scene.material_at(hit);
+        let material = &*self.scene.material_at(hit);
         if matches!(material, Material::Emitter) {
             return emitted;
         }

@@ -21,6 +21,7 @@ use crate::camera::Camera;
 use crate::geometry::{Accel, Hit};
 use crate::light::Light;
 use crate::material::{Material, mean};
+use std::borrow::Cow;
 use std::path::Path;
 
 /// One object of the scene: its material and, for area lights, which light.
@@ -146,13 +147,16 @@ impl Scene {
     }
 
     /// The material at the point hit, its textures looked up there (pbrt's
-    /// `MaterialEvalContext`): what the CPU renderers shade with.
-    pub fn material_at(&self, hit: &Hit) -> Material {
+    /// `MaterialEvalContext`): what the CPU renderers shade with. Borrowed
+    /// where nothing is textured: a copy just made and read back at once
+    /// stalls the load on its store (the path tracer's step spent 5% of its
+    /// time on one such load, perf).
+    pub fn material_at(&self, hit: &Hit) -> Cow<'_, Material> {
         let index = self.surfaces[hit.surface as usize].material;
-        let material = self.materials[index as usize];
+        let material = &self.materials[index as usize];
         match &self.texturing {
-            Some(t) => t.apply(material, index, hit.prim, hit.barycentrics),
-            None => material,
+            Some(t) => Cow::Owned(t.apply(*material, index, hit.prim, hit.barycentrics)),
+            None => Cow::Borrowed(material),
         }
     }
 

@@ -31,7 +31,7 @@ fn down_at(x: f32, y: f32) -> Ray {
 
 fn albedo_at(scene: &Scene, x: f32, y: f32) -> f32 {
     let hit = scene.accel.intersect(&down_at(x, y)).expect("the quad");
-    match scene.material_at(&hit) {
+    match *scene.material_at(&hit) {
         Material::Diffuse { albedo, .. } => {
             assert!(albedo.x == albedo.y && albedo.y == albedo.z, "{albedo}");
             albedo.x
@@ -105,7 +105,7 @@ fn metallic_roughness_texture_channels_reach_the_brdf() {
     let node = quad(&mut b, Vec3::new(0.0, 1.0, 0.0), Vec3::X, -Vec3::Y, 1.0, m);
     let scene = load("mr", &b.to_glb(vec![node]));
     let hit = scene.accel.intersect(&down_at(0.5, 0.5)).unwrap();
-    let Material::Pbr(bsdf) = scene.material_at(&hit) else { panic!("{:?}", scene.material_at(&hit)) };
+    let Material::Pbr(bsdf) = *scene.material_at(&hit) else { panic!("{:?}", scene.material_at(&hit)) };
     assert!((bsdf.metallic - 0.2).abs() < 1e-6, "metallic 1 × B (51/255): {}", bsdf.metallic);
     assert!((bsdf.roughness - 0.5 * 128.0 / 255.0).abs() < 1e-6, "roughness 0.5 × G (linear): {}", bsdf.roughness);
     assert_eq!(bsdf.base_color, Vec3::splat(0.8));
