@@ -25,15 +25,10 @@ pub(super) fn load3(rows: &[[f32; 8]; 3]) -> V3 {
     unsafe { [_mm256_loadu_ps(rows[0].as_ptr()), _mm256_loadu_ps(rows[1].as_ptr()), _mm256_loadu_ps(rows[2].as_ptr())] }
 }
 
-/// A direction component that the slab test may invert: zero becomes
-/// ±1e-20, so it never sees 0·∞. One ray's three components are inverted
-/// as scalars (`wide`; in eight lanes that was slower), a packet's eight
-/// rays' by [`inverse_direction`], the same rule.
-pub(super) fn slab_safe(d: f32) -> f32 {
-    if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d }
-}
-
-/// 1 / [`slab_safe`] of eight direction components at once.
+/// 1 / each of eight direction components, for the slab test: a
+/// component under 1e-20 in magnitude counts as ±1e-20 (its sign kept), so
+/// the test never sees 0·∞. A packet inverts its eight rays' components,
+/// a single ray its three in one division (`wide`).
 #[target_feature(enable = "avx2")]
 #[inline]
 pub(super) fn inverse_direction(d: __m256) -> __m256 {
@@ -103,6 +98,11 @@ pub(super) fn triangle(origin: V3, dir: V3, a: V3, e1: V3, e2: V3, t_min: f32, t
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rule as scalar code.
+    fn slab_safe(d: f32) -> f32 {
+        if d.abs() < 1e-20 { 1e-20f32.copysign(d) } else { d }
+    }
 
     /// The eight-lane inverse is the scalar rule's, bit for bit, on the
     /// components that matter: zeros of both signs, values either side of
