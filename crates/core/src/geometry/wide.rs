@@ -195,7 +195,8 @@ pub(super) mod avx2 {
     fn broadcast(ray: &Ray) -> Broadcast {
         // One 4-byte load per component: the caller has usually just
         // written the ray, and a wider load across its stores waits for
-        // them to reach the cache (8% of the query, perf).
+        // them to reach the cache (perf put 8% of the query's samples on
+        // that load; the whole change gained 1.5% of wall time).
         let splat = |v: &glam::Vec3| [_mm256_broadcast_ss(&v.x), _mm256_broadcast_ss(&v.y), _mm256_broadcast_ss(&v.z)];
         let dir = splat(&ray.dir);
         // One division for the three components: lanes (x, y, z, x, ...).
