@@ -6,6 +6,7 @@
 
 #[cfg(test)]
 pub(crate) mod chi2;
+pub mod cosine8;
 mod equiangular;
 mod rng;
 mod sobol;
