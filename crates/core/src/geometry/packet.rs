@@ -60,7 +60,7 @@ pub(super) mod avx2 {
     use super::{LANES, LaneHits};
     use crate::geometry::Ray;
     use crate::geometry::simd8;
-    use crate::geometry::wide::{LEAF, STACK, WIDTH, WideBvh};
+    use crate::geometry::wide::{Block, LEAF, STACK, WIDTH, WideBvh, WideNode};
     use std::arch::x86_64::*;
     use std::borrow::Borrow;
 
@@ -115,24 +115,37 @@ pub(super) mod avx2 {
         (lanes, t_max)
     }
 
-    /// Lanes whose ray meets the node's box before `t_max`.
+    /// Each child of `node` whose box one of `lanes` meets before its
+    /// `t_max`, in stored order: `visit(child, the lanes that meet it as
+    /// bits)`.
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn slab(r: &Lanes, min: [f32; 3], max: [f32; 3], t_max: __m256) -> __m256 {
-        let (_, hit) =
-            simd8::slab(simd8::splat3(min), simd8::splat3(max), [r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz], t_max);
-        _mm256_and_ps(hit, r.active)
+    fn children_met(r: &Lanes, node: &WideNode, t_max: __m256, lanes: __m256, mut visit: impl FnMut(u32, u32)) {
+        let mut bits = u32::from(node.valid);
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let lo = simd8::splat3([node.lo[0][i], node.lo[1][i], node.lo[2][i]]);
+            let hi = simd8::splat3([node.hi[0][i], node.hi[1][i], node.hi[2][i]]);
+            let (_, hit) = simd8::slab(lo, hi, [r.ox, r.oy, r.oz], [r.ix, r.iy, r.iz], t_max);
+            let meet = _mm256_movemask_ps(_mm256_and_ps(hit, lanes)) as u32;
+            if meet != 0 {
+                visit(node.child[i], meet);
+            }
+        }
     }
 
-    /// Möller–Trumbore against all lanes (`simd8::triangle`, the same t
-    /// to the bit as `PackedPrim::intersect`): (hit mask, t, b1, b2).
+    /// Möller–Trumbore of `lanes` against the triangle in lane `k` of
+    /// `block` (`simd8::triangle`, the same t to the bit as
+    /// `PackedPrim::intersect`): (hit mask, t, b1, b2).
     #[target_feature(enable = "avx2")]
     #[inline]
-    fn triangle(r: &Lanes, a: [f32; 3], e1: [f32; 3], e2: [f32; 3], eps: f32, t_max: __m256) -> [__m256; 4] {
+    fn triangle(r: &Lanes, block: &Block, k: usize, eps: f32, t_max: __m256, lanes: __m256) -> [__m256; 4] {
+        let corner = |v: &[[f32; WIDTH]; 3]| simd8::splat3([v[0][k], v[1][k], v[2][k]]);
         let (origin, dir) = ([r.ox, r.oy, r.oz], [r.dx, r.dy, r.dz]);
         let [ok, t, b1, b2] =
-            simd8::triangle(origin, dir, simd8::splat3(a), simd8::splat3(e1), simd8::splat3(e2), eps, t_max);
-        [_mm256_and_ps(ok, r.active), t, b1, b2]
+            simd8::triangle(origin, dir, corner(&block.a), corner(&block.e1), corner(&block.e2), eps, t_max);
+        [_mm256_and_ps(ok, lanes), t, b1, b2]
     }
 
     /// Closest hits of the packet's rays through the wide BVH. `single`
@@ -162,19 +175,10 @@ pub(super) mod avx2 {
                 // along the packet's summed direction (an insertion sort)
                 // mispredicted more than it culled (cachegrind: +3.7%
                 // cycles a path on the Cornell box, +2.5% on showcase.glb).
-                let node = &bvh.nodes[current as usize];
-                let mut bits = u32::from(node.valid);
-                while bits != 0 {
-                    let i = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    let lo = [node.lo[0][i], node.lo[1][i], node.lo[2][i]];
-                    let hi = [node.hi[0][i], node.hi[1][i], node.hi[2][i]];
-                    if _mm256_movemask_ps(slab(&r, lo, hi, t_max)) == 0 {
-                        continue;
-                    }
-                    pending[top] = MaybeUninit::new(node.child[i]);
+                children_met(&r, &bvh.nodes[current as usize], t_max, r.active, |child, _| {
+                    pending[top] = MaybeUninit::new(child);
                     top += 1;
-                }
+                });
             } else {
                 let mut b = (current & !LEAF) as usize;
                 loop {
@@ -209,10 +213,7 @@ pub(super) mod avx2 {
                             }
                             continue;
                         }
-                        let a = [block.a[0][lane], block.a[1][lane], block.a[2][lane]];
-                        let e1 = [block.e1[0][lane], block.e1[1][lane], block.e1[2][lane]];
-                        let e2 = [block.e2[0][lane], block.e2[1][lane], block.e2[2][lane]];
-                        let [ok, t, b1, b2] = triangle(&r, a, e1, e2, eps, t_max);
+                        let [ok, t, b1, b2] = triangle(&r, block, lane, eps, t_max, r.active);
                         t_max = _mm256_blendv_ps(t_max, t, ok);
                         b1s = _mm256_blendv_ps(b1s, b1, ok);
                         b2s = _mm256_blendv_ps(b2s, b2, ok);
@@ -239,5 +240,86 @@ pub(super) mod avx2 {
             _mm256_storeu_ps(out.b2.as_mut_ptr(), b2s);
         }
         out
+    }
+
+    /// Eight bits, lane l's set where bit l of `bits` is.
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    fn lane_mask(bits: u32) -> __m256 {
+        let each = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        let set = _mm256_and_si256(_mm256_set1_epi32(bits as i32), each);
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, each))
+    }
+
+    /// Which of the packet's rays something blocks in (`eps`, t_max): bit
+    /// l for lane l. Each lane goes down exactly the nodes a single ray
+    /// would (a child is entered with the lanes that meet its box), so it
+    /// tests the same triangles with the same arithmetic and gets
+    /// [`wide::avx2::occluded`](crate::geometry::wide)'s answer; a lane
+    /// stops at its first blocker, the packet when every lane has one.
+    /// `single` tests one lane's ray against a sphere or cut-out.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2.
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn occluded<R: Borrow<Ray>>(
+        bvh: &WideBvh,
+        rays: &[Option<R>; LANES],
+        eps: f32,
+        single: impl Fn(usize, &Ray) -> bool,
+    ) -> u32 {
+        use std::mem::MaybeUninit;
+        let (r, t_max) = load(rays);
+        // SAFETY: `t_max` holds LANES = 8 floats.
+        let t_max_lanes = unsafe { _mm256_loadu_ps(t_max.as_ptr()) };
+        let active = _mm256_movemask_ps(r.active) as u32;
+        let mut blocked = 0u32;
+        // (node or leaf, lanes that reached it)
+        let mut pending = [MaybeUninit::<(u32, u32)>::uninit(); STACK];
+        let (mut top, mut current, mut reached) = (0usize, 0u32, active);
+        loop {
+            let live = reached & !blocked;
+            if live != 0 && current & LEAF == 0 {
+                children_met(&r, &bvh.nodes[current as usize], t_max_lanes, lane_mask(live), |child, meet| {
+                    pending[top] = MaybeUninit::new((child, meet));
+                    top += 1;
+                });
+            } else if live != 0 {
+                let mut b = (current & !LEAF) as usize;
+                'leaf: loop {
+                    let block = &bvh.blocks[b];
+                    for lane in 0..WIDTH {
+                        let k = block.prim[lane];
+                        let live = reached & !blocked;
+                        if k == u32::MAX || live == 0 {
+                            break 'leaf;
+                        }
+                        if block.single & (1 << lane) != 0 {
+                            for (l, ray) in rays.iter().enumerate().filter(|(l, _)| live & (1 << l) != 0) {
+                                if ray.as_ref().is_some_and(|ray| single(k as usize, ray.borrow())) {
+                                    blocked |= 1 << l;
+                                }
+                            }
+                            continue;
+                        }
+                        let [ok, ..] = triangle(&r, block, lane, eps, t_max_lanes, lane_mask(live));
+                        blocked |= _mm256_movemask_ps(ok) as u32;
+                    }
+                    if !block.continues {
+                        break;
+                    }
+                    b += 1;
+                }
+                if blocked == active {
+                    return blocked;
+                }
+            }
+            if top == 0 {
+                return blocked;
+            }
+            top -= 1;
+            // SAFETY: entries below `top` are written.
+            (current, reached) = unsafe { pending[top].assume_init() };
+        }
     }
 }

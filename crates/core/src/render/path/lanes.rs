@@ -11,8 +11,11 @@
 //! polynomials and frame), and a chain overlapped little more than the
 //! next lane's: perf found 45% of the step's time waiting at their ends.
 //! Here the two chains run for the eight lanes at once in AVX2
-//! (`point_light`, `sampling::cosine8`); the sampler's numbers, the
-//! shadow rays and the bookkeeping stay lane by lane.
+//! (`point_light`, `sampling::cosine8`), and the shadow rays toward a
+//! light go through the BVH as one packet (`Accel::occluded_packet`:
+//! shadow rays from a packet's vertices converge on the light, so they
+//! share most of their nodes; one thread, -11% of the Cornell box's wall
+//! time). The sampler's numbers and the bookkeeping stay lane by lane.
 //!
 //! Same numbers: the vector code is the scalar maths operation for
 //! operation (Rust never fuses or reorders float operations, and vector
@@ -147,9 +150,12 @@ impl DiffuseLanes {
             for (lit, taken) in lit.iter_mut().zip(&self.taken) {
                 *lit &= taken;
             }
-            for (i, lit) in lit.iter_mut().enumerate().filter(|(_, lit)| **lit) {
-                let shadow = Ray { t_max: t_max[i], ..Ray::new(get(&self.point, i), get(&wi, i)) };
-                *lit = !scene.accel.occluded(&shadow);
+            let shadow_rays: [Option<Ray>; LANES] = std::array::from_fn(|i| {
+                lit[i].then(|| Ray { t_max: t_max[i], ..Ray::new(get(&self.point, i), get(&wi, i)) })
+            });
+            let blocked = scene.accel.occluded_packet(&shadow_rays);
+            for (i, lit) in lit.iter_mut().enumerate() {
+                *lit &= blocked & (1 << i) == 0;
             }
             for i in 0..LANES {
                 let s = get(&sum, i);

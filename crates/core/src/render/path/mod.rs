@@ -229,8 +229,9 @@ fn advance(
 }
 
 /// Runs paths `0..out.len()` eight at a time, their closest hits found in
-/// packets (`Accel::intersect_packet`; shadow rays stay single: in packets
-/// they saved little). `start(k)` makes path k's camera ray and sampler;
+/// packets (`Accel::intersect_packet`; the lane step casts its shadow rays
+/// in packets too, the scalar step one at a time). `start(k)` makes path
+/// k's camera ray and sampler;
 /// `out[k]` receives its radiance. A lane whose path ends takes the next.
 fn trace_in_packets<S: Sampler>(
     scene: &Scene,
