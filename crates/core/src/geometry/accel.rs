@@ -297,7 +297,9 @@ impl Accel {
             // SAFETY: a WideBvh exists only where the CPU has AVX2.
             let (t, k, b1, b2) = unsafe { super::wide::avx2::closest(wide, ray, eps, single) }?;
             let prim = (wide.prims[k as usize].prim & INDEX_BITS) as usize;
-            return Some(self.hit_record(ray, t, prim, b1, b2));
+            let mut hit = None;
+            self.hit_record(ray, t, prim, b1, b2, &mut hit);
+            return hit;
         }
         self.intersect_cwbvh(ray)
     }
@@ -326,17 +328,23 @@ impl Accel {
         if best.0 == u32::MAX {
             return None;
         }
-        Some(self.hit_record(ray, prim_ray.t_max, best.0 as usize, best.1, best.2))
+        let mut hit = None;
+        self.hit_record(ray, prim_ray.t_max, best.0 as usize, best.1, best.2, &mut hit);
+        hit
     }
 
     /// The hit of `ray` at `t` on primitive `prim` (joint index space) at
-    /// barycentrics (b1, b2). Never inlined: inlined into the path
-    /// tracer's step, the hit went through two temporaries, each copied with
-    /// wider loads than its stores, and the copies stalled (perf put 7% of
-    /// the step's samples there; -3.9% wall time without them). The caller
-    /// still copies the returned hit once, which costs nothing measurable.
+    /// barycentrics (b1, b2), written into `out`. Never inlined: inlined
+    /// into the path tracer's step, the hit went through two temporaries,
+    /// each copied with wider loads than its stores, and the copies
+    /// stalled (perf put 7% of the step's samples there; -3.9% wall time
+    /// without them). Written in place, not returned: the packet's caller
+    /// copied a returned hit into its `Option` with 8- and 16-byte loads
+    /// over this function's 4-byte stores, and waited on them (perf: 11%
+    /// of `trace_in_packets`' samples after the lane step and packet
+    /// shadow rays; -1.6% wall).
     #[inline(never)]
-    fn hit_record(&self, ray: &Ray, t: f32, prim: usize, b1: f32, b2: f32) -> Hit {
+    fn hit_record(&self, ray: &Ray, t: f32, prim: usize, b1: f32, b2: f32, out: &mut Option<Hit>) {
         let point = ray.at(t);
         let info = self.info[prim];
         let (geometric_normal, shading_normal) = if prim >= self.triangles.len() {
@@ -351,7 +359,7 @@ impl Accel {
         } else {
             (info.normal, info.normal)
         };
-        Hit {
+        *out = Some(Hit {
             t,
             point,
             geometric_normal,
@@ -359,7 +367,7 @@ impl Accel {
             surface: info.surface,
             prim: prim as u32,
             barycentrics: Vec2::new(b1, b2),
-        }
+        });
     }
 
     /// The wide BVH, built on first use.
@@ -399,10 +407,12 @@ impl Accel {
             for (l, ray) in rays.iter().enumerate() {
                 let Some(ray) = ray.as_ref().map(R::borrow) else { continue };
                 let k = lanes.prim[l];
-                hits[l] = (k != u32::MAX).then(|| {
+                if k == u32::MAX {
+                    hits[l] = None;
+                } else {
                     let prim = (bvh.prims[k as usize].prim & INDEX_BITS) as usize;
-                    self.hit_record(ray, lanes.t[l], prim, lanes.b1[l], lanes.b2[l])
-                });
+                    self.hit_record(ray, lanes.t[l], prim, lanes.b1[l], lanes.b2[l], &mut hits[l]);
+                }
             }
             return;
         }
