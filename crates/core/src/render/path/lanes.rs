@@ -46,10 +46,13 @@ fn put(a: &mut Lanes3, i: usize, v: Vec3) {
 }
 
 /// A scene the lane step serves (no media, no textures, only point
-/// lights), with its point lights.
+/// lights), with its point lights and the surfaces it takes.
 pub(super) struct LaneStep {
     /// (position, intensity) of each light, in the scene's order.
     lights: Vec<(Vec3, Rgb)>,
+    /// Each surface's albedo where the lane step takes its vertices: a
+    /// diffuse material without a mirror part, not black, not emissive.
+    albedo: Vec<Option<Rgb>>,
 }
 
 impl LaneStep {
@@ -62,20 +65,18 @@ impl LaneStep {
             Light::Point { position, intensity } => Some((position, intensity)),
             _ => None,
         });
-        Some(LaneStep { lights: lights.collect::<Option<_>>()? })
-    }
-
-    /// The albedo at `hit` where the lane step takes the vertex: a diffuse
-    /// material without a mirror part, not black, not emissive.
-    pub fn albedo_at(&self, scene: &Scene, hit: &Hit) -> Option<Rgb> {
-        let surface = &scene.surfaces[hit.surface as usize];
-        if surface.emitter.is_some() {
-            return None;
-        }
-        match scene.materials[surface.material as usize] {
+        let lights = lights.collect::<Option<_>>()?;
+        let albedo = scene.surfaces.iter().map(|surface| match scene.materials[surface.material as usize] {
+            _ if surface.emitter.is_some() => None,
             Material::Diffuse { albedo, specular } if specular == Rgb::ZERO && mean(albedo) > 0.0 => Some(albedo),
             _ => None,
-        }
+        });
+        Some(LaneStep { lights, albedo: albedo.collect() })
+    }
+
+    /// The albedo at `hit` where the lane step takes the vertex.
+    pub fn albedo_at(&self, hit: &Hit) -> Option<Rgb> {
+        self.albedo[hit.surface as usize]
     }
 }
 
@@ -167,12 +168,12 @@ impl DiffuseLanes {
             let (albedo, mut beta) = (get(&self.albedo, i), get(&self.beta, i));
             let l = get(&self.l, i) + beta * get(&sum, i);
             put(&mut self.l, i, l);
-            // The diffuse lobe, chosen with probability 1 (no mirror part).
-            let (p_d, p_s) = (mean(albedo), 0.0);
-            let p_diffuse = p_d / (p_d + p_s);
-            beta *= albedo / p_diffuse;
+            // The diffuse lobe, chosen with probability p_d / (p_d + 0) = 1
+            // exactly (x / x is 1 in IEEE arithmetic for x finite, not 0),
+            // so dividing by it and multiplying by it change no bit.
+            beta *= albedo;
             let (n, dir) = (get(&ns, i), get(&dirs, i));
-            self.pdf[i] = p_diffuse * dir.dot(n).max(0.0) / PI;
+            self.pdf[i] = dir.dot(n).max(0.0) / PI;
             // `survives_roulette`.
             let survive = beta.max_element().min(0.95);
             let dies = self.roulette[i] && self.xi[i] >= survive;

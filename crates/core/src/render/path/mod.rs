@@ -268,7 +268,7 @@ fn trace_in_packets<S: Sampler>(
         for (l, (lane, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
             let Some((k, path, sampler)) = lane else { continue };
             if let (Some(step), Some(hit)) = (&lane_step, hit)
-                && let Some(albedo) = step.albedo_at(scene, hit)
+                && let Some(albedo) = step.albedo_at(hit)
             {
                 diffuse.take(l, path, hit, albedo, sampler);
             } else if !advance(scene, settings, path, hit.as_ref(), sampler) {
