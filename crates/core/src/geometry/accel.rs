@@ -6,7 +6,7 @@
 //! Primitives are addressed by one index space: triangles first, then spheres.
 //! Each primitive carries the id of the surface (object) it belongs to.
 
-use super::packet::LANES;
+use super::packet::{LANES, RayLanes};
 use super::wide::WideBvh;
 use super::{Ray, Sphere, Triangle};
 use crate::texture::Texturing;
@@ -437,10 +437,10 @@ impl Accel {
         self.occluded_cwbvh(ray)
     }
 
-    /// Which of up to `LANES` rays something blocks (bit l for lane l;
-    /// None lanes are clear): [`Accel::occluded`] lane by lane, in one
+    /// Which of a packet's rays something blocks (bit l for lane l;
+    /// inactive lanes are clear): [`Accel::occluded`] lane by lane, in one
     /// packet where the CPU runs packets (`geometry::packet`).
-    pub fn occluded_packet<R: Borrow<Ray>>(&self, rays: &[Option<R>; LANES]) -> u32 {
+    pub fn occluded_packet(&self, rays: &RayLanes) -> u32 {
         #[cfg(target_arch = "x86_64")]
         if let Some(wide) = self.wide_bvh() {
             let eps = self.epsilon;
@@ -448,8 +448,8 @@ impl Accel {
             // SAFETY: a WideBvh exists only where the CPU has AVX2.
             return unsafe { super::packet::avx2::occluded(wide, rays, eps, single) };
         }
-        let blocked = rays.iter().map(|ray| ray.as_ref().is_some_and(|ray| self.occluded(ray.borrow())));
-        blocked.enumerate().fold(0, |bits, (l, b)| bits | u32::from(b) << l)
+        let active = (0..LANES).filter(|l| rays.active & (1 << l) != 0);
+        active.filter(|&l| self.occluded(&rays.ray(l))).fold(0, |bits, l| bits | 1 << l)
     }
 
     /// [`Accel::occluded`] through the CWBVH.
@@ -531,7 +531,7 @@ mod tests {
             });
             let mut hits = [None; LANES];
             accel.intersect_packet(&lanes, &mut hits);
-            let blocked = accel.occluded_packet(&lanes);
+            let blocked = accel.occluded_packet(&RayLanes::gather(&lanes));
             for l in 0..LANES {
                 let single = lanes[l].is_some_and(|r| accel.occluded(&r));
                 assert_eq!(blocked & (1 << l) != 0, single, "lane {l}: {:?}", lanes[l]);
@@ -609,7 +609,7 @@ mod tests {
             let (mut blocked, mut clear) = (0, 0);
             for chunk in shadow_rays.chunks(LANES) {
                 let lanes: [Option<&Ray>; LANES] = std::array::from_fn(|l| chunk.get(l));
-                let bits = scene.accel.occluded_packet(&lanes);
+                let bits = scene.accel.occluded_packet(&RayLanes::gather(&lanes));
                 for (l, ray) in chunk.iter().enumerate() {
                     assert_eq!(bits & (1 << l) != 0, scene.accel.occluded(ray), "{name} lane {l}: {ray:?}");
                     if scene.accel.occluded(ray) { blocked += 1 } else { clear += 1 }

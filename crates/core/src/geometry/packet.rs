@@ -26,6 +26,9 @@
 // Elsewhere than on x86-64 the traversal is compiled out.
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 
+use super::Ray;
+use std::borrow::Borrow;
+
 /// Rays per packet.
 pub const LANES: usize = 8;
 
@@ -52,12 +55,45 @@ pub(super) struct LaneHits {
     pub b2: [f32; LANES],
 }
 
+/// A packet's rays component by component: lane l holds the ray
+/// `origin + t·dir`, t < `t_max[l]`, where bit l of `active` is set.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RayLanes {
+    pub origin: [[f32; LANES]; 3],
+    pub dir: [[f32; LANES]; 3],
+    pub t_max: [f32; LANES],
+    pub active: u32,
+}
+
+impl RayLanes {
+    /// The rays of the lanes that hold one.
+    pub fn gather<R: Borrow<Ray>>(rays: &[Option<R>; LANES]) -> RayLanes {
+        let mut lanes = RayLanes::default();
+        for (l, ray) in rays.iter().enumerate() {
+            let Some(ray) = ray.as_ref().map(R::borrow) else { continue };
+            let (o, d) = (ray.origin, ray.dir);
+            for (k, (o, d)) in [(o.x, d.x), (o.y, d.y), (o.z, d.z)].into_iter().enumerate() {
+                (lanes.origin[k][l], lanes.dir[k][l]) = (o, d);
+            }
+            lanes.t_max[l] = ray.t_max;
+            lanes.active |= 1 << l;
+        }
+        lanes
+    }
+
+    /// Lane l's ray.
+    pub fn ray(&self, l: usize) -> Ray {
+        let component = |c: &[[f32; LANES]; 3]| glam::Vec3::new(c[0][l], c[1][l], c[2][l]);
+        Ray { t_max: self.t_max[l], ..Ray::new(component(&self.origin), component(&self.dir)) }
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2 {
     //! The traversal in AVX2 intrinsics; callers must have checked
     //! `avx2_available` (a `WideBvh` exists only where it holds).
 
-    use super::{LANES, LaneHits};
+    use super::{LANES, LaneHits, RayLanes};
     use crate::geometry::Ray;
     use crate::geometry::simd8;
     use crate::geometry::wide::{Block, LEAF, STACK, WIDTH, WideBvh, WideNode};
@@ -79,40 +115,28 @@ pub(super) mod avx2 {
         active: __m256,
     }
 
+    /// A packet's rays in registers, and their t_max. An inactive lane's
+    /// direction is (1, 1, 1), so that its inverse is finite.
     #[target_feature(enable = "avx2")]
-    fn load<R: Borrow<Ray>>(rays: &[Option<R>; LANES]) -> (Lanes, [f32; LANES]) {
-        let mut c = [[0.0f32; LANES]; 6];
-        let mut t_max = [0.0f32; LANES];
-        let mut active = [0.0f32; LANES];
-        for (lane, ray) in rays.iter().enumerate() {
-            let Some(r) = ray.as_ref().map(R::borrow) else {
-                for component in &mut c[3..] {
-                    component[lane] = 1.0;
-                }
-                continue;
-            };
-            let v = [r.origin.x, r.origin.y, r.origin.z, r.dir.x, r.dir.y, r.dir.z];
-            for k in 0..6 {
-                c[k][lane] = v[k];
-            }
-            t_max[lane] = r.t_max;
-            active[lane] = f32::from_bits(u32::MAX);
-        }
-        // SAFETY: each array holds LANES = 8 floats.
+    fn load(rays: &RayLanes) -> (Lanes, __m256) {
+        let active = lane_mask(rays.active);
+        // SAFETY: each row holds LANES = 8 floats.
         let ld = |a: &[f32; LANES]| unsafe { _mm256_loadu_ps(a.as_ptr()) };
+        let dir = |k: usize| _mm256_blendv_ps(_mm256_set1_ps(1.0), ld(&rays.dir[k]), active);
+        let (dx, dy, dz) = (dir(0), dir(1), dir(2));
         let lanes = Lanes {
-            ox: ld(&c[0]),
-            oy: ld(&c[1]),
-            oz: ld(&c[2]),
-            dx: ld(&c[3]),
-            dy: ld(&c[4]),
-            dz: ld(&c[5]),
-            ix: simd8::inverse_direction(ld(&c[3])),
-            iy: simd8::inverse_direction(ld(&c[4])),
-            iz: simd8::inverse_direction(ld(&c[5])),
-            active: ld(&active),
+            ox: ld(&rays.origin[0]),
+            oy: ld(&rays.origin[1]),
+            oz: ld(&rays.origin[2]),
+            dx,
+            dy,
+            dz,
+            ix: simd8::inverse_direction(dx),
+            iy: simd8::inverse_direction(dy),
+            iz: simd8::inverse_direction(dz),
+            active,
         };
-        (lanes, t_max)
+        (lanes, ld(&rays.t_max))
     }
 
     /// Each child of `node` whose box one of `lanes` meets before its
@@ -162,9 +186,7 @@ pub(super) mod avx2 {
         single: impl Fn(usize, &Ray) -> Option<(f32, f32, f32)>,
     ) -> LaneHits {
         use std::mem::MaybeUninit;
-        let (r, t_max0) = load(rays);
-        // SAFETY (all loads and stores below): arrays of LANES = 8 lanes.
-        let mut t_max = unsafe { _mm256_loadu_ps(t_max0.as_ptr()) };
+        let (r, mut t_max) = load(&RayLanes::gather(rays));
         let mut prim = _mm256_set1_epi32(-1);
         let (mut b1s, mut b2s) = (_mm256_setzero_ps(), _mm256_setzero_ps());
         let mut pending = [MaybeUninit::<u32>::uninit(); STACK];
@@ -262,17 +284,10 @@ pub(super) mod avx2 {
     /// # Safety
     /// The CPU must have AVX2.
     #[target_feature(enable = "avx2")]
-    pub unsafe fn occluded<R: Borrow<Ray>>(
-        bvh: &WideBvh,
-        rays: &[Option<R>; LANES],
-        eps: f32,
-        single: impl Fn(usize, &Ray) -> bool,
-    ) -> u32 {
+    pub unsafe fn occluded(bvh: &WideBvh, rays: &RayLanes, eps: f32, single: impl Fn(usize, &Ray) -> bool) -> u32 {
         use std::mem::MaybeUninit;
-        let (r, t_max) = load(rays);
-        // SAFETY: `t_max` holds LANES = 8 floats.
-        let t_max_lanes = unsafe { _mm256_loadu_ps(t_max.as_ptr()) };
-        let active = _mm256_movemask_ps(r.active) as u32;
+        let (r, t_max_lanes) = load(rays);
+        let active = rays.active & 0xff;
         let mut blocked = 0u32;
         // (node or leaf, lanes that reached it)
         let mut pending = [MaybeUninit::<(u32, u32)>::uninit(); STACK];
@@ -295,8 +310,8 @@ pub(super) mod avx2 {
                             break 'leaf;
                         }
                         if block.single & (1 << lane) != 0 {
-                            for (l, ray) in rays.iter().enumerate().filter(|(l, _)| live & (1 << l) != 0) {
-                                if ray.as_ref().is_some_and(|ray| single(k as usize, ray.borrow())) {
+                            for l in (0..LANES).filter(|l| live & (1 << l) != 0) {
+                                if single(k as usize, &rays.ray(l)) {
                                     blocked |= 1 << l;
                                 }
                             }

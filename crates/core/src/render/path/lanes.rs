@@ -27,7 +27,7 @@
 //! `the_lane_step_gives_the_scalar_steps_image`).
 
 use super::{PathState, Previous};
-use crate::geometry::packet::LANES;
+use crate::geometry::packet::{LANES, RayLanes};
 use crate::geometry::{Hit, Ray};
 use crate::light::Light;
 use crate::material::{Material, Rgb, mean};
@@ -151,9 +151,8 @@ impl DiffuseLanes {
             for (lit, taken) in lit.iter_mut().zip(&self.taken) {
                 *lit &= taken;
             }
-            let shadow_rays: [Option<Ray>; LANES] = std::array::from_fn(|i| {
-                lit[i].then(|| Ray { t_max: t_max[i], ..Ray::new(get(&self.point, i), get(&wi, i)) })
-            });
+            let active = lit.iter().rev().fold(0, |bits, &lit| bits << 1 | u32::from(lit));
+            let shadow_rays = RayLanes { origin: self.point, dir: wi, t_max, active };
             let blocked = scene.accel.occluded_packet(&shadow_rays);
             for (i, lit) in lit.iter_mut().enumerate() {
                 *lit &= blocked & (1 << i) == 0;
