@@ -483,13 +483,20 @@ impl Light {
         }
     }
 
+    /// The fraction of its intensity a spot light sends toward `point`
+    /// (Mitsuba's falloff; 0 outside its cone); 1 for any other light.
+    pub fn falloff_toward(&self, point: Vec3) -> f32 {
+        let Light::Spot { position, axis, cutoff, falloff_start, .. } = *self else { return 1.0 };
+        let to_point = (point - position).normalize_or_zero();
+        spot_falloff(to_point.dot(axis).clamp(-1.0, 1.0).acos(), cutoff, falloff_start)
+    }
+
     /// Samples light arriving at `point`. None if this sample carries nothing.
     pub fn sample_incident(&self, point: Vec3, u: Vec2) -> Option<LightSample> {
         match *self {
             Light::Point { position, intensity } => delta_sample(point, position, intensity),
-            Light::Spot { position, axis, intensity, cutoff, falloff_start } => {
-                let to_point = (point - position).normalize_or_zero();
-                let f = spot_falloff(to_point.dot(axis).clamp(-1.0, 1.0).acos(), cutoff, falloff_start);
+            Light::Spot { position, intensity, .. } => {
+                let f = self.falloff_toward(point);
                 if f <= 0.0 {
                     return None;
                 }

@@ -1,6 +1,7 @@
 //! The path step for a packet's lanes side by side, in structure-of-arrays
 //! form, where a lane's vertex is the common case: a plain diffuse surface
-//! in a scene without media or textures, lit by point lights. Other
+//! in a scene without media or textures, lit by point and spot lights
+//! (a spot is a point light whose intensity falls off by direction). Other
 //! vertices take the scalar step (`advance`).
 //!
 //! Why: against Mitsuba on the Cornell box (perf, one thread), hikari's
@@ -48,11 +49,11 @@ fn put(a: &mut Lanes3, i: usize, v: Vec3) {
     (a[0][i], a[1][i], a[2][i]) = (v.x, v.y, v.z);
 }
 
-/// A scene the lane step serves (no media, no textures, only point
-/// lights), with its point lights and the surfaces it takes.
+/// A scene the lane step serves (no media, no textures, only point and
+/// spot lights), with its lights and the surfaces it takes.
 pub(super) struct LaneStep {
-    /// (position, intensity) of each light, in the scene's order.
-    lights: Vec<(Vec3, Rgb)>,
+    /// Each light with its position and intensity, in the scene's order.
+    lights: Vec<(Light, Vec3, Rgb)>,
     /// Each surface's albedo where the lane step takes its vertices: a
     /// diffuse material without a mirror part, not black, not emissive.
     albedo: Vec<Option<Rgb>>,
@@ -65,7 +66,9 @@ impl LaneStep {
             return None;
         }
         let lights = scene.lights.iter().map(|light| match *light {
-            Light::Point { position, intensity } => Some((position, intensity)),
+            Light::Point { position, intensity } | Light::Spot { position, intensity, .. } => {
+                Some((light.clone(), position, intensity))
+            }
             _ => None,
         });
         let lights = lights.collect::<Option<_>>()?;
@@ -135,19 +138,28 @@ impl DiffuseLanes {
         self.taken[l]
     }
 
-    /// The taken lanes' vertices: light from each point light, the
+    /// The taken lanes' vertices: light from each point or spot light, the
     /// cosine-distributed bounce, the roulette. Lanes not taken compute
     /// on whatever they hold and are never read.
     pub fn step(&mut self, scene: &Scene, step: &LaneStep, max_depth: u32) {
         let [ng, ns] = facing_normals(&self.dir, &self.geometric_normal, &self.shading_normal);
-        // Next-event estimation (`next_event` for point lights: density
+        // Next-event estimation (`next_event` for point and spot lights: density
         // 1, MIS weight 1, transmittance 1).
         let mut sum = Lanes3::default();
-        for &(position, intensity) in &step.lights {
-            let PointLight { mut lit, wi, t_max, light } =
-                point_light(position, intensity, &self.point, &ns, &self.albedo);
-            for (lit, taken) in lit.iter_mut().zip(&self.taken) {
-                *lit &= taken;
+        for (light, position, intensity) in &step.lights {
+            // A spot's falloff toward each vertex, lane by lane (its arc
+            // cosine has no vector twin); a point light has none.
+            let falloff = matches!(light, Light::Spot { .. }).then(|| {
+                std::array::from_fn(|i| if self.taken[i] { light.falloff_toward(get(&self.point, i)) } else { 0.0 })
+            });
+            let in_cone: [bool; LANES] = match &falloff {
+                Some(f) => std::array::from_fn(|i| !(f[i] <= 0.0)),
+                None => self.taken,
+            };
+            let delta = DeltaLight { position: *position, intensity: *intensity, falloff: falloff.as_ref() };
+            let PointLight { mut lit, wi, t_max, light } = point_light(&delta, &self.point, &ns, &self.albedo);
+            for (lit, in_cone) in lit.iter_mut().zip(in_cone) {
+                *lit &= in_cone;
             }
             let active = lit.iter().rev().fold(0, |bits, &lit| bits << 1 | u32::from(lit));
             let shadow_rays = RayLanes { origin: self.point, dir: wi, t_max, active };
@@ -236,6 +248,15 @@ fn scatter_by_lane(v: &mut DiffuseLanes, sum: &Lanes3, dirs: &Lanes3, ns: &Lanes
     }
 }
 
+/// A point light, or a spot as the point light it is toward each of eight
+/// vertices: its intensity scaled lane by lane by the spot's `falloff`.
+#[derive(Clone, Copy)]
+struct DeltaLight<'a> {
+    position: Vec3,
+    intensity: Rgb,
+    falloff: Option<&'a [f32; LANES]>,
+}
+
 /// A point light's sample at eight vertices: where it can light them (at
 /// a distance, in front of the shading normal), the direction and length
 /// of the shadow ray, and the light it brings if unshadowed.
@@ -250,20 +271,23 @@ struct PointLight {
 /// density 1, MIS weight 1, transmittance 1 without media) at eight
 /// vertices `point` with shading normals `ns` and diffuse `albedo`: in
 /// AVX2 where the CPU has it, to the bit (a test checks it).
-fn point_light(position: Vec3, intensity: Rgb, point: &Lanes3, ns: &Lanes3, albedo: &Lanes3) -> PointLight {
+fn point_light(light: &DeltaLight, point: &Lanes3, ns: &Lanes3, albedo: &Lanes3) -> PointLight {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx2") {
         // SAFETY: AVX2 checked above.
-        return unsafe { avx2::point_light(position, intensity, point, ns, albedo) };
+        return unsafe { avx2::point_light(light, point, ns, albedo) };
     }
-    point_light_by_lane(position, intensity, point, ns, albedo)
+    point_light_by_lane(light, point, ns, albedo)
 }
 
-fn point_light_by_lane(position: Vec3, intensity: Rgb, point: &Lanes3, ns: &Lanes3, albedo: &Lanes3) -> PointLight {
+fn point_light_by_lane(light: &DeltaLight, point: &Lanes3, ns: &Lanes3, albedo: &Lanes3) -> PointLight {
+    let DeltaLight { position, intensity, falloff } = *light;
     let mut out =
         PointLight { lit: [false; LANES], wi: Lanes3::default(), t_max: [0.0; LANES], light: Lanes3::default() };
-    let light = Light::Point { position, intensity };
     for i in 0..LANES {
+        // `Light::sample_incident` of a spot: a point light of the
+        // intensity it sends this way.
+        let light = Light::Point { position, intensity: falloff.map_or(intensity, |f| intensity * f[i]) };
         let Some(s) = light.sample_incident(get(point, i), glam::Vec2::ZERO) else { continue };
         let cos = s.wi.dot(get(ns, i));
         out.lit[i] = !(cos <= 0.0 || s.pdf <= 0.0);
@@ -276,8 +300,7 @@ fn point_light_by_lane(position: Vec3, intensity: Rgb, point: &Lanes3, ns: &Lane
 
 #[cfg(target_arch = "x86_64")]
 mod avx2 {
-    use super::{DiffuseLanes, LANES, Lanes3, PointLight, Rgb};
-    use glam::Vec3;
+    use super::{DeltaLight, DiffuseLanes, LANES, Lanes3, PointLight};
     use std::arch::x86_64::*;
     use std::f32::consts::PI;
 
@@ -348,7 +371,8 @@ mod avx2 {
 
     /// `point_light_by_lane`, operation for operation.
     #[target_feature(enable = "avx2")]
-    pub fn point_light(position: Vec3, intensity: Rgb, point: &Lanes3, ns: &Lanes3, albedo: &Lanes3) -> PointLight {
+    pub fn point_light(light: &DeltaLight, point: &Lanes3, ns: &Lanes3, albedo: &Lanes3) -> PointLight {
+        let DeltaLight { position, intensity, falloff } = *light;
         let (mul, add, sub, div, s) = (_mm256_mul_ps, _mm256_add_ps, _mm256_sub_ps, _mm256_div_ps, _mm256_set1_ps);
         // SAFETY (loads and stores): rows of 8 floats.
         let ld = |row: &[f32; LANES]| unsafe { _mm256_loadu_ps(row.as_ptr()) };
@@ -368,12 +392,12 @@ mod avx2 {
             t_max: [0.0; LANES],
             light: Lanes3::default(),
         };
-        let intensity = [intensity.x, intensity.y, intensity.z];
         unsafe {
             _mm256_storeu_ps(out.t_max.as_mut_ptr(), mul(distance, s(1.0 - 1e-4)));
             for k in 0..3 {
                 _mm256_storeu_ps(out.wi[k].as_mut_ptr(), wi[k]);
-                let radiance = div(s(intensity[k]), d2);
+                let toward = falloff.map_or(s(intensity[k]), |f| mul(s(intensity[k]), ld(f)));
+                let radiance = div(toward, d2);
                 let light = mul(mul(div(ld(&albedo[k]), s(PI)), radiance), cos);
                 _mm256_storeu_ps(out.light[k].as_mut_ptr(), light);
             }
@@ -412,8 +436,12 @@ mod tests {
                 put(&mut ns, 2, (position - get(&point, 2)).cross(Vec3::X).normalize()); // edge-on
             }
             let albedo: Lanes3 = std::array::from_fn(|_| std::array::from_fn(|_| random().abs()));
-            let got = point_light(position, intensity, &point, &ns, &albedo);
-            let want = point_light_by_lane(position, intensity, &point, &ns, &albedo);
+            // Every other round as a spot's, with a falloff in each lane.
+            let falloff: [f32; LANES] = std::array::from_fn(|i| (i + 1) as f32 / 8.0 - 0.1 * (round % 3) as f32);
+            let falloff = (round % 2 == 1).then_some(&falloff);
+            let light = DeltaLight { position, intensity, falloff };
+            let got = point_light(&light, &point, &ns, &albedo);
+            let want = point_light_by_lane(&light, &point, &ns, &albedo);
             assert_eq!(got.lit, want.lit, "round {round}");
             let same = |a: f32, b: f32| a.to_bits() == b.to_bits();
             for i in (0..LANES).filter(|&i| want.lit[i]) {

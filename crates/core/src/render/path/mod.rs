@@ -534,7 +534,8 @@ pub(crate) mod tests {
 
     /// The lane step (`lanes`) serves Cornell boxes lit by point lights,
     /// and its images are the scalar step's to the bit: two point lights
-    /// (one low, lighting some walls from behind), paths cut after 3
+    /// (one low, lighting some walls from behind) and a narrow spot whose
+    /// cone's edge and falloff cross the back wall, paths cut after 3
     /// vertices and after 64 (the roulette's), against paths traced one
     /// at a time. Scenes with media (`fog-stage`) or other lights
     /// (`cornell-caustic`'s sphere light) are not served.
@@ -545,6 +546,13 @@ pub(crate) mod tests {
         scene.lights.push(crate::light::Light::Point {
             position: Vec3::new(-0.7, -0.95, 0.4),
             intensity: Rgb::new(0.5, 1.5, 0.25),
+        });
+        scene.lights.push(crate::light::Light::Spot {
+            position: Vec3::new(0.6, 0.9, 0.5),
+            axis: Vec3::new(-0.5, -0.3, -1.0).normalize(),
+            intensity: Rgb::new(3.0, 2.0, 1.0),
+            cutoff: 0.35,
+            falloff_start: 0.2,
         });
         assert!(lanes::LaneStep::for_scene(&scene).is_some());
         for name in ["fog-stage", "cornell-caustic"] {
