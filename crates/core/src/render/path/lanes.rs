@@ -130,6 +130,11 @@ impl DiffuseLanes {
         self.xi[l] = if self.roulette[l] { sampler.next_f32() } else { 0.0 };
     }
 
+    /// Takes no lane (what the lanes held stays, unread, until taken).
+    pub fn clear(&mut self) {
+        self.taken = [false; LANES];
+    }
+
     pub fn any(&self) -> bool {
         self.taken.contains(&true)
     }
