@@ -14,6 +14,7 @@ use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::PhotonCpuSettings;
 use hikari_core::scene::Scene;
+use hikari_gpu::features::SceneFeatures;
 use hikari_gpu::renderer::{SEED_CORNELL_LOD, Stage};
 use hikari_gpu::tiled::Estimator;
 use hikari_gpu::trace::GpuTracer;
@@ -22,15 +23,59 @@ use std::time::Instant;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Frames timed per row (after one warm-up frame).
+    /// Frames timed per row (after one warm-up frame), at most.
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
     pub frames: u32,
+    /// Seconds a row's timed frames may take: a row stops after its frames
+    /// or once past this, after 3 frames at least (fewer only where
+    /// --frames asks for fewer), so the table finishes in minutes even on a
+    /// software rasterizer. 0: no limit.
+    #[arg(long, default_value_t = 4.0)]
+    pub budget: f64,
+    /// Only the rows whose label contains this text (the tracing rates are
+    /// always printed unless --no-tracing).
+    #[arg(long)]
+    pub only: Option<String>,
+    /// Leave out the photon-tracing rates.
+    #[arg(long)]
+    pub no_tracing: bool,
+    /// Pipelines made as if every scene also used these features
+    /// (comma-separated: textured, cut-outs, glossy, sampled-lights,
+    /// sky-image, media, or all): what each costs a scene without it.
+    #[arg(long, value_delimiter = ',', value_parser = parse_feature)]
+    pub with_features: Vec<SceneFeatures>,
     /// Also run 1920×1080 with 1,000,000 photons (meant for real GPUs).
     #[arg(long)]
     pub large: bool,
     /// Only the photon-tracing rates (CPU and GPU tracers).
     #[arg(long)]
     pub tracing_only: bool,
+}
+
+/// One `--with-features` name as the features it turns on.
+fn parse_feature(name: &str) -> Result<SceneFeatures, String> {
+    let none = SceneFeatures {
+        textured: false,
+        cut_outs: false,
+        glossy: false,
+        sampled_lights: false,
+        sky_image: false,
+        media: false,
+    };
+    Ok(match name {
+        "textured" => SceneFeatures { textured: true, ..none },
+        "cut-outs" => SceneFeatures { cut_outs: true, ..none },
+        "glossy" => SceneFeatures { glossy: true, ..none },
+        "sampled-lights" => SceneFeatures { sampled_lights: true, ..none },
+        "sky-image" => SceneFeatures { sky_image: true, ..none },
+        "media" => SceneFeatures { media: true, ..none },
+        "all" => SceneFeatures::ALL,
+        _ => {
+            return Err(format!(
+                "{name:?} is none of textured, cut-outs, glossy, sampled-lights, sky-image, media, all"
+            ));
+        }
+    })
 }
 
 struct Row {
@@ -84,6 +129,27 @@ fn moving_light_row(label: &'static str, scene: &'static str, size: (u32, u32), 
         motion: Motion::MovingLight,
         estimator: Estimator::Raster,
     }
+}
+
+/// The example glTF file (textures, glossy metal, glass, a sun, a spot, a
+/// glowing strip), from the source tree the binary was built in.
+const SHOWCASE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb");
+
+/// A generated glTF file of 1,000,000 triangles (`test_scenes::wavy_grid_glb`).
+const GRID: &str = "generated 1M-triangle grid";
+
+/// A row's scene: a built-in name or path, or the generated grid, written
+/// to a temporary file, loaded and removed.
+fn load_scene(name: &str) -> Result<Scene> {
+    if name != GRID {
+        return Ok(Scene::load(name)?);
+    }
+    let path = std::env::temp_dir().join(format!("hikari-bench-grid-{}.glb", std::process::id()));
+    std::fs::write(&path, hikari_core::test_scenes::wavy_grid_glb(1_000_000))
+        .with_context(|| format!("writing {}", path.display()))?;
+    let scene = Scene::load(&path.to_string_lossy());
+    let _ = std::fs::remove_file(&path);
+    Ok(scene?)
 }
 
 /// The seed's fog-scene LOD settings, in scene units as given (its scene's
@@ -218,6 +284,36 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             motion: Motion::RetraceOnGpu,
             estimator: Estimator::Raster,
         },
+        Row {
+            label: "showcase.glb, 50,000 photons",
+            scene: SHOWCASE,
+            size: (512, 512),
+            photons: 50_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Still,
+            estimator: Estimator::Raster,
+        },
+        Row {
+            label: "showcase.glb, 50,000 photons, camera moving every frame",
+            scene: SHOWCASE,
+            size: (512, 512),
+            photons: 50_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Orbit,
+            estimator: Estimator::Raster,
+        },
+        Row {
+            label: "1M-triangle glTF grid, 20,000 photons",
+            scene: GRID,
+            size: (512, 512),
+            photons: 20_000,
+            volume: false,
+            lod: None,
+            motion: Motion::Still,
+            estimator: Estimator::Raster,
+        },
         moving_light_row(
             "cornell-box, moving light, 20,000 photons re-traced every frame",
             "cornell-box",
@@ -299,16 +395,20 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     // A row the adapter cannot run (media without f32 blending, a size over
     // its limits) is reported and the table goes on.
-    for row in rows.iter().filter(|_| !args.tracing_only) {
-        if let Err(e) = bench_row(ctx.clone(), row, args.frames) {
+    let wanted = |row: &&Row| args.only.as_deref().is_none_or(|text| row.label.contains(text));
+    for row in rows.iter().filter(|_| !args.tracing_only).filter(wanted) {
+        if let Err(e) = bench_row(ctx.clone(), row, args) {
             println!("{}: not run on this adapter: {e:#}", row.label);
         }
+    }
+    if args.no_tracing {
+        return Ok(());
     }
     println!("photon tracing, million photon paths per second (best of 3):");
     let sizes: &[u64] = if args.large { &[200_000, 1_000_000, 4_000_000] } else { &[200_000] };
     for name in ["cornell-box", "cornell-caustic", "fog-stage"] {
         for &photons in sizes {
-            if let Err(e) = bench_tracing(&ctx, name, photons) {
+            if let Err(e) = bench_tracing(&ctx, name, photons, &args.with_features) {
                 println!("{name}, {photons} paths: not run on this adapter: {e:#}");
             }
         }
@@ -318,7 +418,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
 /// The CPU tracer (all cores) against the GPU tracer, with and without
 /// reading the maps back.
-fn bench_tracing(ctx: &GpuContext, name: &str, photons: u64) -> Result<()> {
+fn bench_tracing(ctx: &GpuContext, name: &str, photons: u64, with: &[SceneFeatures]) -> Result<()> {
     let scene = Scene::load(name)?;
     let settings = TraceSettings { photons, seed: 1, ..Default::default() };
     let best = |f: &mut dyn FnMut() -> Result<()>| -> Result<f64> {
@@ -334,7 +434,7 @@ fn bench_tracing(ctx: &GpuContext, name: &str, photons: u64) -> Result<()> {
         trace_photons(&scene, &settings, &Silent);
         Ok(())
     })?;
-    let mut tracer = GpuTracer::new(ctx, &scene)?;
+    let mut tracer = GpuTracer::with_features(ctx, &scene, features_for(&scene, with))?;
     // Warm-up: pipelines compiled, batch buffers sized.
     tracer.trace(ctx, &settings)?;
     let on_gpu = best(&mut || {
@@ -351,8 +451,16 @@ fn bench_tracing(ctx: &GpuContext, name: &str, photons: u64) -> Result<()> {
     Ok(())
 }
 
-fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u32)> {
-    let mut scene = Scene::load(row.scene)?;
+/// What the pipelines for `scene` are specialised to: its own features and `with`.
+fn features_for(scene: &Scene, with: &[SceneFeatures]) -> SceneFeatures {
+    with.iter().fold(SceneFeatures::of_scene(scene), |all, more| all.union(*more))
+}
+
+/// Times `row`: up to `--frames` frames, stopping once `--budget` seconds
+/// have passed after at least 3 (or `--frames`, if fewer).
+fn bench_row(ctx: GpuContext, row: &Row, args: &BenchArgs) -> Result<(GpuRenderer, u32)> {
+    let (frames, budget) = (args.frames, args.budget);
+    let mut scene = load_scene(row.scene)?;
     scene.camera = scene.camera.with_resolution(row.size.0, row.size.1).map_err(anyhow::Error::msg)?;
     let base = orbiting_light(scene.clone());
     let trace = |photons| trace_photons(&scene, &TraceSettings { photons, seed: 1, ..Default::default() }, &Silent);
@@ -371,13 +479,33 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         volume_radius: hikari_core::render::photon_cpu::default_radius(&scene),
         ..GpuSettings::new(global, caustic)
     };
-    let mut renderer = GpuRenderer::new(ctx, &scene, &traced, settings)?;
+    let features = features_for(&scene, &args.with_features);
+    let mut renderer = GpuRenderer::with_features(ctx, &scene, &traced, settings, features)?;
     renderer.render()?;
     let mut tracing = 0.0;
+    // The GPU tracer is made and run once before the timed frames, as the
+    // viewer makes it once: a software adapter compiles a pipeline at its
+    // first use (seconds for the tracer, then kept in Mesa's disk cache).
     let mut gpu_tracer = None;
+    if row.motion == Motion::RetraceOnGpu {
+        let start = Instant::now();
+        let mut tracer = GpuTracer::with_features(&renderer.ctx, &scene, features)?;
+        // Its warm-up trace: a software adapter compiles on first use.
+        tracer.trace(&renderer.ctx, &TraceSettings { photons: row.photons, seed: 1, ..Default::default() })?;
+        gpu_tracer = Some(tracer);
+        println!(
+            "    (GPU tracer made and warmed up in {:.0} ms, before the timed frames)",
+            start.elapsed().as_secs_f64() * 1e3
+        );
+    }
     let mut global_count = traced.indirect().len();
     let start = Instant::now();
+    let mut timed = 0;
     for k in 0..frames {
+        if k >= 3 && budget > 0.0 && start.elapsed().as_secs_f64() > budget {
+            break;
+        }
+        timed += 1;
         match row.motion {
             Motion::Still => {}
             Motion::Orbit => {
@@ -399,11 +527,8 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
             Motion::RetraceOnGpu => {
                 let trace_start = Instant::now();
                 let settings = TraceSettings { photons: row.photons, seed: 2 + k as u64, ..Default::default() };
-                let tracer = gpu_tracer.get_or_insert_with(|| GpuTracer::new(&renderer.ctx, &scene));
-                let fresh = match tracer {
-                    Ok(tracer) => tracer.trace(&renderer.ctx, &settings)?.0,
-                    Err(e) => anyhow::bail!("the GPU tracer: {e}"),
-                };
+                let tracer = gpu_tracer.as_mut().context("the GPU tracer is made before the frames")?;
+                let fresh = tracer.trace(&renderer.ctx, &settings)?.0;
                 tracing += trace_start.elapsed().as_secs_f64();
                 renderer.set_photons(&scene, &fresh)?;
                 global_count = fresh.indirect().len();
@@ -421,6 +546,7 @@ fn bench_row(ctx: GpuContext, row: &Row, frames: u32) -> Result<(GpuRenderer, u3
         renderer.render()?;
     }
     renderer.wait()?;
+    let frames = timed;
     let frame = start.elapsed().as_secs_f64() / frames as f64;
 
     let (global_drawn, _) = renderer.drawn_photons()?;

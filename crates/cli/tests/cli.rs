@@ -642,3 +642,22 @@ fn plots_error_curves() {
         assert_fails_with(&out, &dir, words);
     }
 }
+
+/// `hikari bench` prints its rows in the form scripts/bench_ratio.py reads
+/// (`LABEL at WxH: F fps (T ms/frame), ...`), stops a row at its budget,
+/// and refuses an unknown feature by name.
+#[test]
+fn bench_rows_keep_the_form_scripts_read() {
+    let dir = scratch_dir("bench");
+    let args = ["bench", "--frames", "2", "--only", "2,000 photons", "--no-tracing", "--with-features", "glossy"];
+    let out = hikari(&args, &dir);
+    let text = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(out.status.success(), "{}", stderr(&out));
+    let rows: Vec<&str> = text.lines().filter(|l| l.contains(" ms/frame)")).collect();
+    assert_eq!(rows.len(), 1, "{text}");
+    assert!(rows[0].starts_with("cornell-box, 2,000 photons, LOD off at 512x512: ") && rows[0].contains(" fps ("), "{text}");
+    assert!(text.contains("per pass ("), "{text}");
+    let out = hikari(&["bench", "--with-features", "shiny"], &dir);
+    assert!(!out.status.success());
+    assert!(stderr(&out).contains("\"shiny\" is none of textured"), "{}", stderr(&out));
+}

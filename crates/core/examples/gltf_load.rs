@@ -6,13 +6,9 @@
 //! on it beside cornell-box's. With KEEP.glb the grid is written there and
 //! kept (to try it in `hikari render` and `hikari view`).
 
-use glam::Vec3;
-use gltf::json;
-use gltf::json::extensions::scene::khr_lights_punctual::Type;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::scene::Scene;
-use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial};
 use std::time::Instant;
 
 /// Resident set size of this process, bytes (Linux).
@@ -35,31 +31,7 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let triangles: u64 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
     let photons: u64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
-    // An n×n grid of quads (two triangles each) over [-1, 1]², heights a gentle wave.
-    let n = ((triangles as f64 / 2.0).sqrt().ceil() as u32).max(1);
-    let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, z) = (2.0 * i as f32 / n as f32 - 1.0, 2.0 * j as f32 / n as f32 - 1.0);
-            positions.push(Vec3::new(x, 0.05 * (9.0 * x).sin() * (7.0 * z).cos(), z));
-        }
-    }
-    let mut indices = Vec::with_capacity((6 * n * n) as usize);
-    for j in 0..n {
-        for i in 0..n {
-            let a = j * (n + 1) + i;
-            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
-            indices.extend([a, c, b, b, c, d]);
-        }
-    }
-    let mut builder = GltfBuilder::new();
-    // Lambertian (no specular lobe), so the GPU renderer draws it exactly.
-    let material = builder.material(&PbrMaterial { base_color: Vec3::splat(0.7), specular: 0.0, ..Default::default() });
-    let mesh = builder.mesh(&positions, None, Some(&indices), Some(material));
-    let grid = builder.node(json::Node { mesh: Some(mesh), ..Default::default() });
-    let light = builder.light(Type::Point, Vec3::ONE, 2000.0, None);
-    let light = builder.node(GltfBuilder::light_node(light, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY));
-    let glb = builder.to_glb(vec![grid, light]);
+    let glb = hikari_core::test_scenes::wavy_grid_glb(triangles);
     let keep = args.get(3).map(std::path::PathBuf::from);
     let path =
         keep.clone().unwrap_or_else(|| std::env::temp_dir().join(format!("hikari-grid-{}.glb", std::process::id())));

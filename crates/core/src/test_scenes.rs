@@ -374,3 +374,37 @@ pub mod gltf_textures {
         b.to_glb(vec![floor, cutout, sun])
     }
 }
+
+/// A `.glb` of about `triangles` triangles: an n×n grid of quads over
+/// [-1, 1]² whose heights are a gentle wave, Lambertian grey, under a
+/// point light 1 unit above its centre; no camera (loading frames it).
+/// What `examples/gltf_load` and `hikari bench`'s large-mesh row load.
+pub fn wavy_grid_glb(triangles: u64) -> Vec<u8> {
+    use crate::scene::gltf::export::{GltfBuilder, PbrMaterial};
+    use gltf::json;
+    use gltf::json::extensions::scene::khr_lights_punctual::Type;
+    let n = ((triangles as f64 / 2.0).sqrt().ceil() as u32).max(1);
+    let mut positions = Vec::with_capacity(((n + 1) * (n + 1)) as usize);
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, z) = (2.0 * i as f32 / n as f32 - 1.0, 2.0 * j as f32 / n as f32 - 1.0);
+            positions.push(Vec3::new(x, 0.05 * (9.0 * x).sin() * (7.0 * z).cos(), z));
+        }
+    }
+    let mut indices = Vec::with_capacity((6 * n * n) as usize);
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            let (b, c, d) = (a + 1, a + n + 1, a + n + 2);
+            indices.extend([a, c, b, b, c, d]);
+        }
+    }
+    let mut builder = GltfBuilder::new();
+    // Lambertian (no specular lobe), so the GPU renderer draws it exactly.
+    let material = builder.material(&PbrMaterial { base_color: Vec3::splat(0.7), specular: 0.0, ..Default::default() });
+    let mesh = builder.mesh(&positions, None, Some(&indices), Some(material));
+    let grid = builder.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let light = builder.light(Type::Point, Vec3::ONE, 2000.0, None);
+    let light = builder.node(GltfBuilder::light_node(light, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY));
+    builder.to_glb(vec![grid, light])
+}

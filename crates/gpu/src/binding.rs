@@ -79,6 +79,19 @@ pub fn fullscreen_pipeline(
     module: &wgpu::ShaderModule,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    fullscreen_pipeline_with(device, label, layout, module, format, &[])
+}
+
+/// `fullscreen_pipeline` with values for `fs_main`'s pipeline-overridable
+/// constants.
+pub fn fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
@@ -94,7 +107,7 @@ pub fn fullscreen_pipeline(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
         }),
         multiview_mask: None,
@@ -130,7 +143,7 @@ pub fn square_compute_pipeline(
 
 /// A compute pipeline with values for the shader's pipeline-overridable
 /// constants.
-fn compute_pipeline_with(
+pub fn compute_pipeline_with(
     device: &wgpu::Device,
     label: &str,
     layout: &wgpu::PipelineLayout,

@@ -18,6 +18,15 @@
 //! both estimators, take direct light through it, sample it in the photon
 //! tracer and follow their smoother lobes in the specular pass.
 //!
+//! Every pipeline is specialised to what its scene uses (`features`:
+//! textures, cut-outs, glossy surfaces, skies and emissive meshes, sky
+//! images, media), through pipeline-overridable constants the shaders test
+//! before their per-surface fields: a software rasterizer runs both sides
+//! of every branch, so a Lambertian box would otherwise pay for every
+//! material a glTF file can hold. The splat's quads bound their photon's
+//! sphere exactly on screen and lie at its front depth, so the G-buffer's
+//! depth test skips pixels whose surface lies nearer before they shade.
+//!
 //! Textures (`textures`) are one storage buffer of 8-bit texels with their
 //! mip chains, sampled by `textures.wgsl` with the CPU's filter: in the
 //! G-buffer (mip-mapped by the pixel's footprint), the shadow maps and
@@ -29,6 +38,7 @@ pub mod block;
 pub mod capabilities;
 pub mod context;
 pub mod direct;
+pub mod features;
 pub mod gbuffer;
 pub mod lod;
 pub mod media;

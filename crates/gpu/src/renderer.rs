@@ -4,6 +4,7 @@
 
 use crate::context::{GpuContext, GpuError};
 use crate::direct::DirectPass;
+use crate::features::SceneFeatures;
 use crate::gbuffer::{GBuffer, GBufferBinding, GBufferParams, GBufferPass};
 use crate::lod::{LodOutput, LodPass};
 use crate::media::GpuMedia;
@@ -142,6 +143,8 @@ impl Stage {
 
 pub struct GpuRenderer {
     pub ctx: GpuContext,
+    /// What the pipelines are specialised to: the scene's features.
+    features: SceneFeatures,
     gbuffer_pass: GBufferPass,
     gbuffer_binding: GBufferBinding,
     splat_pass: SplatPass,
@@ -287,16 +290,35 @@ impl GpuRenderer {
         traced: &TracedPhotons,
         settings: GpuSettings,
     ) -> Result<Self, GpuError> {
+        Self::with_features(ctx, scene, traced, settings, SceneFeatures::of_scene(scene))
+    }
+
+    /// `new` with pipelines specialised to `features`, which must include
+    /// the scene's (tests compare `SceneFeatures::ALL` with the scene's own).
+    #[doc(hidden)]
+    pub fn with_features(
+        ctx: GpuContext,
+        scene: &Scene,
+        traced: &TracedPhotons,
+        settings: GpuSettings,
+        features: SceneFeatures,
+    ) -> Result<Self, GpuError> {
         let photons = [traced.indirect().len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
         Self::check_fits(&ctx, scene, &settings, photons)?;
         let scopes = ctx.error_scopes();
-        let renderer = Self::create(ctx, scene, traced, settings);
+        let renderer = Self::create(ctx, scene, traced, settings, features);
         scopes.finish()?;
         renderer.ctx.check()?;
         Ok(renderer)
     }
 
-    fn create(ctx: GpuContext, scene: &Scene, traced: &TracedPhotons, settings: GpuSettings) -> Self {
+    fn create(
+        ctx: GpuContext,
+        scene: &Scene,
+        traced: &TracedPhotons,
+        settings: GpuSettings,
+        features: SceneFeatures,
+    ) -> Self {
         let device = &ctx.device;
         let (w, h) = (scene.camera.width, scene.camera.height);
         let radiance_target = |label| {
@@ -314,7 +336,7 @@ impl GpuRenderer {
                 view_formats: &[],
             })
         };
-        let shadow_pass = ShadowPass::new(device, crate::shadow::map_format(ctx.r32_renderable));
+        let shadow_pass = ShadowPass::new(device, crate::shadow::map_format(ctx.r32_renderable), features);
         let lod_pass = LodPass::new(device);
         let lights = GpuLights::new(scene, settings.area_light_samples);
         let targets = FrameTargets {
@@ -346,6 +368,7 @@ impl GpuRenderer {
             &targets.gbuffer,
             &media,
             &specular_inputs(&settings, traced, &global_photons, ctx.loop_budget),
+            features,
         );
         let volume_params = VolumeParams {
             clip_from_world: clip_from_world.to_cols_array_2d(),
@@ -354,9 +377,9 @@ impl GpuRenderer {
             _pad0: 0,
             _pad1: 0,
         };
-        let gbuffer_pass = GBufferPass::new(device, ctx.gbuffer_storage);
-        let splat_pass = SplatPass::new(device, ctx.radiance_format);
-        let direct_pass = DirectPass::new(device, ctx.radiance_format);
+        let gbuffer_pass = GBufferPass::new(device, ctx.gbuffer_storage, features);
+        let splat_pass = SplatPass::new(device, ctx.radiance_format, features);
+        let direct_pass = DirectPass::new(device, ctx.radiance_format, features);
         let volume_pass = VolumePass::new(device, ctx.radiance_format, &volume_params, &media, &targets.gbuffer);
         let t = &targets;
         let resolve_pass = ResolvePass::new(
@@ -367,8 +390,10 @@ impl GpuRenderer {
             &media,
             lights.sky_radiance,
             &scene_buffers.environment,
+            features,
         );
         GpuRenderer {
+            features,
             resolve_pass,
             specular_pass,
             gbuffer_binding: gbuffer_pass.bind(device, &scene_buffers, &targets.gbuffer),
@@ -476,10 +501,19 @@ impl GpuRenderer {
     /// Draws the next frames of `scene`, the renderer's scene moved (the
     /// same surfaces, lights and media, posed anew: `Scene::posed`), with
     /// `traced`, its photons. Pipelines, targets and the photon passes stay;
-    /// the geometry, lights, shadow views, BVH and photons are uploaded.
+    /// the geometry, lights, shadow views, BVH and photons are uploaded. A
+    /// scene whose materials use other features (`SceneFeatures`) gets
+    /// pipelines made for them, the camera kept.
     pub fn set_scene(&mut self, scene: &Scene, traced: &TracedPhotons) -> Result<(), GpuError> {
         let counts = [traced.indirect().len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
         Self::check_fits(&self.ctx, scene, &self.settings, counts)?;
+        let features = SceneFeatures::of_scene(scene);
+        if features.union(self.features) != self.features {
+            let mut posed = scene.clone();
+            posed.camera = self.camera.clone();
+            *self = Self::with_features(self.ctx.clone(), &posed, traced, self.settings.clone(), features)?;
+            return Ok(());
+        }
         let scopes = self.ctx.error_scopes();
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         self.scene = SceneBuffers::upload(device, scene);
@@ -560,7 +594,7 @@ impl GpuRenderer {
 
     /// The tiled estimator's pass, made on first use.
     fn tiled_pass(&self) -> &TiledPass {
-        self.tiled_pass.get_or_init(|| TiledPass::new(&self.ctx.device, self.ctx.radiance_format))
+        self.tiled_pass.get_or_init(|| TiledPass::new(&self.ctx.device, self.ctx.radiance_format, self.features))
     }
 
     /// The tiled estimator's state for one map and what it estimates into.

@@ -183,7 +183,7 @@ struct Reflector {
 // Surface `s` at a point where its BRDF is `b` (textures applied), of
 // shading normal `n`, seen from `eye` (world, toward the viewer).
 fn surface_reflector(s: Surface, b: Bsdf, eye: vec3<f32>, n: vec3<f32>) -> Reflector {
-    return Reflector(b.base_color, s.glossy != 0u, b, to_shading(eye, n));
+    return Reflector(b.base_color, GLOSSY && s.glossy != 0u, b, to_shading(eye, n));
 }
 
 // f toward the world direction `wi` (every non-delta lobe).
@@ -527,7 +527,7 @@ fn mesh_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
 //   small-disc form of a/d²), one-sided unless two-sided. A glossy point:
 //   `mesh_glossy`.
 fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
-    if (l.kind == KIND_SKY && l.mapped != 0u) {
+    if (SKY_IMAGE && l.kind == KIND_SKY && l.mapped != 0u) {
         return sky_image(l, x, n, r);
     }
     if (l.kind == KIND_SKY && r.glossy) {
@@ -583,7 +583,7 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, 
             break;
         }
         let l = light_record(i);
-        if (l.kind == KIND_SKY || l.kind == KIND_MESH) {
+        if (SAMPLED_LIGHTS && (l.kind == KIND_SKY || l.kind == KIND_MESH)) {
             sum += sampled_radiance(l, x, n, r, rng);
             continue;
         }

@@ -1,6 +1,7 @@
 //! The direct-light pass: a fullscreen pass shading every visible diffuse
 //! pixel from all shadow-mapped light samples.
 
+use crate::features::SceneFeatures;
 use crate::gbuffer::GBuffer;
 use crate::shadow::ShadowMaps;
 use crate::shadow::light_samples::GpuLights;
@@ -105,10 +106,12 @@ pub struct DirectPass {
 }
 
 impl DirectPass {
-    pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
+    /// Specialised to what a scene with `features` uses.
+    pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat, features: SceneFeatures) -> Self {
+        let source = shader_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("direct.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
         });
         use crate::binding::{storage, texture, uniform};
         use wgpu::TextureViewDimension::D2;
@@ -131,7 +134,15 @@ impl DirectPass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "direct", &layout);
-        let pipeline = crate::binding::fullscreen_pipeline(device, "direct", &pipeline_layout, &module, target_format);
+        let constants = features.constants(&source);
+        let pipeline = crate::binding::fullscreen_pipeline_with(
+            device,
+            "direct",
+            &pipeline_layout,
+            &module,
+            target_format,
+            &constants,
+        );
         DirectPass { pipeline, layout }
     }
 

@@ -77,7 +77,7 @@ fn fragment_point(in: VertexOut) -> SurfacePoint {
 // same); a cut-out's fragment is discarded.
 fn shade(in: VertexOut) -> GBufferOut {
     let point = fragment_point(in);
-    if (!point.opaque) {
+    if (CUT_OUTS && !point.opaque) {
         discard;
     }
     let id = in.surface & ~HAS_UV;
@@ -97,7 +97,7 @@ fn shade(in: VertexOut) -> GBufferOut {
 // The depth-only draw of the storage path: cut-outs leave no depth.
 @fragment
 fn fs_depth(in: VertexOut) {
-    if (!fragment_point(in).opaque) {
+    if (CUT_OUTS && !fragment_point(in).opaque) {
         discard;
     }
 }

@@ -113,9 +113,11 @@ enum Mode {
 }
 
 impl GBufferPass {
-    /// With `storage`, the storage path (`GpuContext::gbuffer_storage`).
-    pub fn new(device: &wgpu::Device, storage: bool) -> Self {
+    /// With `storage`, the storage path (`GpuContext::gbuffer_storage`);
+    /// specialised to what a scene with `features` uses.
+    pub fn new(device: &wgpu::Device, storage: bool, features: crate::features::SceneFeatures) -> Self {
         let source = if storage { storage_shader_source() } else { shader_source() };
+        let constants = features.constants(&source);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("gbuffer.wgsl"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -153,7 +155,10 @@ impl GBufferPass {
                 fragment: fragment.map(|(entry_point, targets)| wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(entry_point),
-                    compilation_options: Default::default(),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
                     targets,
                 }),
                 multiview_mask: None,

@@ -102,6 +102,9 @@ fn segment_optical_depth(origin: vec3<f32>, dir: vec3<f32>, len: f32) -> vec3<f3
 
 // Light reaching x from a light sample through the media (eq. 5.8, 5.26).
 fn light_transmittance(x: vec3<f32>, light_position: vec3<f32>) -> vec3<f32> {
+    if (!MEDIA) {
+        return vec3<f32>(1.0);
+    }
     let d = light_position - x;
     let len = length(d);
     return exp(-segment_optical_depth(x, d / len, len));

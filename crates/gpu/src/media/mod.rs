@@ -14,7 +14,7 @@ use wgpu::util::DeviceExt;
 pub static MEDIA: crate::wgsl::Module = crate::wgsl::Module {
     name: "media.wgsl",
     source: include_str!("media.wgsl"),
-    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::REGION_CROSSING],
+    requires: &[&crate::wgsl::CONSTANTS, &crate::wgsl::REGION_CROSSING, &crate::features::FEATURES],
 };
 /// `region_triangle(i)` for media.wgsl from the includer's `regions` array.
 pub static REGION_ARRAY: crate::wgsl::Module = crate::wgsl::Module {
@@ -261,7 +261,8 @@ impl GpuMedia {
             source: wgpu::ShaderSource::Wgsl(optical_depth_shader_source().into()),
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "optical depth", &layout);
-        let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &[], "optical depth");
+        let pipeline =
+            crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &[], "optical depth", &[], None);
         GpuMedia { params, params_buffer, regions, slices: slices_texture, pipeline, bind_group, clip_buffer }
     }
 

@@ -6,6 +6,9 @@
 // filling the scene, linear between slices for the regions (layer j holds
 // the regions' optical depth to l·(j+1)/S).
 fn view_optical_depth(pixel: vec2<i32>, s: f32, l: f32) -> vec3<f32> {
+    if (!MEDIA) {
+        return vec3<f32>(0.0);
+    }
     var tau = media.global_sigma_t * s;
     if (media.slices > 0u) {
         let x = clamp(s / l, 0.0, 1.0) * f32(media.slices);

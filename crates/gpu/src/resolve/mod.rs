@@ -63,12 +63,14 @@ impl ResolvePass {
         media: &crate::media::GpuMedia,
         sky: glam::Vec3,
         environment: &wgpu::Buffer,
+        features: crate::features::SceneFeatures,
     ) -> Self {
         let (width, height) = (inputs[0].width(), inputs[0].height());
         use crate::binding::{entry, storage, storage_texture_rgba32f, texture, uniform};
+        let source = shader_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("resolve.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
         });
         let stage = wgpu::ShaderStages::COMPUTE;
         let mut entries: Vec<wgpu::BindGroupLayoutEntry> =
@@ -85,8 +87,10 @@ impl ResolvePass {
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("resolve"), entries: &entries });
         let pipeline_layout = crate::binding::pipeline_layout(device, "resolve", &layout);
+        let mut constants = features.constants(&source);
+        constants.push(("WORKGROUP", WORKGROUP as f64));
         let pipeline =
-            crate::binding::square_compute_pipeline(device, "resolve", &pipeline_layout, &module, "main", WORKGROUP);
+            crate::binding::compute_pipeline_with(device, "resolve", &pipeline_layout, &module, "main", &constants);
         let output = crate::binding::storage_output_texture(device, "resolved radiance", width, height);
         let mut views: Vec<wgpu::TextureView> = inputs.iter().map(|t| t.create_view(&Default::default())).collect();
         views.push(output.create_view(&Default::default()));

@@ -133,12 +133,14 @@ pub struct ShadowPass {
 }
 
 impl ShadowPass {
-    /// Maps in `format` (`map_format`).
-    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+    /// Maps in `format` (`map_format`), of a scene with `features`.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, features: crate::features::SceneFeatures) -> Self {
+        let source = shader_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("shadow.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
         });
+        let constants = features.constants(&source);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow view"),
             entries: &[crate::binding::entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, crate::binding::uniform())],
@@ -176,7 +178,7 @@ impl ShadowPass {
             fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
                 targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
             }),
             multiview_mask: None,

@@ -34,7 +34,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let dx = dpdx(in.uv);
     let dy = dpdy(in.uv);
     let id = in.surface & ~HAS_UV;
-    if (id != NO_SURFACE) {
+    if (CUT_OUTS && id != NO_SURFACE) {
         let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
         if (!surface_point(surfaces[id], uv, dx, dy).opaque) {
             discard;

@@ -387,12 +387,14 @@ impl SpecularPass {
         gbuffer: &GBuffer,
         media: &GpuMedia,
         inputs: &SpecularInputs,
+        features: crate::features::SceneFeatures,
     ) -> Self {
         let (width, height) = (gbuffer.width, gbuffer.height);
         let iteration_budget = inputs.iteration_budget;
+        let source = shader_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("specular.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
         });
         use crate::binding::{storage, storage_texture_rgba32f, texture, uniform};
         use wgpu::TextureViewDimension::{D2, D2Array};
@@ -418,8 +420,12 @@ impl SpecularPass {
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
+        // Specialised to the scene's features; the renderer remakes the
+        // pass for a scene that uses others (`GpuRenderer::set_scene`).
+        let mut constants = features.constants(&source);
+        constants.push(("WORKGROUP", WORKGROUP as f64));
         let pipeline =
-            crate::binding::square_compute_pipeline(device, "specular", &pipeline_layout, &module, "main", WORKGROUP);
+            crate::binding::compute_pipeline_with(device, "specular", &pipeline_layout, &module, "main", &constants);
 
         let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();

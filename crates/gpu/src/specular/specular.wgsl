@@ -300,13 +300,13 @@ struct Branch {
 // eye follows (smoother than GATHER_ROUGHNESS; the photon maps stand for
 // rougher ones).
 fn follows_lobe(s: Surface, b: Bsdf) -> bool {
-    return s.kind == 0u && s.glossy != 0u && b.roughness < GATHER_ROUGHNESS;
+    return GLOSSY && s.kind == 0u && s.glossy != 0u && b.roughness < GATHER_ROUGHNESS;
 }
 
 // Whether surface `s` may follow its lobe somewhere: smooth enough, or
 // made so by a metallic–roughness texture.
 fn may_follow_lobe(s: Surface) -> bool {
-    return s.kind == 0u && s.glossy != 0u && (s.roughness < GATHER_ROUGHNESS || s.metallic_roughness_texture != NO_TEXTURE);
+    return GLOSSY && s.kind == 0u && s.glossy != 0u && (s.roughness < GATHER_ROUGHNESS || s.metallic_roughness_texture != NO_TEXTURE);
 }
 
 const STACK: u32 = 16u;
@@ -390,7 +390,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 // only its mirror part or followed lobe is.
                 let eye = -b.dir;
                 let bsdf = Bsdf(point.base, point.metallic, point.roughness, s.specular_factor);
-                let glossy = s.glossy != 0u;
+                let glossy = GLOSSY && s.glossy != 0u;
                 if (b.depth > 0u) {
                     if (slice.index == 0u) {
                         // Its own stream, so slice 0's draws leave the path's alone.

@@ -16,6 +16,10 @@ struct SplatVertex {
     @location(1) @interpolate(flat) power_rgb9e5: u32,
     @location(2) @interpolate(flat) direction_and_class: u32,
     @location(3) @interpolate(flat) scale: f32,
+    // The photon's decoded travel direction and power (per photon, so
+    // decoded by its 4 vertices rather than its hundreds of fragments).
+    @location(4) @interpolate(flat) direction: vec3<f32>,
+    @location(5) @interpolate(flat) power: vec3<f32>,
 }
 
 @vertex
@@ -26,10 +30,14 @@ fn vs_main(@builtin(vertex_index) corner: u32, photon: PhotonIn) -> SplatVertex 
     let hi = select(footprint.zw, lo, footprint.x > footprint.z);
     var out: SplatVertex;
     let xy = vec2<f32>(select(lo.x, hi.x, (corner & 1u) != 0u), select(lo.y, hi.y, (corner & 2u) != 0u));
-    out.clip = vec4<f32>(xy, 0.0, 1.0);
+    // At the sphere's front depth: the surface splat's depth test skips
+    // pixels whose surface lies nearer (photon_front_depth).
+    out.clip = vec4<f32>(xy, photon_front_depth(photon.position), 1.0);
     out.photon_position = photon.position;
     out.power_rgb9e5 = photon.power_rgb9e5;
     out.direction_and_class = photon.direction_and_class;
     out.scale = photon.scale;
+    out.direction = decode_octahedral_15(photon.direction_and_class & 0x3fffffffu);
+    out.power = decode_rgb9e5(photon.power_rgb9e5);
     return out;
 }

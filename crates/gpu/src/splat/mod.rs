@@ -37,7 +37,10 @@ pub fn shader_source() -> String {
 
 /// A render pipeline (`vs_main`, `fs_main`) that adds its fragments into a
 /// float target: the photon splats (a triangle strip per instance when
-/// `buffers` holds the photon stream) and the optical-depth pass (a list).
+/// `buffers` holds the photon stream) and the optical-depth pass (a list),
+/// with values for `fs_main`'s pipeline-overridable constants and a depth
+/// test (read only) where given.
+#[allow(clippy::too_many_arguments)]
 pub fn additive_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
@@ -45,6 +48,8 @@ pub fn additive_pipeline(
     format: wgpu::TextureFormat,
     buffers: &[Option<wgpu::VertexBufferLayout>],
     label: &str,
+    constants: &[(&str, f64)],
+    depth_stencil: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
     let additive = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,
@@ -63,12 +68,12 @@ pub fn additive_pipeline(
             buffers,
         },
         primitive: wgpu::PrimitiveState { topology, cull_mode: None, ..Default::default() },
-        depth_stencil: None,
+        depth_stencil,
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some("fs_main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             targets: &[Some(wgpu::ColorTargetState {
                 format,
                 blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
@@ -84,6 +89,8 @@ pub fn additive_pipeline(
 pub struct SplatBinding {
     uniforms: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
+    /// The G-buffer's depth, against which the quads are tested.
+    depth: wgpu::TextureView,
 }
 
 pub struct SplatPass {
@@ -92,10 +99,16 @@ pub struct SplatPass {
 }
 
 impl SplatPass {
-    pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Self {
+    /// Specialised to what a scene with `features` uses.
+    pub fn new(
+        device: &wgpu::Device,
+        target_format: wgpu::TextureFormat,
+        features: crate::features::SceneFeatures,
+    ) -> Self {
+        let source = shader_source();
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("splat.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shader_source().into()),
+            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
         });
         use crate::binding::{entry, texture, uniform};
         use wgpu::TextureViewDimension::D2;
@@ -118,6 +131,16 @@ impl SplatPass {
             target_format,
             &[Some(crate::photons::photon_instances())],
             "splat",
+            &features.constants(&source),
+            // Quads lie at their sphere's front depth (footprint_rect.wgsl):
+            // pixels whose surface is nearer fail before their fragment runs.
+            Some(wgpu::DepthStencilState {
+                format: crate::gbuffer::DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
         );
         SplatPass { pipeline, layout }
     }
@@ -146,7 +169,7 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&emission) },
             ],
         });
-        SplatBinding { uniforms, bind_group }
+        SplatBinding { uniforms, bind_group, depth: view(&gbuffer.depth) }
     }
 
     /// Adds the surviving photons' radiance (counted by the LOD pass) into
@@ -165,7 +188,25 @@ impl SplatPass {
     ) {
         queue.write_buffer(&binding.uniforms, 0, bytemuck::bytes_of(params));
         let bind_group = &binding.bind_group;
-        let mut pass = crate::binding::color_pass(encoder, "photon splat", target, clear);
+        let load = if clear { wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT) } else { wgpu::LoadOp::Load };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("photon splat"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+            })],
+            // The G-buffer's depth, read only.
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &binding.depth,
+                depth_ops: None,
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, photons.survivors.slice(..));

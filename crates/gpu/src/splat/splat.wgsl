@@ -34,7 +34,7 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let normal = g.xyz;
     let d = position.xyz - in.photon_position;
-    let direction = decode_octahedral_15(in.direction_and_class & 0x3fffffffu);
+    let direction = in.direction;
     if (!photon_accepted(dot(d, d), direction, normal, params.radius, params.normal_test != 0u)) {
         discard;
     }
@@ -43,12 +43,12 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     // the BRDF for the photon's own direction over π r².
     var weight = radiance_per_power(albedo.rgb, params.radius);
     let surface = surfaces[u32(g.w)];
-    if (surface.glossy != 0u) {
+    if (GLOSSY && surface.glossy != 0u) {
         let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
         let eye = unit(params.camera_position - position.xyz);
         weight = photon_brdf(b, eye, normal, direction) * radiance_per_weighted_power(params.radius);
     }
-    let radiance = weight * decode_rgb9e5(in.power_rgb9e5) * (params.power_unit * in.scale);
+    let radiance = weight * in.power * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);
 }

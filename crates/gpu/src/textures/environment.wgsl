@@ -6,7 +6,7 @@
 fn environment_radiance(dir: vec3<f32>) -> vec3<f32> {
     let width = environment_word(0);
     let height = environment_word(1);
-    if (width == 0u) {
+    if (!SKY_IMAGE || width == 0u) {
         return vec3<f32>(1.0);
     }
     // u = ½ + atan2(−z, −x)/2π, v = acos(y)/π (Blender's layout).

@@ -201,7 +201,7 @@ pub fn environment_words(scene: &Scene) -> Vec<u32> {
 pub static ENVIRONMENT: crate::wgsl::Module = crate::wgsl::Module {
     name: "environment.wgsl",
     source: include_str!("environment.wgsl"),
-    requires: &[&crate::wgsl::CONSTANTS],
+    requires: &[&crate::wgsl::CONSTANTS, &crate::features::FEATURES],
 };
 
 /// Bytes of the renderer's sky image (`environment_words`).

@@ -28,11 +28,16 @@ fn texture_lookup(t: u32, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Textur
     return TextureLookup(sample_texture_footprint(t, uv.xy, dx, dy), true);
 }
 
+// TEXTURED and CUT_OUTS (features.wgsl) leave out what no surface has.
 fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> SurfacePoint {
     var p = SurfacePoint(s.albedo, s.metallic, s.emission, s.roughness, true);
+    if (!TEXTURED) {
+        p.opaque = !CUT_OUTS || s.alpha_cutoff < 0.0 || s.alpha_factor >= s.alpha_cutoff;
+        return p;
+    }
     let base = texture_lookup(s.base_color_texture, uv, dx, dy);
     p.base *= base.value.rgb;
-    if (s.alpha_cutoff >= 0.0) {
+    if (CUT_OUTS && s.alpha_cutoff >= 0.0) {
         p.opaque = s.alpha_factor * base.value.a >= s.alpha_cutoff;
     }
     let mr = texture_lookup(s.metallic_roughness_texture, uv, dx, dy);

@@ -142,11 +142,18 @@ pub struct TiledStatus {
 const PARAMS_STRIDE: u64 = 256;
 
 impl TiledPass {
-    pub fn new(device: &wgpu::Device, radiance_format: wgpu::TextureFormat) -> Self {
+    /// Specialised to what a scene with `features` uses.
+    pub fn new(
+        device: &wgpu::Device,
+        radiance_format: wgpu::TextureFormat,
+        features: crate::features::SceneFeatures,
+    ) -> Self {
+        let source = shader_source(radiance_format);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("tiled.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(shader_source(radiance_format).into()),
+            source: wgpu::ShaderSource::Wgsl(source.as_str().into()),
         });
+        let constants = features.constants(&source);
         use crate::binding::{dynamic_uniform, entry, storage, texture};
         let compute = |b, ty| entry(b, wgpu::ShaderStages::COMPUTE, ty);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -181,7 +188,14 @@ impl TiledPass {
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "tiled", &layout);
         let pipeline = |entry_point: &str| {
-            crate::binding::compute_pipeline(device, entry_point, &pipeline_layout, &module, entry_point)
+            crate::binding::compute_pipeline_with(
+                device,
+                entry_point,
+                &pipeline_layout,
+                &module,
+                entry_point,
+                &constants,
+            )
         };
         TiledPass {
             count_tiles: pipeline("count_tiles"),

@@ -243,7 +243,7 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     // A glossy surface weights each photon by its BRDF (photon_brdf) in
     // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
     let surface = surfaces[u32(g.w)];
-    let glossy = surface.glossy != 0u;
+    let glossy = GLOSSY && surface.glossy != 0u;
     let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let eye = unit(media.camera_position - position.xyz);
     // Only visible diffuse surfaces (kind 0) take photon light.

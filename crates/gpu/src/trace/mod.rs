@@ -10,6 +10,7 @@
 //! could not write), so nothing is dropped and the maps stay deterministic.
 
 use crate::context::{GpuContext, GpuError};
+use crate::features::SceneFeatures;
 use crate::lod::dispatch_grid;
 use crate::tables::PackedTables;
 use crate::wgsl::{BVH, Module, OPTICS, PHOTON_ENCODING, PREFIX_SUM, RANDOM, SAMPLING, SPOT, SURFACE, compose};
@@ -413,6 +414,11 @@ pub struct GpuTraceReport {
 
 pub struct GpuTracer {
     trace: wgpu::ComputePipeline,
+    /// What `trace` is specialised to (`SceneFeatures`); a scene edited to
+    /// use more gets a new pipeline.
+    features: SceneFeatures,
+    trace_module: wgpu::ShaderModule,
+    trace_pipeline_layout: wgpu::PipelineLayout,
     sum_groups: wgpu::ComputePipeline,
     scan_groups: wgpu::ComputePipeline,
     write_offsets: wgpu::ComputePipeline,
@@ -432,8 +438,27 @@ pub struct GpuTracer {
     pub records_per_path: u32,
 }
 
+/// The tracing pipeline of `module` (trace.wgsl), specialised to `features`.
+fn trace_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    features: SceneFeatures,
+) -> wgpu::ComputePipeline {
+    let mut constants = features.constants(&trace_shader_source());
+    constants.push(("WORKGROUP_SIZE", TRACE_WORKGROUP as f64));
+    crate::binding::compute_pipeline_with(device, "trace paths", layout, module, "trace_paths", &constants)
+}
+
 impl GpuTracer {
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<Self, GpuError> {
+        Self::with_features(ctx, scene, SceneFeatures::of_scene(scene))
+    }
+
+    /// `new` with the tracing pipeline specialised to `features`, which
+    /// must include the scene's (tests compare `SceneFeatures::ALL`).
+    #[doc(hidden)]
+    pub fn with_features(ctx: &GpuContext, scene: &Scene, features: SceneFeatures) -> Result<Self, GpuError> {
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -474,17 +499,7 @@ impl GpuTracer {
                 source: wgpu::ShaderSource::Wgsl(compact_shader_source().into()),
             });
             let trace_pipeline_layout = crate::binding::pipeline_layout(device, "trace", &trace_layout);
-            let trace = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("trace paths"),
-                layout: Some(&trace_pipeline_layout),
-                module: &trace_module,
-                entry_point: Some("trace_paths"),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("WORKGROUP_SIZE", TRACE_WORKGROUP as f64)],
-                    ..Default::default()
-                },
-                cache: None,
-            });
+            let trace = trace_pipeline(device, &trace_pipeline_layout, &trace_module, features);
             let compact_pipeline_layout = crate::binding::pipeline_layout(device, "trace compact", &compact_layout);
             let compact = |entry_point: &str| {
                 crate::binding::compute_pipeline(
@@ -497,6 +512,9 @@ impl GpuTracer {
             };
             GpuTracer {
                 trace,
+                features,
+                trace_module,
+                trace_pipeline_layout,
                 sum_groups: compact("sum_groups"),
                 scan_groups: compact("scan_groups"),
                 write_offsets: compact("write_offsets"),
@@ -515,6 +533,13 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
+        let features = SceneFeatures::of_scene(scene);
+        if features.union(self.features) != self.features {
+            let device = &ctx.device;
+            self.trace =
+                ctx.scoped(|| trace_pipeline(device, &self.trace_pipeline_layout, &self.trace_module, features))?;
+            self.features = features;
+        }
         let scene = ctx.scoped(|| TraceScene::upload(&ctx.device, scene))?;
         self.scene = scene;
         // The bind groups hold the old scene's buffers.

@@ -277,7 +277,7 @@ fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
             return Ray(disc_origin(l, l.axis, rng_next_2d(rng)), l.axis);
         }
         case 5u: {
-            if (l.sky_image != 0u) {
+            if (SKY_IMAGE && l.sky_image != 0u) {
                 // From the image's sky direction ω, the photon travels along −ω.
                 let sky = sample_sky_image(l.sky_image, rng_next_2d(rng));
                 emission_weight = sky.weight;
@@ -524,7 +524,7 @@ fn trace_one(rng: ptr<function, Rng>) {
                     next_dir = refract_direction(ray.dir, n, eta, cos_i, fresnel.y);
                 }
             }
-        } else if (s.glossy != 0u) {
+        } else if (GLOSSY && s.glossy != 0u) {
             // The glTF BRDF (photon::trace's Pbr arm): stored where the
             // photon maps stand for some lobe, then a bounce sampling the
             // whole BRDF with roulette on the sample's weight.

@@ -88,7 +88,8 @@ impl VolumePass {
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "volume splat", &layout);
         let instances = [Some(crate::photons::photon_instances())];
-        let pipeline = crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &instances, "volume");
+        let pipeline =
+            crate::splat::additive_pipeline(device, &pipeline_layout, &module, format, &instances, "volume", &[], None);
         VolumePass { pipeline, bind_group, uniforms }
     }
 

@@ -55,7 +55,8 @@ pub static SAMPLING: Module =
 pub static OPTICS: Module = Module { name: "optics.wgsl", source: include_str!("optics.wgsl"), requires: &[] };
 
 /// The per-surface material record (scene_upload::GpuSurface).
-pub static SURFACE: Module = Module { name: "surface.wgsl", source: include_str!("surface.wgsl"), requires: &[] };
+pub static SURFACE: Module =
+    Module { name: "surface.wgsl", source: include_str!("surface.wgsl"), requires: &[&crate::features::FEATURES] };
 
 /// The glTF metallic–roughness BRDF (hikari_core::bsdf), and a surface's.
 pub static BSDF: Module = Module {
@@ -80,6 +81,7 @@ pub static BVH: Module = Module { name: "bvh.wgsl", source: include_str!("bvh.wg
 pub static CUT_OUTS: Module = Module {
     name: "cut_outs",
     source: "fn prim_is_there(prim: u32, b: vec2<f32>) -> bool {\n\
+             if (!CUT_OUTS) { return true; }\n\
              let p = prims[prim];\n\
              if (p.is_sphere != 0u) { return true; }\n\
              let s = surfaces[p.surface];\n\

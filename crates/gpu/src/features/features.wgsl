@@ -1,0 +1,19 @@
+// What the scene's surfaces and lights use (features/mod.rs, `SceneFeatures`), fixed
+// per pipeline: a pass tests these before the per-surface field, so code
+// for a feature no surface has folds away when the pipeline is compiled.
+// A software rasterizer (llvmpipe) runs both sides of every branch under a
+// mask; a real GPU skips them, but pays for their registers. The defaults
+// (everything on) are correct for any scene.
+
+// Some surface has a texture (base colour, metallic–roughness, emissive).
+override TEXTURED: bool = true;
+// Some surface is a cut-out (alphaMode MASK).
+override CUT_OUTS: bool = true;
+// Some surface reflects by the glTF BRDF's specular lobe (`Surface::glossy`).
+override GLOSSY: bool = true;
+// Some light is a sky or an emissive mesh (light_eval.wgsl's `sampled_radiance`).
+override SAMPLED_LIGHTS: bool = true;
+// The sky is an image (environment.wgsl).
+override SKY_IMAGE: bool = true;
+// Some medium fills the scene or a region (media.wgsl, view_depth.wgsl).
+override MEDIA: bool = true;

@@ -1,0 +1,129 @@
+//! Which material and light features a scene uses, as pipeline-overridable
+//! constants (features.wgsl): the passes test them before the per-surface
+//! fields, so a scene pays only for what it uses. Measured on llvmpipe,
+//! which runs both sides of every branch: the G-buffer of `cornell-box`
+//! (no texture, no cut-out, nothing glossy) took 9x its time before the
+//! glTF materials with the texture and cut-out code in it (BENCHMARKS.md).
+
+use crate::scene_upload::GpuSurface;
+use crate::textures::NO_TEXTURE;
+use hikari_core::light::Light;
+
+/// features.wgsl, required by `wgsl::SURFACE` (every pass that reads surfaces).
+pub static FEATURES: crate::wgsl::Module =
+    crate::wgsl::Module { name: "features.wgsl", source: include_str!("features.wgsl"), requires: &[] };
+
+/// What the surfaces and lights of a scene use (features.wgsl says what
+/// each stands for). `ALL` is correct for any scene.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SceneFeatures {
+    pub textured: bool,
+    pub cut_outs: bool,
+    pub glossy: bool,
+    pub sampled_lights: bool,
+    pub sky_image: bool,
+    pub media: bool,
+}
+
+impl SceneFeatures {
+    pub const ALL: SceneFeatures = SceneFeatures {
+        textured: true,
+        cut_outs: true,
+        glossy: true,
+        sampled_lights: true,
+        sky_image: true,
+        media: true,
+    };
+
+    /// What `surfaces` (scene_upload::scene_surfaces) and `lights` use, in
+    /// a scene with media where `media`.
+    pub fn of(surfaces: &[GpuSurface], lights: &[Light], media: bool) -> Self {
+        SceneFeatures {
+            textured: surfaces.iter().any(|s| {
+                [s.base_color_texture, s.metallic_roughness_texture, s.emissive_texture]
+                    .iter()
+                    .any(|&t| t != NO_TEXTURE)
+            }),
+            cut_outs: surfaces.iter().any(|s| s.alpha_cutoff >= 0.0),
+            glossy: surfaces.iter().any(|s| s.glossy != 0),
+            sampled_lights: lights.iter().any(|l| matches!(l, Light::Environment { .. } | Light::Mesh(_))),
+            sky_image: lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. })),
+            media,
+        }
+    }
+
+    /// Everything either uses.
+    pub fn union(self, other: SceneFeatures) -> SceneFeatures {
+        SceneFeatures {
+            textured: self.textured || other.textured,
+            cut_outs: self.cut_outs || other.cut_outs,
+            glossy: self.glossy || other.glossy,
+            sampled_lights: self.sampled_lights || other.sampled_lights,
+            sky_image: self.sky_image || other.sky_image,
+            media: self.media || other.media,
+        }
+    }
+
+    /// What `scene`'s surfaces and lights use.
+    pub fn of_scene(scene: &hikari_core::scene::Scene) -> Self {
+        Self::of(&crate::scene_upload::scene_surfaces(scene), &scene.lights, !scene.media.is_empty())
+    }
+
+    /// The constants for a pipeline of the shader `source`: those of
+    /// features.wgsl it declares (wgpu refuses values for overrides a
+    /// module lacks).
+    pub fn constants(&self, source: &str) -> Vec<(&'static str, f64)> {
+        [
+            ("TEXTURED", self.textured),
+            ("CUT_OUTS", self.cut_outs),
+            ("GLOSSY", self.glossy),
+            ("SAMPLED_LIGHTS", self.sampled_lights),
+            ("SKY_IMAGE", self.sky_image),
+            ("MEDIA", self.media),
+        ]
+        .into_iter()
+        .filter(|(name, _)| source.contains(&format!("override {name}: bool")))
+        .map(|(name, on)| (name, on as u32 as f64))
+        .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_constants_are_the_overrides_features_wgsl_declares() {
+        let features = SceneFeatures { textured: false, cut_outs: true, sampled_lights: false, ..SceneFeatures::ALL };
+        let constants = features.constants(FEATURES.source);
+        let expected = [
+            ("TEXTURED", 0.0),
+            ("CUT_OUTS", 1.0),
+            ("GLOSSY", 1.0),
+            ("SAMPLED_LIGHTS", 0.0),
+            ("SKY_IMAGE", 1.0),
+            ("MEDIA", 1.0),
+        ];
+        assert_eq!(constants, expected);
+        assert!(features.constants("fn main() {}").is_empty());
+    }
+
+    #[test]
+    fn built_in_scenes_use_what_their_materials_have() {
+        use hikari_core::scene::Scene;
+        let plain = SceneFeatures::of_scene(&Scene::load("cornell-box").unwrap());
+        let nothing = SceneFeatures {
+            textured: false,
+            cut_outs: false,
+            glossy: false,
+            sampled_lights: false,
+            sky_image: false,
+            media: false,
+        };
+        assert_eq!(plain, nothing);
+        assert!(SceneFeatures::of_scene(&Scene::load("fog-stage").unwrap()).media);
+        let showcase = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb");
+        let showcase = SceneFeatures::of_scene(&Scene::load(showcase).unwrap());
+        assert!(showcase.glossy && showcase.sampled_lights && !showcase.sky_image, "{showcase:?}");
+    }
+}
