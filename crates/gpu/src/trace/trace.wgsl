@@ -277,6 +277,10 @@ fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
             return Ray(disc_origin(l, l.axis, rng_next_2d(rng)), l.axis);
         }
         case 5u: {
+            if (!SAMPLED_LIGHTS) {
+                // No sky in the scene (features.wgsl): never reached.
+                return Ray(l.origin, l.axis);
+            }
             if (SKY_IMAGE && l.sky_image != 0u) {
                 // From the image's sky direction ω, the photon travels along −ω.
                 let sky = sample_sky_image(l.sky_image, rng_next_2d(rng));
@@ -287,6 +291,10 @@ fn emit(l: TraceLight, rng: ptr<function, Rng>) -> Ray {
             return Ray(disc_origin(l, dir, rng_next_2d(rng)), dir);
         }
         default: {
+            if (!SAMPLED_LIGHTS) {
+                // No emissive mesh in the scene: never reached.
+                return Ray(l.origin, l.axis);
+            }
             let point = mesh_point(l, rng_next_2d(rng));
             // Two-sided: either face, each with half the power.
             var n = point.normal;
@@ -473,7 +481,7 @@ fn trace_one(rng: ptr<function, Rng>) {
         }
         let hit = trace_bvh(ray.origin, ray.dir, params.epsilon);
         // Free flight through the media (eq. 5.10–5.12).
-        if (params.medium_count > 0u) {
+        if (MEDIA && params.medium_count > 0u) {
             var t_max = hit.t;
             let disc = params.distant_disc;
             if (hit.t >= NO_HIT && disc.w > 0.0) {
