@@ -655,7 +655,10 @@ fn bench_rows_keep_the_form_scripts_read() {
     assert!(out.status.success(), "{}", stderr(&out));
     let rows: Vec<&str> = text.lines().filter(|l| l.contains(" ms/frame)")).collect();
     assert_eq!(rows.len(), 1, "{text}");
-    assert!(rows[0].starts_with("cornell-box, 2,000 photons, LOD off at 512x512: ") && rows[0].contains(" fps ("), "{text}");
+    assert!(
+        rows[0].starts_with("cornell-box, 2,000 photons, LOD off at 512x512: ") && rows[0].contains(" fps ("),
+        "{text}"
+    );
     assert!(text.contains("per pass ("), "{text}");
     let out = hikari(&["bench", "--with-features", "shiny"], &dir);
     assert!(!out.status.success());

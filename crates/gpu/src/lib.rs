@@ -25,7 +25,9 @@
 //! of every branch, so a Lambertian box would otherwise pay for every
 //! material a glTF file can hold. The splat's quads bound their photon's
 //! sphere exactly on screen and lie at its front depth, so the G-buffer's
-//! depth test skips pixels whose surface lies nearer before they shade.
+//! depth test skips pixels whose surface lies nearer before they shade; its
+//! vertex shader trims each quad to the 16-pixel tiles whose depth range
+//! (`splat::depth_tiles`) meets the sphere's.
 //!
 //! Textures (`textures`) are one storage buffer of 8-bit texels with their
 //! mip chains, sampled by `textures.wgsl` with the CPU's filter: in the

@@ -16,6 +16,7 @@ use crate::scene_upload::SceneBuffers;
 use crate::shadow::light_samples::GpuLights;
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
+use crate::splat::depth_tiles::DepthTiles;
 use crate::splat::{SplatBinding, SplatParams, SplatPass};
 use crate::tiled::{Estimator, TiledBinding, TiledMap, TiledPass};
 use crate::volume::{VolumeParams, VolumePass};
@@ -147,6 +148,9 @@ pub struct GpuRenderer {
     features: SceneFeatures,
     gbuffer_pass: GBufferPass,
     gbuffer_binding: GBufferBinding,
+    /// The G-buffer's depth range per tile, made after it each frame (the
+    /// surface splat trims its quads by it).
+    depth_tiles: DepthTiles,
     splat_pass: SplatPass,
     global_splat: SplatBinding,
     caustic_splat: SplatBinding,
@@ -378,6 +382,7 @@ impl GpuRenderer {
             _pad1: 0,
         };
         let gbuffer_pass = GBufferPass::new(device, ctx.gbuffer_storage, features);
+        let depth_tiles = DepthTiles::new(device, &targets.gbuffer);
         let splat_pass = SplatPass::new(device, ctx.radiance_format, features);
         let direct_pass = DirectPass::new(device, ctx.radiance_format, features);
         let volume_pass = VolumePass::new(device, ctx.radiance_format, &volume_params, &media, &targets.gbuffer);
@@ -398,8 +403,9 @@ impl GpuRenderer {
             specular_pass,
             gbuffer_binding: gbuffer_pass.bind(device, &scene_buffers, &targets.gbuffer),
             gbuffer_pass,
-            global_splat: splat_pass.bind(device, &targets.gbuffer, &scene_buffers.surfaces),
-            caustic_splat: splat_pass.bind(device, &targets.gbuffer, &scene_buffers.surfaces),
+            global_splat: splat_pass.bind(device, &targets.gbuffer, &scene_buffers.surfaces, &depth_tiles.tiles),
+            caustic_splat: splat_pass.bind(device, &targets.gbuffer, &scene_buffers.surfaces, &depth_tiles.tiles),
+            depth_tiles,
             splat_pass,
             direct_binding: direct_pass.bind(
                 device,
@@ -519,8 +525,10 @@ impl GpuRenderer {
         self.scene = SceneBuffers::upload(device, scene);
         self.gbuffer_binding = self.gbuffer_pass.bind(device, &self.scene, &self.targets.gbuffer);
         self.shadow_scene = self.shadow_pass.bind_scene(device, &self.scene);
-        self.global_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
-        self.caustic_splat = self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces);
+        self.global_splat =
+            self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces, &self.depth_tiles.tiles);
+        self.caustic_splat =
+            self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces, &self.depth_tiles.tiles);
         self.bounds = scene.accel.bounds();
         let lights = GpuLights::new(scene, self.settings.area_light_samples);
         self.shadows_drawn.set(false);
@@ -836,6 +844,7 @@ impl GpuRenderer {
                 };
                 let t = &self.targets;
                 self.gbuffer_pass.record(queue, encoder, &self.scene, &self.gbuffer_binding, &params, &t.gbuffer);
+                self.depth_tiles.record(queue, encoder, self.clip_from_world);
             }
             Stage::Shadows => {
                 if !self.shadows_drawn.replace(true) {

@@ -40,13 +40,14 @@ fn photon_footprint(position: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(clamp(lo, vec2<f32>(-1.0), vec2<f32>(1.0)), clamp(hi, vec2<f32>(-1.0), vec2<f32>(1.0)));
 }
 
-// The depth (NDC z in [0, 1]) of a photon's sphere's nearest point, less a
-// few ulps of the depth buffer: every point within the sphere lies at
-// least this deep, so a pixel whose G-buffer surface is nearer (a depth
-// test LessEqual against the G-buffer's depth) cannot see it lit by this
-// photon, nor its view ray reach the sphere, and is skipped before its
-// fragment runs. A sphere reaching the eye plane: 0 (nothing skipped).
-fn photon_front_depth(position: vec3<f32>) -> f32 {
+// The depths (NDC z in [0, 1]) of a photon's sphere's nearest (x) and
+// farthest (y) points, widened by a few ulps of the depth buffer: every
+// point within the sphere lies between them, so a pixel whose G-buffer
+// surface lies nearer (the surface splat's depth test, LessEqual against
+// the G-buffer's depth, at x) or whose tile of pixels lies wholly outside
+// them (`trimmed_footprint`) cannot see it lit by this photon. A sphere
+// reaching the eye plane: (0, 1), nothing skipped.
+fn photon_depth_range(position: vec3<f32>) -> vec2<f32> {
     let m = params.clip_from_world;
     let c = m * vec4<f32>(position, 1.0);
     // The view's forward direction scaled by w's rate (unit for a camera).
@@ -54,10 +55,15 @@ fn photon_front_depth(position: vec3<f32>) -> f32 {
     let reach = length(forward);
     // Depth ulps near 1 span up to 6e-8 · w² / near in w, and near is
     // 1e-4 of the far plane: 0.4% of w is several ulps at any depth.
-    let w = c.w - params.radius * 1.01 * reach - 0.004 * c.w;
-    if (w <= 1.0e-6 || reach == 0.0) {
-        return 0.0;
+    let slack = 0.004 * c.w;
+    let w_front = c.w - params.radius * 1.01 * reach - slack;
+    if (w_front <= 1.0e-6 || reach == 0.0) {
+        return vec2<f32>(0.0, 1.0);
     }
-    let z = c.z - (params.radius * 1.01 + 0.004 * c.w / reach) * dot(vec3<f32>(m[0].z, m[1].z, m[2].z), forward) / reach;
-    return clamp(z / w, 0.0, 1.0);
+    // Along the forward axis from the centre, s world units.
+    let s = params.radius * 1.01 + slack / reach;
+    let dz = s * dot(vec3<f32>(m[0].z, m[1].z, m[2].z), forward) / reach;
+    let front = (c.z - dz) / w_front;
+    let back = (c.z + dz) / (c.w + s * reach);
+    return clamp(vec2<f32>(front, back), vec2<f32>(0.0), vec2<f32>(1.0));
 }

@@ -1,6 +1,8 @@
 //! The photon splat pass: instanced quads, one per photon, additively
 //! blended into a float radiance target (METHOD.md §4, steps 2–3).
 
+pub mod depth_tiles;
+
 use crate::gbuffer::GBuffer;
 use bytemuck::{Pod, Zeroable};
 
@@ -31,7 +33,8 @@ pub static FOOTPRINT_RECT: crate::wgsl::Module =
 
 pub fn shader_source() -> String {
     use crate::wgsl::{ESTIMATE, Module, compose};
-    static SPLAT: Module = Module { name: "splat.wgsl", source: include_str!("splat.wgsl"), requires: &[] };
+    static SPLAT: Module =
+        Module { name: "splat.wgsl", source: include_str!("splat.wgsl"), requires: &[&depth_tiles::TILE_CONSTANTS] };
     compose(&[&ESTIMATE, &FOOTPRINT, &SPLAT])
 }
 
@@ -116,11 +119,13 @@ impl SplatPass {
             label: Some("splat"),
             entries: &[
                 entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, uniform()),
-                entry(1, wgpu::ShaderStages::FRAGMENT, texture(D2)),
+                // The G-buffer's position: its size is read by the vertex shader.
+                entry(1, wgpu::ShaderStages::VERTEX_FRAGMENT, texture(D2)),
                 entry(2, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(3, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(4, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
                 entry(5, wgpu::ShaderStages::FRAGMENT, texture(D2)),
+                entry(6, wgpu::ShaderStages::VERTEX, texture(D2)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "splat", &layout);
@@ -146,8 +151,15 @@ impl SplatPass {
     }
 
     /// The uniforms and bind group of one map's splat over `gbuffer` of a
-    /// scene with `surfaces` (`SceneBuffers::surfaces`), made once per scene.
-    pub fn bind(&self, device: &wgpu::Device, gbuffer: &GBuffer, surfaces: &wgpu::Buffer) -> SplatBinding {
+    /// scene with `surfaces` (`SceneBuffers::surfaces`), with `depth_tiles`
+    /// (`depth_tiles::DepthTiles::tiles`), made once per scene.
+    pub fn bind(
+        &self,
+        device: &wgpu::Device,
+        gbuffer: &GBuffer,
+        surfaces: &wgpu::Buffer,
+        depth_tiles: &wgpu::Texture,
+    ) -> SplatBinding {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("splat params"),
             size: std::mem::size_of::<SplatParams>() as u64,
@@ -167,6 +179,7 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&albedo) },
                 wgpu::BindGroupEntry { binding: 4, resource: surfaces.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&emission) },
+                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&view(depth_tiles)) },
             ],
         });
         SplatBinding { uniforms, bind_group, depth: view(&gbuffer.depth) }

@@ -22,6 +22,51 @@ struct SplatParams {
 @group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
 @group(0) @binding(5) var gbuffer_emission: texture_2d<f32>;
 
+// Tiles of the G-buffer's depth range (depth_tiles.rs), read by the
+// vertex shader.
+@group(0) @binding(6) var depth_tiles: texture_2d<f32>;
+
+// The photon's footprint trimmed to the tiles whose depth range meets its
+// sphere's (photon_depth_range): only their pixels can hold a point within
+// r of it. No tile: nothing drawn. Quads over more than TRIM_TILES tiles a
+// side are drawn whole (the loop reads that many squared).
+fn splat_footprint(position: vec3<f32>) -> vec4<f32> {
+    let rect = photon_footprint(position);
+    if (rect.x > rect.z || rect.y > rect.w) {
+        return rect;
+    }
+    let size = vec2<f32>(textureDimensions(gbuffer_position));
+    let tiles = vec2<i32>(textureDimensions(depth_tiles));
+    // NDC to pixels (y down).
+    let px_lo = vec2<f32>(rect.x + 1.0, 1.0 - rect.w) * 0.5 * size;
+    let px_hi = vec2<f32>(rect.z + 1.0, 1.0 - rect.y) * 0.5 * size;
+    let t0 = clamp(vec2<i32>(floor(px_lo / f32(DEPTH_TILE))), vec2<i32>(0), tiles - 1);
+    let t1 = clamp(vec2<i32>(floor(px_hi / f32(DEPTH_TILE))), vec2<i32>(0), tiles - 1);
+    if (any(t1 - t0 >= vec2<i32>(i32(TRIM_TILES)))) {
+        return rect;
+    }
+    let depth = photon_depth_range(position);
+    var lo = tiles;
+    var hi = vec2<i32>(-1);
+    for (var y = t0.y; y <= t1.y; y++) {
+        for (var x = t0.x; x <= t1.x; x++) {
+            let range = textureLoad(depth_tiles, vec2<i32>(x, y), 0).xy;
+            if (range.x <= depth.y && range.y >= depth.x) {
+                lo = min(lo, vec2<i32>(x, y));
+                hi = max(hi, vec2<i32>(x, y));
+            }
+        }
+    }
+    if (hi.x < 0) {
+        return vec4<f32>(1.0, 1.0, -1.0, -1.0);
+    }
+    // The tiles' pixel edges back in NDC, within the sphere's rectangle.
+    let edge_lo = vec2<f32>(lo * i32(DEPTH_TILE)) / size;
+    let edge_hi = vec2<f32>((hi + 1) * i32(DEPTH_TILE)) / size;
+    let trimmed = vec4<f32>(edge_lo.x * 2.0 - 1.0, 1.0 - edge_hi.y * 2.0, edge_hi.x * 2.0 - 1.0, 1.0 - edge_lo.y * 2.0);
+    return vec4<f32>(max(rect.xy, trimmed.xy), min(rect.zw, trimmed.zw));
+}
+
 @fragment
 fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(in.clip.xy);

@@ -21,6 +21,12 @@ struct VolumeParams {
 @group(0) @binding(3) var slices_tex: texture_2d_array<f32>;
 @group(0) @binding(4) var gbuffer_position: texture_2d<f32>;
 
+// Every pixel of the sphere's footprint: the view ray can cross the sphere
+// in front of any surface.
+fn splat_footprint(position: vec3<f32>) -> vec4<f32> {
+    return photon_footprint(position);
+}
+
 @fragment
 fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(in.clip.xy);
