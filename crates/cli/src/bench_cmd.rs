@@ -54,14 +54,7 @@ pub struct BenchArgs {
 
 /// One `--with-features` name as the features it turns on.
 fn parse_feature(name: &str) -> Result<SceneFeatures, String> {
-    let none = SceneFeatures {
-        textured: false,
-        cut_outs: false,
-        glossy: false,
-        sampled_lights: false,
-        sky_image: false,
-        media: false,
-    };
+    let none = SceneFeatures::NONE;
     Ok(match name {
         "textured" => SceneFeatures { textured: true, ..none },
         "cut-outs" => SceneFeatures { cut_outs: true, ..none },

@@ -26,6 +26,15 @@ pub struct SceneFeatures {
 }
 
 impl SceneFeatures {
+    /// What a Lambertian scene lit by point, spot, area and sun lights uses.
+    pub const NONE: SceneFeatures = SceneFeatures {
+        textured: false,
+        cut_outs: false,
+        glossy: false,
+        sampled_lights: false,
+        sky_image: false,
+        media: false,
+    };
     pub const ALL: SceneFeatures = SceneFeatures {
         textured: true,
         cut_outs: true,
@@ -112,15 +121,7 @@ mod tests {
     fn built_in_scenes_use_what_their_materials_have() {
         use hikari_core::scene::Scene;
         let plain = SceneFeatures::of_scene(&Scene::load("cornell-box").unwrap());
-        let nothing = SceneFeatures {
-            textured: false,
-            cut_outs: false,
-            glossy: false,
-            sampled_lights: false,
-            sky_image: false,
-            media: false,
-        };
-        assert_eq!(plain, nothing);
+        assert_eq!(plain, SceneFeatures::NONE);
         assert!(SceneFeatures::of_scene(&Scene::load("fog-stage").unwrap()).media);
         let showcase = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb");
         let showcase = SceneFeatures::of_scene(&Scene::load(showcase).unwrap());
