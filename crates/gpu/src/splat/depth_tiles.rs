@@ -13,7 +13,8 @@ pub const DEPTH_TILE: u32 = 16;
 /// the eye, are drawn whole: the vertex shader reads this many squared).
 pub const TRIM_TILES: u32 = 8;
 
-/// `DEPTH_TILE` and `TRIM_TILES` for the WGSL that reads them.
+/// `DEPTH_TILE` and `TRIM_TILES` for the WGSL that reads them (a test
+/// holds the two to the Rust constants).
 pub static TILE_CONSTANTS: crate::wgsl::Module = crate::wgsl::Module {
     name: "depth_tile_constants",
     source: "const DEPTH_TILE: u32 = 16u;\nconst TRIM_TILES: u32 = 8u;\n",
@@ -95,5 +96,17 @@ impl DepthTiles {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(self.tiles.width().div_ceil(8), self.tiles.height().div_ceil(8), 1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_wgsl_constants_are_the_rust_ones() {
+        let source = TILE_CONSTANTS.source;
+        assert!(source.contains(&format!("const DEPTH_TILE: u32 = {DEPTH_TILE}u;")), "{source}");
+        assert!(source.contains(&format!("const TRIM_TILES: u32 = {TRIM_TILES}u;")), "{source}");
     }
 }
