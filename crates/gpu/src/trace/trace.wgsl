@@ -489,13 +489,13 @@ fn trace_one(rng: ptr<function, Rng>) {
             }
             let flight = sample_flight(ray.origin, ray.dir, t_max, rng_next_f32(rng));
             if (flight.interaction) {
-                let scattering = media_scattering(flight.mask);
+                let scattering = media_scattering(flight.coefficients);
                 if (rng_next_f32(rng) >= scattering.w) {
                     return;
                 }
                 power *= flight.weight * scattering.xyz;
                 let x = ray.origin + ray.dir * flight.distance;
-                let m = medium_at(choose_scatterer(flight.mask, rng_next_f32(rng)));
+                let m = medium_at(choose_scatterer(flight.mask, rgb_mean(flight.coefficients.sigma_s), rng_next_f32(rng)));
                 store(VOLUME_MAP, diffuse_bounces, x, power, ray.dir, m.phase_slot);
                 diffuse_bounces += 1u;
                 ray = Ray(x, phase_sample(m.phase_kind, m.phase_parameter, ray.dir, rng_next_2d(rng)));
@@ -611,9 +611,9 @@ fn mask_coefficients(mask: u32) -> Coefficients {
     return total;
 }
 
-// Media::scattering: the albedo roulette's per-channel factor (xyz) and Λ (w).
-fn media_scattering(mask: u32) -> vec4<f32> {
-    let coefficients = mask_coefficients(mask);
+// Media::scattering: the albedo roulette's per-channel factor (xyz) and Λ (w),
+// from the summed coefficients of the media there.
+fn media_scattering(coefficients: Coefficients) -> vec4<f32> {
     let sigma_t = coefficients.sigma_t;
     let sigma_s = coefficients.sigma_s;
     var lambda = 0.0;
@@ -627,9 +627,14 @@ fn media_scattering(mask: u32) -> vec4<f32> {
     return vec4<f32>(albedo / lambda, lambda);
 }
 
-// Media::choose_scatterer: a medium of `mask` with probability ∝ its mean σ_s.
-fn choose_scatterer(mask: u32, xi: f32) -> u32 {
-    let total = rgb_mean(mask_coefficients(mask).sigma_s);
+// Media::choose_scatterer: a medium of `mask` with probability ∝ its mean σ_s
+// (`total`: the mask's summed mean σ_s). A mask of one medium is that medium
+// without reading it, as the loop gives (acc = x / x = 1 > xi, or NaN for
+// σ_s = 0, where the loop ends on that same last bit).
+fn choose_scatterer(mask: u32, total: f32, xi: f32) -> u32 {
+    if (countOneBits(mask) == 1u) {
+        return firstTrailingBit(mask);
+    }
     var acc = 0.0;
     var bits = mask;
     var last = firstTrailingBit(mask);
@@ -653,6 +658,9 @@ struct Flight {
     distance: f32,
     weight: vec3<f32>,
     mask: u32,
+    // The summed coefficients of the media in `mask` (read once per flight
+    // piece: each medium is a table record of 12 words).
+    coefficients: Coefficients,
 }
 
 // A region triangle's crossing (region_crossing.wgsl): its distance, or 0.
@@ -685,6 +693,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
     var tau_bar = 0.0;
     var tau = vec3<f32>(0.0);
     var t0 = 0.0;
+    var coefficients = Coefficients(vec3<f32>(0.0), vec3<f32>(0.0));
     var mask = params.global_mask;
     if (params.region_triangles > 0u) {
         for (var i = 0u; i < params.medium_count; i++) {
@@ -718,7 +727,8 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
             }
         }
         let t1 = min(t_next, t_max);
-        let sigma_t = mask_coefficients(mask).sigma_t;
+        coefficients = mask_coefficients(mask);
+        let sigma_t = coefficients.sigma_t;
         let sigma_bar = rgb_mean(sigma_t);
         if (sigma_bar > 0.0) {
             let length = t1 - t0;
@@ -726,7 +736,7 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
                 let distance = (target_depth - tau_bar) / sigma_bar;
                 let tau_c = tau + sigma_t * distance;
                 let weight = exp(-(tau_c - vec3<f32>(target_depth))) * sigma_t / sigma_bar;
-                return Flight(true, t0 + distance, weight, mask);
+                return Flight(true, t0 + distance, weight, mask, coefficients);
             }
             tau_bar += sigma_bar * length;
             tau += sigma_t * length;
@@ -747,5 +757,5 @@ fn sample_flight(o: vec3<f32>, d: vec3<f32>, t_max: f32, xi: f32) -> Flight {
         t0 = t_next;
         mask = winding_mask(params.medium_count);
     }
-    return Flight(false, 0.0, exp(-(tau - vec3<f32>(tau_bar))), mask);
+    return Flight(false, 0.0, exp(-(tau - vec3<f32>(tau_bar))), mask, coefficients);
 }
