@@ -37,7 +37,7 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
         discard;
     }
     let transmittance = exp(-view_optical_depth(pixel, chord.z, ray.w));
-    let radiance = transmittance * chord_scattering(in.power_rgb9e5, in.direction_and_class, dir, chord)
+    let radiance = transmittance * decoded_chord_scattering(in.power, in.direction, in.direction_and_class >> 30u, dir, chord)
         * (volume_kernel(params.radius) * params.power_unit * in.scale);
     return vec4<f32>(radiance, 1.0);
 }

@@ -23,9 +23,15 @@ fn volume_chord(o: vec3<f32>, d: vec3<f32>, len: f32, p: vec3<f32>, r2: f32) -> 
 // (propagation `d`) times the chord length: what the photon scatters along
 // the chord, before the transmittance to s_p and the 1/((4/3)πr³) kernel.
 fn chord_scattering(power_rgb9e5: u32, direction_and_class: u32, d: vec3<f32>, chord: vec3<f32>) -> vec3<f32> {
-    let mu = dot(decode_octahedral_15(direction_and_class & 0x3fffffffu), -d);
-    let phase = phase_eval(direction_and_class >> 30u, mu);
-    return decode_rgb9e5(power_rgb9e5) * (phase * (chord.y - chord.x));
+    let direction = decode_octahedral_15(direction_and_class & 0x3fffffffu);
+    return decoded_chord_scattering(decode_rgb9e5(power_rgb9e5), direction, direction_and_class >> 30u, d, chord);
+}
+
+// The same from the photon already decoded: its power, travel direction and
+// phase slot (the volume splat decodes them per vertex, not per fragment).
+fn decoded_chord_scattering(power: vec3<f32>, direction: vec3<f32>, phase_slot: u32, d: vec3<f32>, chord: vec3<f32>) -> vec3<f32> {
+    let phase = phase_eval(phase_slot, dot(direction, -d));
+    return power * (phase * (chord.y - chord.x));
 }
 
 // The kernel 1/((4/3)πr³) of the volume estimate.
