@@ -6,7 +6,6 @@ mod passes;
 mod plot_cmd;
 mod progress_bar;
 mod render_cmd;
-mod tracing;
 mod view;
 
 use clap::{Parser, Subcommand};

@@ -1,30 +1,20 @@
-//! `hikari render`: load a scene, trace photons, render, write the image.
+//! `hikari render`: arguments in, image or shard part out. What renders
+//! (the renderer chosen once, its fallback, the passes and when they stop)
+//! is the engine's (`hikari_engine::Session`).
 
-use crate::passes::renderers::{CpuPasses, GpuPasses, PathPasses, VcmPasses};
-use crate::passes::{self, PassPlan, read_reference};
+use crate::passes::{self, Reporting, read_reference};
 use crate::progress_bar::TerminalProgress;
-use crate::tracing::{PhotonTracer, TraceDevice};
 use anyhow::{Context, Result};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use hikari_core::lod::LodSettings;
 use hikari_core::output::write_image;
-use hikari_core::photon::TracedPhotons;
-use hikari_core::photon::{TraceSettings, trace_photons};
-use hikari_core::progress::Silent;
+use hikari_core::progressive::DEFAULT_ALPHA;
 use hikari_core::progressive::shard::{Part, PartHeader, Shard, fingerprint};
-use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_trace_settings};
-use hikari_core::render::{Image, path, photon_cpu, vcm};
-
-/// A render without --passes, --time or --target-error (nor --spp with the
-/// path tracer) renders passes until the noise they estimate falls to this
-/// fraction of the image's mean, or for this many seconds, whichever first.
-pub const DEFAULT_TARGET_ERROR: f64 = 0.02;
-pub const DEFAULT_TIME_LIMIT: f64 = 20.0;
-/// Samples per pixel of the path tracer's open-ended passes (without --spp).
-const PATH_PASS_SPP: u32 = 4;
 use hikari_core::scene::{Scene, builtin};
-use hikari_gpu::tiled::Estimator;
-use hikari_gpu::{GpuContext, GpuError, GpuRenderer, GpuSettings};
+pub use hikari_engine::settings::{
+    DEFAULT_TARGET_ERROR, DEFAULT_TIME_LIMIT, EstimatorChoice, RendererKind, TraceDevice, VcmStrategies,
+};
+use hikari_engine::{Log, Plan, RenderSettings, Session};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -33,69 +23,6 @@ macro_rules! usage {
     ($($arg:tt)*) => {
         return Err(UsageError(format!($($arg)*)).into())
     };
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum RendererKind {
-    /// The seed's photon splatting on the GPU. Falls back to photon-cpu,
-    /// saying why, when no adapter can run it, when the scene or settings
-    /// exceed the adapter's limits, or on any GPU error.
-    Gpu,
-    /// The seed's fixed-radius photon mapping on the CPU.
-    PhotonCpu,
-    /// Path tracer: the unbiased ground truth (next-event estimation with MIS; equiangular sampling of point and spot lights in fog).
-    Path,
-    /// Vertex connection and merging: light tracing, bidirectional
-    /// connections and photon merging weighted by MIS, in progressive
-    /// passes, fog included (points in media merge within a ball).
-    Vcm,
-}
-
-/// Which of VCM's strategies `--renderer vcm` uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum VcmStrategies {
-    /// Connections and merging.
-    All,
-    /// Connections only: bidirectional path tracing (unbiased).
-    Connections,
-    /// Merging only: progressive photon mapping at every eye vertex.
-    Merging,
-    /// Light tracing alone (and the lights the eye sees directly).
-    LightTracing,
-}
-
-impl From<VcmStrategies> for hikari_core::render::vcm::Strategies {
-    fn from(s: VcmStrategies) -> Self {
-        use hikari_core::render::vcm::Strategies;
-        match s {
-            VcmStrategies::All => Strategies::All,
-            VcmStrategies::Connections => Strategies::Connections,
-            VcmStrategies::Merging => Strategies::Merging,
-            VcmStrategies::LightTracing => Strategies::LightTracing,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum EstimatorChoice {
-    /// Tiled on hardware GPUs (their compute units far outnumber their
-    /// rasterizers), raster on software adapters (lavapipe, llvmpipe).
-    Auto,
-    /// The seed's method: one instanced quad per photon, added by blending.
-    Raster,
-    /// Photons binned into 16×16-pixel screen tiles, each pixel summing
-    /// its tile's photons in a compute shader (exact fixed-point sums).
-    Tiled,
-}
-
-impl EstimatorChoice {
-    pub fn on(self, ctx: &GpuContext) -> Estimator {
-        match self {
-            EstimatorChoice::Auto => Estimator::for_adapter(ctx),
-            EstimatorChoice::Raster => Estimator::Raster,
-            EstimatorChoice::Tiled => Estimator::Tiled,
-        }
-    }
 }
 
 #[derive(Args, Clone, Debug)]
@@ -370,176 +297,42 @@ pub fn load_scene(
 /// built-in scenes (3 stored photons of 20 bytes per path).
 pub const MAX_PHOTONS: u64 = 100_000_000;
 
-/// photon-cpu's settings for these arguments (also the GPU's radii).
-fn cpu_settings(args: &RenderArgs) -> photon_cpu::PhotonCpuSettings {
-    photon_cpu::PhotonCpuSettings {
-        radius: args.radius,
-        caustic_radius: args.caustic_radius,
-        spp: args.spp.unwrap_or(4),
-        seed: args.seed,
-        area_light_samples: args.area_light_samples,
-        normal_test: args.normal_test.unwrap_or(progressive(args)),
-        volume_radius: args.volume_radius,
-        ..Default::default()
-    }
-}
-
-/// The GPU renderer's settings for these arguments.
-fn gpu_settings(args: &RenderArgs, scene: &Scene, settings: &photon_cpu::PhotonCpuSettings) -> GpuSettings {
-    let (global, caustic) = settings.estimate_params(scene);
+/// The engine's settings for these arguments.
+fn render_settings(args: &RenderArgs) -> RenderSettings {
     let lod = match (args.lod_near, args.lod_far) {
         (Some(near), Some(far)) => Some(LodSettings { near, far, groups: args.lod_groups }),
         _ => None,
     };
-    GpuSettings {
+    RenderSettings {
+        renderer: args.renderer,
+        trace: args.trace,
+        estimator: args.estimator,
+        photons: args.photons,
+        radius: args.radius,
+        caustic_radius: args.caustic_radius,
+        volume_radius: args.volume_radius,
+        spp: args.spp,
+        seed: args.seed,
+        vcm_strategies: args.vcm_strategies,
         area_light_samples: args.area_light_samples,
         shadow_map_size: args.shadow_map_size,
-        lod,
-        volume_radius: args.volume_radius.unwrap_or_else(|| photon_cpu::default_radius(scene)),
         volume_slices: args.volume_slices,
-        ..GpuSettings::new(global, caustic)
+        normal_test: args.normal_test,
+        lod,
+        alpha: args.alpha,
     }
 }
 
-/// Photons each map will hold for `photons` paths, from a pilot trace of a
-/// few thousand paths (with 25% to spare), so limits are checked before
-/// the real trace.
-fn expected_map_sizes(scene: &Scene, photons: u64, seed: u64) -> [u64; 3] {
-    const PILOT: u64 = 4096;
-    let quiet = TerminalProgress::new(true);
-    let pilot =
-        trace_photons(scene, &TraceSettings { photons: PILOT, seed: seed ^ 0x9e37, ..Default::default() }, &quiet);
-    let per_path = |stored: usize| (stored as f64 / PILOT as f64 * photons as f64 * 1.25).ceil() as u64 + 64;
-    [per_path(pilot.indirect().len()), per_path(pilot.caustic.len()), per_path(pilot.volume.len())]
-}
-
-/// An adapter that can draw `scene` with `settings`, or None after one line
-/// saying why not.
-fn open_gpu(scene: &Scene, settings: &GpuSettings, expected: [u64; 3]) -> Option<GpuContext> {
-    let ctx = match GpuContext::new() {
-        Ok(ctx) => ctx,
-        Err(e) => {
-            eprintln!("{e}: rendering with photon-cpu instead");
-            return None;
-        }
-    };
-    if let Err(e) = GpuRenderer::check_fits(&ctx, scene, settings, expected) {
-        eprintln!("gpu {}: {e}: rendering with photon-cpu instead", ctx.describe());
-        return None;
+/// When the passes stop, as the flags say (checkpoints and a reference
+/// ask for passes).
+fn render_plan(args: &RenderArgs) -> Plan {
+    Plan {
+        passes: args.passes,
+        time: args.time.map(Duration::from_secs_f64),
+        target_error: args.target_error,
+        shard: args.shard,
+        in_passes: args.reference.is_some() || args.checkpoint.is_some(),
     }
-    Some(ctx)
-}
-
-/// One frame on the GPU, read back.
-fn render_on_gpu(
-    ctx: GpuContext,
-    scene: &Scene,
-    traced: &TracedPhotons,
-    settings: GpuSettings,
-) -> Result<(Image, u64), GpuError> {
-    let adapter = format!("{}, {:?} estimator", ctx.describe(), settings.estimator);
-    if !ctx.float32_blend && settings.estimator == Estimator::Raster {
-        eprintln!(
-            "note: {} cannot blend 32-bit float targets; photon splats accumulate in 16-bit floats (about 3 significant digits)",
-            ctx.describe()
-        );
-    }
-    let setup_start = Instant::now();
-    let renderer = GpuRenderer::new(ctx, scene, traced, settings)?;
-    let setup = setup_start.elapsed().as_secs_f64();
-    let frame_start = Instant::now();
-    renderer.render()?;
-    let result = renderer.read_image()?;
-    let slices = renderer.specular_slices();
-    let split = if slices > 1 { format!(", specular gathers split into {slices} dispatches") } else { String::new() };
-    eprintln!(
-        "gpu: {adapter}; setup {setup:.2} s, frame and readback {:.3} s (1 sample per pixel{split})",
-        frame_start.elapsed().as_secs_f64()
-    );
-    Ok(result)
-}
-
-/// Traces photons, then splats them on the GPU or estimates them on the CPU.
-fn render_photons(
-    args: &RenderArgs,
-    renderer: RendererKind,
-    scene: &Scene,
-    progress: &TerminalProgress,
-) -> Result<(Image, u64)> {
-    let settings = cpu_settings(args);
-    let gpu_settings = gpu_settings(args, scene, &settings);
-    let needs_estimate = renderer == RendererKind::Gpu || args.photons > 2_000_000;
-    let expected = if needs_estimate { expected_map_sizes(scene, args.photons, args.seed) } else { [0; 3] };
-    if args.photons > 2_000_000 {
-        let stored: u64 = expected.iter().sum();
-        eprintln!(
-            "note: {} photon paths will store about {} M photons: about {} MiB of photon maps",
-            args.photons,
-            stored / 1_000_000,
-            (stored * 20) >> 20
-        );
-    }
-    let gpu = match renderer {
-        RendererKind::Gpu => open_gpu(scene, &gpu_settings, expected),
-        _ => None,
-    };
-    let mut tracer = PhotonTracer::choose(args.trace, gpu.as_ref(), scene);
-    let trace_start = Instant::now();
-    let traced =
-        tracer.trace(scene, &TraceSettings { photons: args.photons, seed: args.seed, ..Default::default() }, progress);
-    let trace_time = trace_start.elapsed().as_secs_f64();
-    eprintln!(
-        "photons (traced on the {}): {} emitted, {} stored in the global map, {} in the caustic map, {} in the volume map; {:.2} M paths/s ({:.2} s)",
-        tracer.device(),
-        traced.stats.emitted,
-        traced.global.len(),
-        traced.caustic.len(),
-        traced.volume.len(),
-        traced.stats.emitted as f64 / trace_time / 1e6,
-        trace_time
-    );
-    let (global, caustic) = settings.estimate_params(scene);
-    eprintln!("radius {:.4}, caustic radius {:.4}", global.radius, caustic.radius);
-    if let Some(ctx) = gpu {
-        let gpu_settings = GpuSettings { estimator: args.estimator.on(&ctx), ..gpu_settings };
-        match render_on_gpu(ctx, scene, &traced, gpu_settings) {
-            Ok(result) => return Ok(result),
-            Err(e) => eprintln!("gpu: {e}: rendering with photon-cpu instead"),
-        }
-    }
-    let build_start = Instant::now();
-    let cpu = photon_cpu::PhotonCpuRenderer::new(scene, &traced, &settings);
-    let build_time = build_start.elapsed().as_secs_f64();
-    let render_start = Instant::now();
-    let result = cpu.render(progress);
-    eprintln!(
-        "photon-cpu: photon-map indexes {build_time:.2} s, render {:.2} s ({} spp)",
-        render_start.elapsed().as_secs_f64(),
-        settings.spp
-    );
-    Ok(result)
-}
-
-/// Whether to render in progressive passes: more than one pass, a time
-/// limit, checkpoints or a reference to compare with, or nothing said
-/// ([`by_default`]).
-fn progressive(args: &RenderArgs) -> bool {
-    args.passes.is_some_and(|n| n > 1)
-        || args.time.is_some()
-        || args.reference.is_some()
-        || args.checkpoint.is_some()
-        || args.target_error.is_some()
-        || by_default(args)
-}
-
-/// Whether nothing says when to stop, so the render stops at
-/// [`DEFAULT_TARGET_ERROR`] or [`DEFAULT_TIME_LIMIT`]: no --passes,
-/// --time or --target-error, and for the path tracer no --spp.
-fn by_default(args: &RenderArgs) -> bool {
-    args.passes.is_none()
-        && args.time.is_none()
-        && args.target_error.is_none()
-        && !(args.renderer == RendererKind::Path && args.spp.is_some())
 }
 
 /// A fraction in (0, 1).
@@ -550,46 +343,9 @@ fn parse_fraction(text: &str) -> Result<f64, String> {
     }
 }
 
-/// What a render in passes made: the image, the non-finite samples
-/// dropped and, for a shard, what its part keeps.
-struct Passes {
-    image: Image,
-    nonfinite: u64,
-    part: Option<PartBody>,
-}
-
-/// A shard's passes: its sums, which passes, and who rendered them.
-struct PartBody {
-    sums: Vec<[f64; 3]>,
-    passes: Vec<u32>,
-    stopped_early: bool,
-    /// The renderer that ran (after any fallback), with how (gpu: where photons were traced, the estimator).
-    renderer: String,
-}
-
-/// What `renderer` made of `plan` (`done`): a shard keeps its sums.
-fn finish<R: passes::PassRenderer>(
-    done: passes::Outcome,
-    renderer: &mut R,
-    plan: &PassPlan,
-    name: &str,
-    nonfinite: impl Fn(&R) -> u64,
-) -> Result<Passes> {
-    let part = match plan.shard {
-        None => None,
-        Some(_) => Some(PartBody {
-            sums: renderer.sums()?,
-            passes: done.passes,
-            stopped_early: done.stopped_early,
-            renderer: name.to_string(),
-        }),
-    };
-    Ok(Passes { image: done.image, nonfinite: nonfinite(renderer), part })
-}
-
-/// Renders in passes (`--passes`, `--time`, `--reference`, `--shard`) with
-/// `kind`; the GPU falls back to photon-cpu as the single pass does.
-fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Result<Passes> {
+/// What the terminal shows while the passes run; a bad reference or
+/// checkpoint is a usage error.
+fn reporting(args: &RenderArgs, scene: &Scene, settings: &RenderSettings, plan: &Plan) -> Result<Reporting> {
     let reference = match &args.reference {
         None => None,
         Some(path) => {
@@ -601,126 +357,27 @@ fn render_in_passes(args: &RenderArgs, kind: RendererKind, scene: &Scene) -> Res
             Some((path.clone(), image))
         }
     };
-    let defaults = by_default(args);
-    let target_error = args.target_error.or(defaults.then_some(DEFAULT_TARGET_ERROR));
-    let time = args.time.or(defaults.then_some(DEFAULT_TIME_LIMIT));
-    if args.checkpoint.is_some() && args.passes.is_none_or(|n| n == 1) && time.is_none() && target_error.is_none() {
+    if args.checkpoint.is_some()
+        && args.passes.is_none_or(|n| n == 1)
+        && plan.time_or_default(settings).is_none()
+        && plan.target_error_or_default(settings).is_none()
+    {
         usage!("--checkpoint needs --passes (more than 1), --time or --target-error");
     }
-    if defaults && !args.quiet {
+    if plan.by_default(settings) && !args.quiet {
         eprintln!(
             "rendering passes until the estimated noise is {}% or {DEFAULT_TIME_LIMIT} s have passed (--passes 1: the seed's single pass)",
             100.0 * DEFAULT_TARGET_ERROR
         );
     }
-    let open_ended = time.is_some() || target_error.is_some();
-    let plan = PassPlan {
-        passes: args.passes.unwrap_or(if open_ended { u32::MAX } else { 1 }),
+    Ok(Reporting {
         shard: args.shard,
-        target_error,
-        time: time.map(Duration::from_secs_f64),
         checkpoint: args.checkpoint.map(Duration::from_secs_f64),
         reference,
         output: args.output.clone(),
         exposure: args.exposure,
         quiet: args.quiet,
-    };
-    let (w, h) = (scene.camera.width, scene.camera.height);
-    if kind == RendererKind::Path {
-        let spp = args.spp.unwrap_or(if open_ended { PATH_PASS_SPP } else { 64 });
-        let settings = path::PathSettings { spp, seed: args.seed, ..Default::default() };
-        eprintln!("path tracing in passes of {} spp", settings.spp);
-        let mut passes = PathPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0 };
-        let done = passes::run(&mut passes, &plan)?;
-        return finish(done, &mut passes, &plan, "path", |p| p.nonfinite);
-    }
-    if kind == RendererKind::Vcm {
-        let settings = vcm::VcmSettings {
-            seed: args.seed,
-            strategies: args.vcm_strategies.into(),
-            radius: args.radius,
-            volume_radius: args.volume_radius,
-            alpha: args.alpha,
-            ..Default::default()
-        };
-        let radius = settings.radius.unwrap_or_else(|| vcm::default_radius(scene));
-        let in_media = if scene.media.is_empty() {
-            String::new()
-        } else {
-            let volume = settings.volume_radius.unwrap_or_else(|| vcm::default_volume_radius(scene));
-            format!(" ({volume:.4} in media)")
-        };
-        eprintln!(
-            "vcm ({:?}): one light and one camera subpath per pixel a pass, first merging radius {radius:.4}{in_media}, α = {}",
-            settings.strategies, args.alpha
-        );
-        let mut passes =
-            VcmPasses { scene, settings, mean: ImageMean::new(w, h), nonfinite: 0, workspace: Default::default() };
-        let done = passes::run(&mut passes, &plan)?;
-        return finish(done, &mut passes, &plan, "vcm", |p| p.nonfinite);
-    }
-    let settings = cpu_settings(args);
-    let (global, caustic) = settings.estimate_params(scene);
-    let volume = args.volume_radius.unwrap_or_else(|| hikari_core::progressive::default_volume_radius(scene));
-    let schedules = Schedules::new([global.radius, caustic.radius, volume], args.alpha);
-    eprintln!(
-        "progressive: {} photon paths per pass, α = {}; first radii {:.4} (global), {:.4} (caustic){}",
-        args.photons,
-        args.alpha,
-        global.radius,
-        caustic.radius,
-        if scene.media.is_empty() { String::new() } else { format!(", {volume:.4} (volume)") }
-    );
-    if kind == RendererKind::Gpu {
-        let gpu_settings = gpu_settings(args, scene, &settings);
-        let expected = expected_map_sizes(scene, args.photons, args.seed);
-        if let Some(ctx) = open_gpu(scene, &gpu_settings, expected) {
-            let adapter = ctx.describe();
-            let mut tracer = PhotonTracer::choose(args.trace, Some(&ctx), scene);
-            let device = tracer.device();
-            // A shard's first pass builds the renderer (a shard with no passes: pass 1).
-            let first_pass = plan.shard.map_or(1, |s| s.index);
-            let first = tracer.trace(scene, &pass_trace_settings(args.photons, args.seed, first_pass), &Silent);
-            let gpu_settings = GpuSettings { estimator: args.estimator.on(&ctx), ..gpu_settings };
-            let estimator = gpu_settings.estimator;
-            let name = format!("gpu ({estimator:?} estimator, photons traced on the {device})");
-            let run = GpuPasses::new(
-                ctx,
-                scene,
-                (first_pass, &first),
-                gpu_settings,
-                args.photons,
-                args.seed,
-                schedules,
-                tracer,
-            )
-            .and_then(|mut passes| {
-                let done = passes::run(&mut passes, &plan)?;
-                finish(done, &mut passes, &plan, &name, |p| p.nonfinite)
-            });
-            match run {
-                Ok(result) => {
-                    eprintln!(
-                        "gpu: {adapter}, photons traced on the {device}, passes estimated ({estimator:?}) and averaged on the GPU"
-                    );
-                    return Ok(result);
-                }
-                Err(e) => eprintln!("gpu: {e:#}: rendering the passes with photon-cpu instead"),
-            }
-        }
-    }
-    let tracer = PhotonTracer::choose(args.trace, None, scene);
-    let mut passes = CpuPasses {
-        scene,
-        settings,
-        photons: args.photons,
-        schedules,
-        mean: ImageMean::new(w, h),
-        nonfinite: 0,
-        tracer,
-    };
-    let done = passes::run(&mut passes, &plan)?;
-    finish(done, &mut passes, &plan, "photon-cpu", |p| p.nonfinite)
+    })
 }
 
 /// The fingerprint of the scene's content: the built-in scene's text or
@@ -895,36 +552,29 @@ fn render_scene(args: &RenderArgs, mut scene: Scene) -> Result<()> {
     radius_in_range("radius", args.radius, diagonal)?;
     radius_in_range("caustic-radius", args.caustic_radius, diagonal)?;
     radius_in_range("volume-radius", args.volume_radius, diagonal)?;
-    let renderer = args.renderer;
     if let Some(resolution) = args.resolution {
         let (w, h) = resolution.resolve(scene.camera.aspect()).map_err(UsageError)?;
         scene.camera = scene.camera.with_resolution(w, h).map_err(UsageError)?;
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
-    let progressive = progressive(args) || args.shard.is_some();
-    let in_passes = |kind| render_in_passes(args, kind, &scene);
-    let Passes { image, nonfinite, part } = match renderer {
-        _ if progressive => in_passes(renderer)?,
-        RendererKind::Path => {
-            let settings = path::PathSettings { spp: args.spp.unwrap_or(64), seed: args.seed, ..Default::default() };
-            let (image, nonfinite) = path::render(&scene, &settings, &progress);
-            eprintln!("path tracing: {} spp", settings.spp);
-            Passes { image, nonfinite, part: None }
-        }
-        RendererKind::Gpu | RendererKind::PhotonCpu => {
-            let (image, nonfinite) = render_photons(args, renderer, &scene, &progress)?;
-            Passes { image, nonfinite, part: None }
-        }
-        RendererKind::Vcm => in_passes(renderer)?,
+    let settings = render_settings(args);
+    let plan = render_plan(args);
+    let progressive = plan.progressive(&settings);
+    let reporting = if progressive { Some(reporting(args, &scene, &settings, &plan)?) } else { None };
+    let session = Session::new(&scene, settings, plan, Log::stderr(), &progress)?;
+    let outcome = match &reporting {
+        Some(reporting) => passes::run(session, reporting)?,
+        None => session.run(|_, _| Ok(()))?,
     };
+    let (image, nonfinite) = (&outcome.image, outcome.nonfinite);
     if nonfinite > 0 {
         eprintln!("warning: {nonfinite} non-finite samples were dropped");
     }
-    match (part, args.shard) {
-        (Some(body), Some(shard)) => {
+    match (&outcome.sums, args.shard) {
+        (Some(sums), Some(shard)) => {
             let header = PartHeader {
-                renderer: body.renderer,
+                renderer: outcome.renderer.clone(),
                 scene: args.scene.clone(),
                 scene_hash: scene_fingerprint(&args.scene)?,
                 settings: image_settings(args),
@@ -933,13 +583,13 @@ fn render_scene(args: &RenderArgs, mut scene: Scene) -> Result<()> {
                 total_passes: args.passes,
                 shard: shard.index,
                 shards: shard.count,
-                passes: body.passes,
-                stopped_early: body.stopped_early,
+                passes: outcome.passes.clone(),
+                stopped_early: outcome.stopped_early,
                 time_limited: args.time.is_some(),
             };
-            Part { header, sums: body.sums }.write(&args.output).map_err(anyhow::Error::msg)?;
+            Part { header, sums: sums.clone() }.write(&args.output).map_err(anyhow::Error::msg)?;
         }
-        _ => write_image(&args.output, &image, args.exposure)?,
+        _ => write_image(&args.output, image, args.exposure)?,
     }
     eprintln!(
         "wrote {} ({}x{}) in {:.2} s total",

@@ -40,12 +40,12 @@ mod scene_watch;
 mod trace_budget;
 
 use crate::render_cmd::{MAX_PHOTONS, Resolution, UsageError, load_scene, parse_resolution, parse_time};
-use crate::tracing::{PhotonTracer, TraceDevice};
 use anyhow::{Result, anyhow};
 use clap::Args;
 use glam::Vec3;
 use hikari_core::output::write_image;
 use hikari_core::scene::{Pose, Scene, builtin};
+use hikari_engine::tracer::{PhotonTracer, TraceDevice};
 use hikari_gpu::accumulate::AccumulatePass;
 use hikari_gpu::present::PresentPass;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
@@ -278,7 +278,7 @@ impl Viewer {
             TraceDevice::Cpu => None,
             _ => GpuContext::new().ok(),
         };
-        let tracer = PhotonTracer::choose(self.args.trace, ctx.as_ref(), &self.base);
+        let tracer = PhotonTracer::choose(self.args.trace, ctx.as_ref(), &self.base, hikari_engine::Log::stderr());
         let device = tracer.device();
         self.photon_sets = Some(PhotonSets::start(self.base.clone(), tracer)?);
         self.requested = None;

@@ -6,10 +6,10 @@
 //! with the posed scene they were traced in, so the window always draws a
 //! scene and photons that belong together.
 
-use crate::tracing::PhotonTracer;
 use anyhow::{Result, anyhow};
 use hikari_core::photon::TraceSettings;
 use hikari_core::scene::{Pose, Scene};
+use hikari_engine::tracer::PhotonTracer;
 pub use hikari_viewer::photon_set::{Job, PhotonSet};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
@@ -133,7 +133,7 @@ mod tests {
     #[test]
     fn a_set_is_the_trace_of_its_request() {
         let scene = Arc::new(Scene::load("cornell-orbit").unwrap());
-        let mut sets = PhotonSets::start(scene.clone(), PhotonTracer::cpu()).unwrap();
+        let mut sets = PhotonSets::start(scene.clone(), PhotonTracer::cpu(hikari_engine::Log::stderr())).unwrap();
         for (k, time) in [(1u64, 0.0f32), (2, 1.7)] {
             let pose = Pose { time, ..scene.rest_pose() };
             let id = sets.request(Job { pose: pose.clone(), photons: 500, seed: 7 + k }).unwrap();
@@ -153,10 +153,10 @@ mod tests {
     /// hands every newly posed scene to the tracer.
     #[test]
     fn gpu_sets_follow_the_pose() {
-        use crate::tracing::TraceDevice;
+        use hikari_engine::tracer::TraceDevice;
         let scene = Arc::new(Scene::load("cornell-orbit").unwrap());
         let ctx = hikari_gpu::GpuContext::new().expect("an adapter (scripts/test.sh installs lavapipe)");
-        let tracer = PhotonTracer::choose(TraceDevice::Gpu, Some(&ctx), &scene);
+        let tracer = PhotonTracer::choose(TraceDevice::Gpu, Some(&ctx), &scene, hikari_engine::Log::stderr());
         assert_eq!(tracer.device(), "gpu");
         let mut sets = PhotonSets::start(scene.clone(), tracer).unwrap();
         let mut previous = None;
@@ -176,7 +176,7 @@ mod tests {
     #[test]
     fn waiting_skips_to_the_newest_request() {
         let scene = Arc::new(Scene::load("cornell-box").unwrap());
-        let mut sets = PhotonSets::start(scene.clone(), PhotonTracer::cpu()).unwrap();
+        let mut sets = PhotonSets::start(scene.clone(), PhotonTracer::cpu(hikari_engine::Log::stderr())).unwrap();
         for seed in 0..5 {
             sets.request(Job { pose: scene.rest_pose(), photons: 2000, seed }).unwrap();
         }

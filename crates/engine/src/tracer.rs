@@ -2,18 +2,20 @@
 //! or the CPU one, chosen once per run and falling back to the CPU, with one
 //! line saying why, whenever the GPU cannot trace.
 
-use clap::ValueEnum;
+use crate::log::Log;
 use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::progress::Progress;
 use hikari_core::scene::Scene;
 use hikari_gpu::GpuContext;
 use hikari_gpu::trace::GpuTracer;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum TraceDevice {
     /// The GPU on a hardware adapter, the CPU on a software one (lavapipe,
     /// llvmpipe), where the "GPU" is the same CPU cores running an emulator
     /// and the native CPU tracer is faster.
+    #[default]
     Auto,
     /// A compute shader on the GPU, falling back to the CPU (saying why)
     /// where the adapter or the scene does not allow it.
@@ -32,21 +34,23 @@ pub fn gpu_by_default(ctx: &GpuContext) -> bool {
 /// works, else on the CPU.
 pub struct PhotonTracer {
     gpu: Option<(GpuContext, GpuTracer)>,
+    /// Where a fallback to the CPU is said.
+    log: Log,
 }
 
 impl PhotonTracer {
-    pub fn cpu() -> Self {
-        PhotonTracer { gpu: None }
+    pub fn cpu(log: Log) -> Self {
+        PhotonTracer { gpu: None, log }
     }
 
     /// The tracer `choice` asks for on `ctx` (an adapter already opened for
     /// rendering, if any; `--trace gpu` opens one otherwise).
-    pub fn choose(choice: TraceDevice, ctx: Option<&GpuContext>, scene: &Scene) -> Self {
+    pub fn choose(choice: TraceDevice, ctx: Option<&GpuContext>, scene: &Scene, log: Log) -> Self {
         let opened;
         let ctx = match (choice, ctx) {
-            (TraceDevice::Cpu, _) => return Self::cpu(),
-            (TraceDevice::Auto, None) => return Self::cpu(),
-            (TraceDevice::Auto, Some(ctx)) if !gpu_by_default(ctx) => return Self::cpu(),
+            (TraceDevice::Cpu, _) => return Self::cpu(log),
+            (TraceDevice::Auto, None) => return Self::cpu(log),
+            (TraceDevice::Auto, Some(ctx)) if !gpu_by_default(ctx) => return Self::cpu(log),
             (_, Some(ctx)) => ctx,
             (TraceDevice::Gpu, None) => match GpuContext::new() {
                 Ok(ctx) => {
@@ -54,16 +58,16 @@ impl PhotonTracer {
                     &opened
                 }
                 Err(e) => {
-                    eprintln!("trace: {e}: tracing photons on the CPU instead");
-                    return Self::cpu();
+                    log.note(&format!("trace: {e}: tracing photons on the CPU instead"));
+                    return Self::cpu(log);
                 }
             },
         };
         match GpuTracer::new(ctx, scene) {
-            Ok(tracer) => PhotonTracer { gpu: Some((ctx.clone(), tracer)) },
+            Ok(tracer) => PhotonTracer { gpu: Some((ctx.clone(), tracer)), log },
             Err(e) => {
-                eprintln!("trace: {e}: tracing photons on the CPU instead");
-                Self::cpu()
+                log.note(&format!("trace: {e}: tracing photons on the CPU instead"));
+                Self::cpu(log)
             }
         }
     }
@@ -73,7 +77,7 @@ impl PhotonTracer {
     pub fn set_scene(&mut self, scene: &Scene) {
         if let Some((ctx, tracer)) = &mut self.gpu {
             if let Err(e) = tracer.set_scene(ctx, scene) {
-                eprintln!("trace: gpu: {e}: tracing photons on the CPU instead");
+                self.log.note(&format!("trace: gpu: {e}: tracing photons on the CPU instead"));
                 self.gpu = None;
             }
         }
@@ -91,7 +95,7 @@ impl PhotonTracer {
             match tracer.trace(ctx, settings) {
                 Ok((traced, _)) => return traced,
                 Err(e) => {
-                    eprintln!("trace: gpu: {e}: tracing photons on the CPU instead");
+                    self.log.note(&format!("trace: gpu: {e}: tracing photons on the CPU instead"));
                     self.gpu = None;
                 }
             }

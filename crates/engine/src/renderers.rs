@@ -1,10 +1,11 @@
 //! The renderers, pass by pass. Pass i traces with seed + i − 1 (the
 //! photon renderers) or draws the next samples of the pixels' Sobol streams
 //! (the path tracer, `PathSettings::pass`), so pass 1 is the single-pass
-//! render and every pass depends on the seed and its number alone.
+//! render and every pass depends on the seed and its number alone. The
+//! seed's single pass (`OnePass`) is a renderer of one pass too.
 
-use super::PassRenderer;
-use crate::tracing::PhotonTracer;
+use crate::passes::PassRenderer;
+use crate::tracer::PhotonTracer;
 use anyhow::Result;
 use hikari_core::photon::TracedPhotons;
 use hikari_core::progress::Silent;
@@ -27,6 +28,10 @@ pub struct CpuPasses<'a> {
 }
 
 impl PassRenderer for CpuPasses<'_> {
+    fn nonfinite(&self) -> u64 {
+        self.nonfinite
+    }
+
     fn render_pass(&mut self, pass: u32) -> Result<()> {
         let settings = pass_trace_settings(self.photons, self.settings.seed, pass);
         let traced = self.tracer.trace(self.scene, &settings, &Silent);
@@ -62,6 +67,10 @@ pub struct PathPasses<'a> {
 }
 
 impl PassRenderer for PathPasses<'_> {
+    fn nonfinite(&self) -> u64 {
+        self.nonfinite
+    }
+
     fn render_pass(&mut self, pass: u32) -> Result<()> {
         let settings = path::PathSettings { pass, ..self.settings.clone() };
         let (image, nonfinite) = path::render(self.scene, &settings, &Silent);
@@ -98,6 +107,10 @@ pub struct VcmPasses<'a> {
 }
 
 impl PassRenderer for VcmPasses<'_> {
+    fn nonfinite(&self) -> u64 {
+        self.nonfinite
+    }
+
     fn render_pass(&mut self, pass: u32) -> Result<()> {
         let (image, nonfinite) =
             vcm::render_pass_in(&mut self.workspace, self.scene, &self.settings, pass).map_err(anyhow::Error::msg)?;
@@ -185,6 +198,10 @@ impl<'a> GpuPasses<'a> {
 }
 
 impl PassRenderer for GpuPasses<'_> {
+    fn nonfinite(&self) -> u64 {
+        self.nonfinite
+    }
+
     fn render_pass(&mut self, pass: u32) -> Result<()> {
         if self.first_built.take() != Some(pass) {
             let traced = self.tracer.trace(self.scene, &pass_trace_settings(self.photons, self.seed, pass), &Silent);
@@ -238,5 +255,45 @@ impl PassRenderer for GpuPasses<'_> {
 
     fn radius(&self, pass: u32) -> Option<f32> {
         Some(self.schedules.global.radius(pass))
+    }
+}
+
+/// The seed's single pass, not a mean of passes: the path tracer at its
+/// spp, or photons traced once and splatted on the GPU or estimated by
+/// photon-cpu at its spp (`render` runs it, within-pass progress and all).
+pub struct OnePass<'a> {
+    render: Box<dyn FnMut() -> Result<(Image, u64)> + 'a>,
+    image: Option<Image>,
+    pub nonfinite: u64,
+}
+
+impl<'a> OnePass<'a> {
+    pub fn new(render: impl FnMut() -> Result<(Image, u64)> + 'a) -> Self {
+        OnePass { render: Box::new(render), image: None, nonfinite: 0 }
+    }
+}
+
+impl PassRenderer for OnePass<'_> {
+    fn render_pass(&mut self, _pass: u32) -> Result<()> {
+        let (image, nonfinite) = (self.render)()?;
+        self.image = Some(image);
+        self.nonfinite = nonfinite;
+        Ok(())
+    }
+
+    fn mean(&mut self) -> Result<Image> {
+        self.image.clone().ok_or_else(|| anyhow::anyhow!("the single pass has not been rendered"))
+    }
+
+    fn sums(&mut self) -> Result<Vec<[f64; 3]>> {
+        Ok(self.mean()?.pixels.iter().map(|p| [p.x as f64, p.y as f64, p.z as f64]).collect())
+    }
+
+    fn radius(&self, _: u32) -> Option<f32> {
+        None
+    }
+
+    fn nonfinite(&self) -> u64 {
+        self.nonfinite
     }
 }
