@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need=()
-for pkg in mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool chromium; do
+for pkg in mesa-vulkan-drivers libvulkan1 xvfb xauth xdotool chromium python3-venv; do
     dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || need+=("$pkg")
 done
 if [ ${#need[@]} -gt 0 ]; then
@@ -56,6 +56,15 @@ done
 # shards and its dependent merge, compared with the single run. Installs
 # slurm-wlm and munge; skipped, loudly, only where Slurm cannot start.
 bash scripts/slurm/test.sh target/debug/hikari
+
+# The Python module (#43): `pip install .` in a fresh virtual environment,
+# then its tests (python/tests), which compare pixels with the CLI built above.
+echo "Python: pip install . and pytest"
+venv="$(mktemp -d)/venv"
+python3 -m venv "$venv"
+"$venv/bin/pip" install --quiet --upgrade pip
+"$venv/bin/pip" install --quiet ".[test]"
+(cd python/tests && HIKARI_BIN="$PWD/../../target/debug/hikari" "$venv/bin/python" -m pytest -q .)
 
 # A minute of the structured scene fuzzer (new mutants for every commit).
 bash scripts/fuzz-ci.sh "$@"

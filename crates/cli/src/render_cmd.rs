@@ -12,7 +12,7 @@ use hikari_core::progressive::DEFAULT_ALPHA;
 use hikari_core::progressive::shard::{Part, PartHeader, Shard, fingerprint};
 use hikari_core::scene::{Scene, builtin};
 pub use hikari_engine::settings::{
-    DEFAULT_TARGET_ERROR, DEFAULT_TIME_LIMIT, EstimatorChoice, RendererKind, TraceDevice, VcmStrategies,
+    DEFAULT_TARGET_ERROR, DEFAULT_TIME_LIMIT, EstimatorChoice, MAX_PHOTONS, RendererKind, TraceDevice, VcmStrategies,
 };
 use hikari_engine::{Log, Plan, RenderSettings, Session};
 use std::path::PathBuf;
@@ -293,10 +293,6 @@ pub fn load_scene(
     Ok(scene)
 }
 
-/// Most photon paths `--photons` accepts: about 6 GB of photon maps in the
-/// built-in scenes (3 stored photons of 20 bytes per path).
-pub const MAX_PHOTONS: u64 = 100_000_000;
-
 /// The engine's settings for these arguments.
 fn render_settings(args: &RenderArgs) -> RenderSettings {
     let lod = match (args.lod_near, args.lod_far) {
@@ -431,36 +427,7 @@ impl std::fmt::Display for UsageError {
 
 impl std::error::Error for UsageError {}
 
-/// Radii outside [1e-5, 0.5] scene diagonals: below, the estimate's 1/r²
-/// overflows or no photon is ever found; above, every photon covers every
-/// pixel and a frame takes for ever.
-pub const RADIUS_RANGE: (f32, f32) = (1e-5, 0.5);
-
-fn radius_in_range(name: &str, v: Option<f32>, diagonal: f32) -> Result<()> {
-    if let Some(r) = v {
-        let (lo, hi) = (RADIUS_RANGE.0 * diagonal, RADIUS_RANGE.1 * diagonal);
-        if !(r >= lo && r <= hi) {
-            usage!(
-                "--{name} {r}: must be between {lo:.3e} and {hi:.3e} (1e-5 to 0.5 of this scene's diagonal {diagonal:.3})"
-            );
-        }
-    }
-    Ok(())
-}
-
-fn positive(name: &str, v: Option<f32>) -> Result<()> {
-    match v {
-        Some(r) if !(r.is_finite() && r > 0.0) => {
-            usage!("--{name} {r}: must be a positive, finite length")
-        }
-        _ => Ok(()),
-    }
-}
-
 pub fn run(args: &RenderArgs) -> Result<()> {
-    positive("radius", args.radius)?;
-    positive("caustic-radius", args.caustic_radius)?;
-    positive("volume-radius", args.volume_radius)?;
     for (name, v) in [("lod-near", args.lod_near), ("lod-far", args.lod_far)] {
         if let Some(d) = v {
             if !(d.is_finite() && d >= 0.0) {
@@ -548,17 +515,14 @@ fn render_frames(args: &RenderArgs, scene: &Scene, (first, last): (u32, u32)) ->
 
 /// Renders `scene` (at its time already) as the flags say and writes the image or part.
 fn render_scene(args: &RenderArgs, mut scene: Scene) -> Result<()> {
-    let diagonal = scene.diagonal();
-    radius_in_range("radius", args.radius, diagonal)?;
-    radius_in_range("caustic-radius", args.caustic_radius, diagonal)?;
-    radius_in_range("volume-radius", args.volume_radius, diagonal)?;
+    let settings = render_settings(args);
+    settings.check(&scene, |name| format!("--{name}")).map_err(UsageError)?;
     if let Some(resolution) = args.resolution {
         let (w, h) = resolution.resolve(scene.camera.aspect()).map_err(UsageError)?;
         scene.camera = scene.camera.with_resolution(w, h).map_err(UsageError)?;
     }
     let progress = TerminalProgress::new(args.quiet);
     let start = Instant::now();
-    let settings = render_settings(args);
     let plan = render_plan(args);
     let progressive = plan.progressive(&settings);
     let reporting = if progressive { Some(reporting(args, &scene, &settings, &plan)?) } else { None };

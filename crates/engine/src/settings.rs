@@ -237,7 +237,48 @@ impl Plan {
     }
 }
 
+/// Radii outside [1e-5, 0.5] scene diagonals: below, the estimate's 1/r²
+/// overflows or no photon is ever found; above, every photon covers every
+/// pixel and a frame takes for ever.
+pub const RADIUS_RANGE: (f32, f32) = (1e-5, 0.5);
+
+/// Most photon paths a pass may emit: about 6 GB of photon maps in the
+/// built-in scenes (3 stored photons of 20 bytes per path).
+pub const MAX_PHOTONS: u64 = 100_000_000;
+
 impl RenderSettings {
+    /// Settings this scene cannot render with, as a message naming the
+    /// setting the way the front end spells it (`spell("caustic-radius")`:
+    /// "--caustic-radius" on the command line, "caustic_radius" in Python).
+    pub fn check(&self, scene: &Scene, spell: impl Fn(&str) -> String) -> Result<(), String> {
+        let diagonal = scene.diagonal();
+        let (lo, hi) = (RADIUS_RANGE.0 * diagonal, RADIUS_RANGE.1 * diagonal);
+        for (name, value) in
+            [("radius", self.radius), ("caustic-radius", self.caustic_radius), ("volume-radius", self.volume_radius)]
+        {
+            let Some(r) = value else { continue };
+            if !(r.is_finite() && r > 0.0) {
+                return Err(format!("{} {r}: must be a positive, finite length", spell(name)));
+            }
+            if !(r >= lo && r <= hi) {
+                return Err(format!(
+                    "{} {r}: must be between {lo:.3e} and {hi:.3e} (1e-5 to 0.5 of this scene's diagonal {diagonal:.3})",
+                    spell(name)
+                ));
+            }
+        }
+        if !(1..=MAX_PHOTONS).contains(&self.photons) {
+            return Err(format!("{} {}: must be between 1 and {MAX_PHOTONS}", spell("photons"), self.photons));
+        }
+        if let Some(spp) = self.spp.filter(|spp| !(1..=65536).contains(spp)) {
+            return Err(format!("{} {spp}: must be between 1 and 65536", spell("spp")));
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) {
+            return Err(format!("{} {}: α must lie strictly between 0 and 1", spell("alpha"), self.alpha));
+        }
+        Ok(())
+    }
+
     /// photon-cpu's settings (also the GPU's radii), for a render in
     /// passes (`progressive`) or one.
     pub fn photon_cpu(&self, progressive: bool) -> photon_cpu::PhotonCpuSettings {

@@ -1,0 +1,81 @@
+"""Types of hikari_render (the module `_hikari` built from crates/python)."""
+
+import os
+from collections.abc import Iterator
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+Renderer = Literal["gpu", "photon-cpu", "path", "vcm"]
+Image = npt.NDArray[np.float32]
+
+class SceneError(ValueError):
+    """A scene that cannot be loaded: the message names the file, the place and the problem."""
+
+def scenes() -> list[str]:
+    """The built-in scenes' names."""
+
+def load(
+    scene: str | os.PathLike[str],
+    *,
+    camera: str | None = None,
+    environment: str | os.PathLike[str] | None = None,
+) -> Scene:
+    """A built-in name, a .toml scene, or a glTF 2.0 file (.glb, .gltf); raises SceneError."""
+
+def save(path: str | os.PathLike[str], image: Image, *, exposure: float = 0.0) -> None:
+    """A .png tone-mapped as the CLI does, or a linear .exr."""
+
+class Pass:
+    """One progressive pass: the mean so far and its estimated noise."""
+
+    index: int
+    image: Image
+    noise: float | None
+    seconds: float
+
+class Passes(Iterator[Pass]):
+    def __iter__(self) -> Passes: ...
+    def __next__(self) -> Pass: ...
+
+class Scene:
+    """A loaded scene."""
+
+    @property
+    def resolution(self) -> tuple[int, int]: ...
+    def render(
+        self,
+        renderer: Renderer = "gpu",
+        *,
+        spp: int | None = None,
+        passes: int | None = None,
+        time: float | None = None,
+        target_error: float | None = None,
+        photons: int | None = None,
+        radius: float | None = None,
+        resolution: tuple[int, int] | None = None,
+        seed: int = 0,
+        threads: int | None = None,
+        at: float = 0.0,
+    ) -> Image:
+        """The image, float32 (height, width, 3), linear radiance."""
+
+    def progressive(
+        self,
+        renderer: Renderer = "gpu",
+        *,
+        spp: int | None = None,
+        passes: int | None = None,
+        time: float | None = None,
+        target_error: float | None = None,
+        photons: int | None = None,
+        radius: float | None = None,
+        resolution: tuple[int, int] | None = None,
+        seed: int = 0,
+        threads: int | None = None,
+        at: float = 0.0,
+    ) -> Passes:
+        """The same render pass by pass."""

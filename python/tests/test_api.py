@@ -1,0 +1,217 @@
+"""hikari_render's contract (issue #43): loading, rendering to numpy with the
+CLI's pixels, passes, errors, the GIL, Ctrl-C and memory."""
+
+import _thread
+import os
+import pathlib
+import subprocess
+import threading
+import time
+import warnings
+
+import numpy as np
+import pytest
+
+import hikari_render as hk
+
+
+def small(**kw):
+    """Settings small enough for a software adapter and 2 cores."""
+    return dict(resolution=(24, 24), seed=1, **kw)
+
+
+def test_version_and_builtin_scenes():
+    assert hk.__version__.count(".") == 2
+    assert "cornell-box" in hk.scenes() and "fog-stage" in hk.scenes()
+
+
+def test_load_takes_names_and_pathlike(tmp_path):
+    scene = hk.load("cornell-box")
+    assert scene.resolution[0] > 0
+    toml = tmp_path / "box.toml"
+    toml.write_text(
+        """
+[camera]
+position = [0.0, 1.0, 4.0]
+look_at = [0.0, 1.0, 0.0]
+fov_y = 40.0
+resolution = [16, 12]
+
+[[material]]
+name = "white"
+type = "diffuse"
+albedo = [0.8, 0.8, 0.8]
+
+[[object]]
+shape = "sphere"
+center = [0.0, 1.0, 0.0]
+radius = 0.5
+material = "white"
+
+[[light]]
+type = "point"
+position = [0.0, 3.0, 2.0]
+intensity = [10.0, 10.0, 10.0]
+"""
+    )
+    assert hk.load(toml).resolution == (16, 12)
+
+
+def test_scene_errors_name_the_file_and_raise_scene_error(tmp_path):
+    missing = tmp_path / "missing.glb"
+    with pytest.raises(hk.SceneError, match="missing.glb"):
+        hk.load(missing)
+    truncated = tmp_path / "truncated.glb"
+    truncated.write_bytes(b"glTF\x02\x00\x00\x00\x40\x00\x00")
+    with pytest.raises(hk.SceneError, match="truncated.glb"):
+        hk.load(truncated)
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[camera]\nposition = [0.0, 1.0]\n")
+    with pytest.raises(ValueError, match="bad.toml"):
+        hk.load(bad)
+    assert issubclass(hk.SceneError, ValueError)
+
+
+def test_bad_settings_raise_value_error():
+    scene = hk.load("cornell-box")
+    with pytest.raises(ValueError, match="renderer"):
+        scene.render("nope", passes=1)
+    with pytest.raises(ValueError, match="radius"):
+        scene.render("photon-cpu", passes=1, radius=-1.0)
+    with pytest.raises(ValueError, match="target_error"):
+        scene.render("path", target_error=2.0)
+
+
+@pytest.mark.parametrize(
+    "renderer, flags, kw",
+    [
+        ("photon-cpu", ["--passes", "1", "--photons", "3000"], dict(passes=1, photons=3000)),
+        ("path", ["--spp", "4"], dict(spp=4)),
+        ("vcm", ["--passes", "2"], dict(passes=2)),
+    ],
+)
+def test_the_clis_pixels(tmp_path, hikari_bin, renderer, flags, kw):
+    """The same settings as the CLI give the same pixels, to the bit: both
+    images written by the same EXR writer compare byte for byte."""
+    cli = tmp_path / "cli.exr"
+    subprocess.run(
+        [hikari_bin, "render", "cornell-box", "--renderer", renderer, "--resolution", "24x24", "--seed", "1",
+         "-q", "-o", str(cli), *flags],
+        check=True,
+        capture_output=True,
+    )
+    image = hk.load("cornell-box").render(renderer, **small(**kw))
+    assert image.dtype == np.float32 and image.shape == (24, 24, 3)
+    assert np.isfinite(image).all() and image.mean() > 0
+    ours = tmp_path / "ours.exr"
+    hk.save(ours, image)
+    assert ours.read_bytes() == cli.read_bytes()
+
+
+def test_same_image_whatever_the_thread_count():
+    scene = hk.load("cornell-box")
+    one = scene.render("path", **small(spp=2, threads=1))
+    two = scene.render("path", **small(spp=2, threads=2))
+    assert np.array_equal(one, two)
+
+
+def test_progressive_passes_report_the_mean_and_its_noise():
+    scene = hk.load("cornell-box")
+    passes = list(scene.progressive("path", **small(spp=1, passes=4)))
+    assert [p.index for p in passes] == [1, 2, 3, 4]
+    assert passes[0].noise is None or passes[0].noise >= 0
+    assert passes[-1].noise is not None and passes[-1].noise > 0
+    assert all(p.image.shape == (24, 24, 3) for p in passes)
+    assert passes[-1].seconds >= passes[0].seconds
+    # The last pass's mean is the whole render's image.
+    assert np.array_equal(passes[-1].image, scene.render("path", **small(spp=1, passes=4)))
+    # Stopping early stops the passes.
+    for p in scene.progressive("path", **small(spp=1, passes=1000)):
+        if p.index == 2:
+            break
+
+
+def test_the_gpu_renders_or_says_why_not():
+    """On the GPU where an adapter can, else photon-cpu with a warning
+    saying why (never silently)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        image = hk.load("cornell-box").render("gpu", **small(passes=2, photons=2000))
+    assert image.shape == (24, 24, 3) and np.isfinite(image).all() and image.mean() > 0
+    for w in caught:
+        assert "instead" in str(w.message)
+
+
+def test_the_gil_is_released_while_rendering():
+    ticks = []
+    done = threading.Event()
+
+    def tick():
+        while not done.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=tick)
+    thread.start()
+    start = time.perf_counter()
+    # Passes until half a second has passed: at least that long.
+    hk.load("cornell-box").render("path", resolution=(32, 32), spp=1, time=0.5, threads=1)
+    end = time.perf_counter()
+    done.set()
+    thread.join()
+    during = [t for t in ticks if start < t < end]
+    assert len(during) >= 10, f"the other thread ran {len(during)} times in {end - start:.2f} s"
+
+
+def test_ctrl_c_raises_keyboard_interrupt_within_a_second():
+    scene = hk.load("cornell-box")
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        scene.render("path", resolution=(64, 64), spp=1, time=60.0)
+    assert time.perf_counter() - start < 1.5
+
+
+def _rss_bytes():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/statm").exists(), reason="needs Linux's /proc")
+def test_memory_stays_flat_over_hundreds_of_renders():
+    scene = hk.load("cornell-box")
+    for _ in range(20):
+        scene.render("path", resolution=(16, 16), spp=1)
+    before = _rss_bytes()
+    for _ in range(200):
+        scene.render("path", resolution=(16, 16), spp=1)
+    grown = _rss_bytes() - before
+    assert grown < 16 << 20, f"grew {grown / 2**20:.1f} MiB over 200 renders"
+
+
+def test_save_writes_png_and_exr(tmp_path):
+    image = np.full((8, 10, 3), 0.5, dtype=np.float32)
+    hk.save(tmp_path / "a.png", image)
+    hk.save(tmp_path / "a.exr", image, exposure=1.0)
+    assert (tmp_path / "a.png").read_bytes()[:4] == b"\x89PNG"
+    assert (tmp_path / "a.exr").stat().st_size > 0
+    with pytest.raises(ValueError, match="height, width, 3"):
+        hk.save(tmp_path / "b.png", np.zeros((4, 4, 4), dtype=np.float32))
+
+
+def test_unknown_keywords_and_wrong_types_are_refused():
+    scene = hk.load("cornell-box")
+    with pytest.raises(TypeError, match="spps"):
+        scene.render("path", spps=4)
+    with pytest.raises(ValueError, match="resolution"):
+        scene.render("path", resolution="big")
+    with pytest.raises(ValueError, match="passes"):
+        scene.render("path", passes=-1)
+
+
+def test_help_explains_every_argument():
+    doc = hk.Scene.render.__doc__
+    for name in ["renderer", "spp", "passes", "time", "target_error", "photons", "radius", "resolution", "seed",
+                 "threads", "at"]:
+        assert name in doc, name
