@@ -10,6 +10,8 @@ the same settings give the same pixels. See docs/python.md.
 """
 
 from ._hikari import (
+    Camera,
+    Light,
     Pass,
     Passes,
     Scene,
@@ -20,4 +22,4 @@ from ._hikari import (
     scenes,
 )
 
-__all__ = ["Pass", "Passes", "Scene", "SceneError", "__version__", "load", "save", "scenes"]
+__all__ = ["Camera", "Light", "Pass", "Passes", "Scene", "SceneError", "__version__", "load", "save", "scenes"]

@@ -41,11 +41,39 @@ class Passes(Iterator[Pass]):
     def __iter__(self) -> Passes: ...
     def __next__(self) -> Pass: ...
 
+Vec3 = tuple[float, float, float]
+
+class Camera:
+    """The scene's camera: setting a field changes what the next render sees."""
+
+    position: Vec3
+    look_at: Vec3
+    up: Vec3
+    fov_y: float
+
+class Light:
+    """One of the scene's lights: setting a field changes the next render."""
+
+    @property
+    def kind(self) -> Literal["point", "spot", "sphere", "quad", "sun", "sky", "mesh"]: ...
+    @property
+    def name(self) -> str | None: ...
+    color: Vec3
+    """W/sr (point, spot), W/m² (sun), W/(m² sr) (area lights, skies, emissive meshes)."""
+    @property
+    def position(self) -> Vec3 | None: ...
+    @position.setter
+    def position(self, value: Vec3) -> None: ...
+
 class Scene:
     """A loaded scene."""
 
     @property
     def resolution(self) -> tuple[int, int]: ...
+    @property
+    def camera(self) -> Camera: ...
+    @property
+    def lights(self) -> list[Light]: ...
     def render(
         self,
         renderer: Renderer = "gpu",

@@ -215,3 +215,57 @@ def test_help_explains_every_argument():
     for name in ["renderer", "spp", "passes", "time", "target_error", "photons", "radius", "resolution", "seed",
                  "threads", "at"]:
         assert name in doc, name
+
+
+def test_lights_doubled_double_the_image():
+    scene = hk.load("cornell-box")
+    for renderer, kw in [("photon-cpu", dict(passes=1, photons=3000)), ("path", dict(spp=2))]:
+        before = scene.render(renderer, **small(**kw))
+        colors = [light.color for light in scene.lights]
+        for light, c in zip(scene.lights, colors):
+            light.color = tuple(2 * x for x in c)
+        doubled = scene.render(renderer, **small(**kw))
+        for light, c in zip(scene.lights, colors):
+            light.color = c
+        assert np.allclose(doubled, 2 * before, rtol=1e-5, atol=1e-7), renderer
+        assert np.array_equal(scene.render(renderer, **small(**kw)), before), "put back: the first image"
+
+
+def test_camera_moved_and_put_back_gives_the_first_image():
+    scene = hk.load("cornell-box")
+    first = scene.render("path", **small(spp=2))
+    camera = scene.camera
+    position = camera.position
+    camera.position = (position[0] + 0.3, position[1], position[2])
+    moved = scene.render("path", **small(spp=2))
+    assert not np.array_equal(moved, first)
+    camera.position = position
+    assert np.array_equal(scene.render("path", **small(spp=2)), first)
+    camera.fov_y = camera.fov_y / 2
+    assert not np.array_equal(scene.render("path", **small(spp=2)), first)
+    with pytest.raises(ValueError, match="camera"):
+        camera.look_at = camera.position
+
+
+def test_a_light_moved_lights_the_scene_from_there():
+    scene = hk.load("fog-stage")
+    spot = scene.lights[0]
+    assert spot.kind == "spot" and spot.position is not None
+    before = scene.render("path", **small(spp=2))
+    x, y, z = spot.position
+    spot.position = (x + 1.5, y, z)
+    assert spot.position == (x + 1.5, y, z)
+    assert not np.array_equal(scene.render("path", **small(spp=2)), before)
+    with pytest.raises(ValueError, match="negative"):
+        spot.color = (-1.0, 0.0, 0.0)
+
+
+def test_an_area_light_moved_carries_its_geometry():
+    scene = hk.load("cornell-caustic")
+    area = [light for light in scene.lights if light.kind in ("quad", "sphere")]
+    assert area, "cornell-caustic has a sphere light"
+    before = scene.render("path", **small(spp=2))
+    x, y, z = area[0].position
+    area[0].position = (x + 0.2, y, z)
+    after = scene.render("path", **small(spp=2))
+    assert not np.array_equal(after, before) and np.isfinite(after).all()

@@ -4,6 +4,7 @@
 //! `__init__.pyi` types it.
 
 mod convert;
+mod edit;
 mod scene;
 mod settings;
 mod worker;
@@ -45,6 +46,8 @@ fn _hikari(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(scene::load, m)?)?;
     m.add_function(wrap_pyfunction!(save, m)?)?;
     m.add_class::<scene::Scene>()?;
+    m.add_class::<edit::Camera>()?;
+    m.add_class::<edit::Light>()?;
     m.add_class::<scene::Pass>()?;
     m.add_class::<scene::Passes>()?;
     Ok(())

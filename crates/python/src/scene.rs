@@ -2,6 +2,7 @@
 
 use crate::SceneError;
 use crate::convert::image_to_array;
+use crate::edit::{Camera, Edited, Light};
 use crate::settings::{Request, request};
 use crate::worker::{Message, Worker};
 use hikari_core::scene::{LoadOptions, Scene as CoreScene};
@@ -9,7 +10,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// Loads a scene: a built-in name (`hk.scenes()`), a `.toml` scene file or
 /// a glTF 2.0 file (`.glb`, or `.gltf` with its buffers), as a str or
@@ -25,13 +26,13 @@ pub fn load(py: Python<'_>, scene: PathBuf, camera: Option<String>, environment:
     let loaded = py.detach(|| CoreScene::load_with(&spec, &options)).map_err(|e| SceneError::new_err(e.to_string()))?;
     let notes = loaded.notes.clone();
     warn_each(py, &notes)?;
-    Ok(Scene { scene: Arc::new(loaded), spec })
+    Ok(Scene { state: Mutex::new(Edited::new(loaded)), spec })
 }
 
-/// A loaded scene.
+/// A loaded scene, with the edits made to it since (`camera`, `lights`).
 #[pyclass(module = "hikari_render", frozen)]
 pub struct Scene {
-    scene: Arc<CoreScene>,
+    pub(crate) state: Mutex<Edited>,
     spec: String,
 }
 
@@ -96,33 +97,54 @@ impl Scene {
     /// The image's size as the scene's camera gives it: (width, height).
     #[getter]
     fn resolution(&self) -> (u32, u32) {
-        (self.scene.camera.width, self.scene.camera.height)
+        let camera = self.state().camera().clone();
+        (camera.width, camera.height)
+    }
+
+    /// The camera: set its `position`, `look_at`, `up` (3-tuples) and
+    /// `fov_y` (degrees) and the next render looks through it.
+    #[getter]
+    fn camera(slf: Py<Self>) -> Camera {
+        Camera { scene: slf }
+    }
+
+    /// The lights, in the scene's order: set a light's `color` (its
+    /// emission) or `position` and the next render uses it.
+    #[getter]
+    fn lights(slf: Bound<'_, Self>) -> Vec<Light> {
+        let count = slf.get().state().lights().len();
+        (0..count).map(|index| Light { scene: slf.clone().unbind(), index }).collect()
     }
 
     fn __repr__(&self) -> String {
-        format!("<hikari_render.Scene {:?}, {}x{}>", self.spec, self.scene.camera.width, self.scene.camera.height)
+        let (w, h) = self.resolution();
+        format!("<hikari_render.Scene {:?}, {w}x{h}>", self.spec)
     }
 }
 
 impl Scene {
-    /// The scene as `request` renders it (posed at its time, at its
-    /// resolution; the loaded one, not a copy, where neither changes it),
-    /// its settings checked against it.
+    pub(crate) fn state(&self) -> std::sync::MutexGuard<'_, Edited> {
+        self.state.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The scene as `request` renders it (its edits, posed at its time, at
+    /// its resolution; the scene held, not a copy, where nothing changes
+    /// it), its settings checked against it.
     fn posed(&self, py: Python<'_>, request: &Request) -> PyResult<Arc<CoreScene>> {
-        let scene = &self.scene;
-        let animated = scene.is_animated() && request.at != 0.0;
-        let resized = request.resolution.filter(|&r| r != (scene.camera.width, scene.camera.height));
-        let posed = if animated || resized.is_some() {
-            let mut posed = py.detach(|| if animated { scene.at_time(request.at) } else { (**scene).clone() });
-            if let Some((w, h)) = resized {
-                posed.camera = posed.camera.with_resolution(w, h).map_err(PyValueError::new_err)?;
-            }
-            Arc::new(posed)
-        } else if scene.is_animated() {
-            Arc::new(py.detach(|| scene.at_time(0.0)))
-        } else {
-            scene.clone()
-        };
+        let edited = self.state().clone();
+        let resized = request.resolution.filter(|&r| r != (edited.camera().width, edited.camera().height));
+        let posed = py.detach(|| -> Result<Arc<CoreScene>, String> {
+            let scene = edited.at_time(request.at);
+            Ok(match resized {
+                None => scene,
+                Some((w, h)) => {
+                    let mut resized = (*scene).clone();
+                    resized.camera = resized.camera.with_resolution(w, h)?;
+                    Arc::new(resized)
+                }
+            })
+        });
+        let posed = posed.map_err(PyValueError::new_err)?;
         request.settings.check(&posed, |name| name.replace('-', "_")).map_err(PyValueError::new_err)?;
         Ok(posed)
     }
