@@ -47,6 +47,8 @@ converges as you look. Saving the scene file reloads it.")]
 }
 
 fn main() -> ExitCode {
+    // SAFETY: no other thread has started yet.
+    unsafe { hikari_gpu::context::quiet_headless_device_select() };
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(&args),

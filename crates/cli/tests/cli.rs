@@ -664,3 +664,25 @@ fn bench_rows_keep_the_form_scripts_read() {
     assert!(!out.status.success());
     assert!(stderr(&out).contains("\"shiny\" is none of textured"), "{}", stderr(&out));
 }
+
+/// On a machine with no window system (no desktop session: no
+/// XDG_RUNTIME_DIR, DISPLAY nor WAYLAND_DISPLAY) a render that succeeds
+/// prints no error: Mesa's device-select layer, which would ask Wayland for
+/// the default GPU, is switched off (#43 item 7).
+#[test]
+fn a_render_without_a_desktop_session_prints_no_error() {
+    let dir = scratch_dir("headless");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_hikari"))
+        .args(["render", "--resolution", "16x16", "--photons", "500", "--passes", "1", "-o", "out.png"])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env_remove("NODEVICE_SELECT")
+        .current_dir(&dir)
+        .output()
+        .expect("the binary runs");
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("error"), "{err}");
+    assert!(dir.join("out.png").is_file());
+}

@@ -66,6 +66,30 @@ fn bus_suffix(info: &wgpu::AdapterInfo) -> String {
     if info.device_pci_bus_id.is_empty() { String::new() } else { format!(", bus {}", info.device_pci_bus_id) }
 }
 
+/// Mesa's device-select Vulkan layer (an implicit layer in Debian's Mesa)
+/// asks Wayland and X11 for the default GPU while adapters are enumerated;
+/// on a machine with no window system at all, libwayland then prints
+/// "error: XDG_RUNTIME_DIR is invalid or not set in the environment." twice
+/// on a render that succeeds. Where no display is named (none of
+/// `WAYLAND_DISPLAY`, `DISPLAY`, `XDG_RUNTIME_DIR`) the layer has nothing to
+/// ask, so this turns it off with its own switch (`NODEVICE_SELECT=1`)
+/// unless the user set that already. Returns whether it did.
+///
+/// # Safety
+///
+/// It changes the process's environment: call it before any other thread
+/// runs (first thing in `main`).
+pub unsafe fn quiet_headless_device_select() -> bool {
+    let unset = |name: &str| std::env::var_os(name).is_none_or(|v| v.is_empty());
+    let headless = unset("WAYLAND_DISPLAY") && unset("DISPLAY") && unset("XDG_RUNTIME_DIR");
+    if !headless || std::env::var_os("NODEVICE_SELECT").is_some() {
+        return false;
+    }
+    // SAFETY: the caller runs this before any other thread exists.
+    unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    true
+}
+
 /// Default `wait_timeout`: a software adapter needs tens of seconds for a
 /// large frame; a hung driver should not hold the CLI for ever.
 pub const WAIT_TIMEOUT: Duration = Duration::from_secs(600);
