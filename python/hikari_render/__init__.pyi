@@ -2,7 +2,7 @@
 
 import os
 from collections.abc import Iterator
-from typing import Literal
+from typing import Literal, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -74,6 +74,7 @@ class Scene:
     def camera(self) -> Camera: ...
     @property
     def lights(self) -> list[Light]: ...
+    @overload
     def render(
         self,
         renderer: Renderer = "gpu",
@@ -88,8 +89,27 @@ class Scene:
         seed: int = 0,
         threads: int | None = None,
         at: float = 0.0,
+        aovs: Literal[False] = False,
     ) -> Image:
         """The image, float32 (height, width, 3), linear radiance."""
+    @overload
+    def render(
+        self,
+        renderer: Renderer = "gpu",
+        *,
+        spp: int | None = None,
+        passes: int | None = None,
+        time: float | None = None,
+        target_error: float | None = None,
+        photons: int | None = None,
+        radius: float | None = None,
+        resolution: tuple[int, int] | None = None,
+        seed: int = 0,
+        threads: int | None = None,
+        at: float = 0.0,
+        aovs: Literal[True],
+    ) -> dict[str, Image]:
+        """"color", "albedo", "normal" (height, width, 3) and "depth" (height, width)."""
 
     def progressive(
         self,

@@ -269,3 +269,60 @@ def test_an_area_light_moved_carries_its_geometry():
     area[0].position = (x + 0.2, y, z)
     after = scene.render("path", **small(spp=2))
     assert not np.array_equal(after, before) and np.isfinite(after).all()
+
+
+WALL = """
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 20.0
+resolution = [8, 6]
+
+[[material]]
+name = "wall"
+type = "diffuse"
+albedo = [0.2, 0.4, 0.6]
+
+[[object]]
+shape = "quad"
+corner = [-5.0, -5.0, 0.0]
+edge_u = [10.0, 0.0, 0.0]
+edge_v = [0.0, 10.0, 0.0]
+material = "wall"
+
+[[light]]
+type = "point"
+position = [0.0, 0.0, 3.0]
+intensity = [5.0, 5.0, 5.0]
+"""
+
+
+def test_aovs_against_hand_computed_values(tmp_path):
+    """A wall facing the eye 5 units away fills the view: its albedo, its
+    normal toward the eye, and 5 / cos(angle off the axis) as depth; the
+    same for every renderer."""
+    path = tmp_path / "wall.toml"
+    path.write_text(WALL)
+    scene = hk.load(path)
+    out = scene.render("path", spp=2, aovs=True)
+    assert set(out) == {"color", "albedo", "normal", "depth"}
+    assert out["color"].shape == (6, 8, 3) and out["depth"].shape == (6, 8)
+    assert np.allclose(out["albedo"], [0.2, 0.4, 0.6], atol=1e-6)
+    assert np.allclose(out["normal"], [0.0, 0.0, 1.0], atol=1e-6)
+    # The centre ray of pixel (x, y) at the camera's 20° vertical field of view.
+    tan = np.tan(np.radians(10.0))
+    ys, xs = np.mgrid[0:6, 0:8] + 0.5
+    u = (2 * xs / 8 - 1) * tan * 8 / 6
+    v = (1 - 2 * ys / 6) * tan
+    expected = 5.0 * np.sqrt(1 + u * u + v * v)
+    assert np.allclose(out["depth"], expected, rtol=1e-4)
+    other = scene.render("photon-cpu", passes=1, photons=2000, aovs=True)
+    for key in ["albedo", "normal", "depth"]:
+        assert np.array_equal(other[key], out[key]), key
+
+
+def test_depth_is_infinite_where_nothing_is_hit(tmp_path):
+    path = tmp_path / "empty.toml"
+    path.write_text(WALL.replace("[-5.0, -5.0, 0.0]", "[20.0, 20.0, 0.0]"))  # the wall out of view
+    out = hk.load(path).render("path", spp=1, aovs=True)
+    assert np.isinf(out["depth"]).all() and (out["albedo"] == 0).all() and (out["normal"] == 0).all()

@@ -7,9 +7,10 @@ use crate::progress_bar::TerminalProgress;
 use anyhow::{Context, Result};
 use clap::Args;
 use hikari_core::lod::LodSettings;
-use hikari_core::output::write_image;
+use hikari_core::output::{Aov, write_exr_with_aovs, write_image};
 use hikari_core::progressive::DEFAULT_ALPHA;
 use hikari_core::progressive::shard::{Part, PartHeader, Shard, fingerprint};
+use hikari_core::render::aov::render_aovs;
 use hikari_core::scene::{Scene, builtin};
 pub use hikari_engine::settings::{
     DEFAULT_TARGET_ERROR, DEFAULT_TIME_LIMIT, EstimatorChoice, MAX_PHOTONS, RendererKind, TraceDevice, VcmStrategies,
@@ -168,9 +169,37 @@ pub struct RenderArgs {
     /// Frames per second of --frames (0.001 to 10,000).
     #[arg(long, default_value_t = 24.0, value_parser = parse_fps, requires = "frames")]
     pub fps: f64,
+    /// Auxiliary images for denoisers, comma-separated (albedo, normal,
+    /// depth), written as further channels of the .exr output under
+    /// Blender's pass names ("Denoising Albedo", "Denoising Normal",
+    /// "Depth"): the first surface seen through mirrors and glass, from the
+    /// camera alone, so the same for every renderer.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub aov: Vec<AovName>,
     /// No progress bars.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--aov`'s names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum AovName {
+    /// The reflectance of the first non-specular surface seen.
+    Albedo,
+    /// Its shading normal (world space, unit length).
+    Normal,
+    /// The distance along the camera ray to the first surface (infinity where none).
+    Depth,
+}
+
+impl From<AovName> for Aov {
+    fn from(name: AovName) -> Aov {
+        match name {
+            AovName::Albedo => Aov::Albedo,
+            AovName::Normal => Aov::Normal,
+            AovName::Depth => Aov::Depth,
+        }
+    }
 }
 
 /// "A..B" with A ≤ B ≤ 1,000,000.
@@ -442,6 +471,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if !matches!(ext.as_deref(), Some("png" | "exr")) {
         usage!("{}: unsupported image type (use .png or .exr)", args.output.display());
     }
+    if !args.aov.is_empty() && ext.as_deref() != Some("exr") {
+        usage!("--aov: {} must be an .exr file (the AOVs are further channels of it)", args.output.display());
+    }
+    if !args.aov.is_empty() && args.shard.is_some() {
+        usage!("--aov: a shard's part keeps sums; render the AOVs with the merged image's settings instead");
+    }
     if let Some(shard) = args.shard {
         if ext.as_deref() != Some("exr") {
             usage!(
@@ -552,6 +587,10 @@ fn render_scene(args: &RenderArgs, mut scene: Scene) -> Result<()> {
                 time_limited: args.time.is_some(),
             };
             Part { header, sums: sums.clone() }.write(&args.output).map_err(anyhow::Error::msg)?;
+        }
+        _ if !args.aov.is_empty() => {
+            let which: Vec<Aov> = args.aov.iter().map(|&a| a.into()).collect();
+            write_exr_with_aovs(&args.output, image, &render_aovs(&scene), &which)?;
         }
         _ => write_image(&args.output, image, args.exposure)?,
     }

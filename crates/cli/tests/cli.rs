@@ -686,3 +686,19 @@ fn a_render_without_a_desktop_session_prints_no_error() {
     assert!(!err.contains("error"), "{err}");
     assert!(dir.join("out.png").is_file());
 }
+
+/// `--aov` writes further channels of an .exr; with a PNG it is a usage
+/// error that writes nothing.
+#[test]
+fn aovs_need_an_exr_output() {
+    let dir = scratch_dir("aov");
+    let args = ["render", "--resolution", "16x16", "--renderer", "path", "--spp", "1", "--aov", "albedo,depth"];
+    let out = hikari(&[&args[..], &["-o", "out.png"]].concat(), &dir);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--aov") && !dir.join("out.png").exists());
+    let out = hikari(&[&args[..], &["-o", "out.exr"]].concat(), &dir);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bytes = std::fs::read(dir.join("out.exr")).unwrap();
+    let has = |name: &str| bytes.windows(name.len()).any(|w| w == name.as_bytes());
+    assert!(has("Denoising Albedo.R") && has("Depth.Z") && !has("Denoising Normal.X"));
+}

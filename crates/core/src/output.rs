@@ -54,6 +54,65 @@ pub fn write_image(path: &Path, image: &Image, exposure: f32) -> Result<(), Outp
     })
 }
 
+/// An auxiliary image written beside the colour (`--aov`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aov {
+    Albedo,
+    Normal,
+    Depth,
+}
+
+impl Aov {
+    /// Blender's pass names, so its compositor (the Denoise node) and OIDN
+    /// front ends find them: "Denoising Albedo" (R, G, B), "Denoising
+    /// Normal" (X, Y, Z), "Depth" (Z).
+    fn channels(self) -> (&'static str, &'static [&'static str]) {
+        match self {
+            Aov::Albedo => ("Denoising Albedo", &["R", "G", "B"]),
+            Aov::Normal => ("Denoising Normal", &["X", "Y", "Z"]),
+            Aov::Depth => ("Depth", &["Z"]),
+        }
+    }
+}
+
+/// Writes `image` as an EXR's R, G, B channels (what any reader takes as
+/// the picture) with the AOVs `which` from `aovs` as further channels named
+/// as Blender names its passes ("Denoising Albedo.R", …, "Depth.Z"),
+/// atomically. Depth keeps infinity where the camera ray hits nothing.
+pub fn write_exr_with_aovs(
+    path: &Path,
+    image: &Image,
+    aovs: &crate::render::aov::Aovs,
+    which: &[Aov],
+) -> Result<(), OutputError> {
+    use exr::prelude::*;
+    let shown = path.display().to_string();
+    if path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() != Some("exr") {
+        return Err(OutputError::UnsupportedExtension { path: shown });
+    }
+    let finite = |c: f32| if c.is_finite() { c } else { 0.0 };
+    let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        channels.push(AnyChannel::new(*name, FlatSamples::F32(image.pixels.iter().map(|p| finite(p[c])).collect())));
+    }
+    for aov in which {
+        let (pass, names) = aov.channels();
+        for (c, name) in names.iter().enumerate() {
+            let samples: Vec<f32> = match aov {
+                Aov::Albedo => aovs.albedo.pixels.iter().map(|p| p[c]).collect(),
+                Aov::Normal => aovs.normal.pixels.iter().map(|p| p[c]).collect(),
+                Aov::Depth => aovs.depth.clone(),
+            };
+            channels.push(AnyChannel::new(format!("{pass}.{name}").as_str(), FlatSamples::F32(samples)));
+        }
+    }
+    let size = (image.width as usize, image.height as usize);
+    let layer = Layer::new(size, LayerAttributes::default(), Encoding::FAST_LOSSLESS, AnyChannels::sort(channels));
+    let exr_image = exr::image::Image::from_layer(layer);
+    atomically(path, |tmp| exr_image.write().to_file(tmp).map_err(|e| e.to_string()))
+        .map_err(|e| OutputError::Write { path: shown, source: e.into() })
+}
+
 /// Writes an 8-bit sRGB image (`data`: RGB rows, `width` × `height`) as
 /// PNG, atomically, as [`write_image`] does (a chart, a screenshot).
 pub fn write_rgb8_png(path: &Path, width: u32, height: u32, data: Vec<u8>) -> Result<(), OutputError> {
@@ -118,6 +177,39 @@ fn temporary_name(path: &Path) -> PathBuf {
 mod tests {
     use super::*;
     use glam::Vec3;
+
+    /// The AOVs come back under Blender's pass names, depth's infinity
+    /// kept, and the picture stays what `read_exr` reads.
+    #[test]
+    fn aovs_are_channels_named_as_blender_names_its_passes() {
+        use exr::prelude::{ReadChannels, ReadLayers, Text, read};
+        let dir = std::env::temp_dir().join(format!("hikari-aov-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("aov.exr");
+        let mut color = Image::new(2, 1);
+        color.pixels = vec![Vec3::new(1.0, 2.0, 3.0), Vec3::new(f32::NAN, 0.5, 0.25)];
+        let mut albedo = Image::new(2, 1);
+        albedo.pixels = vec![Vec3::new(0.1, 0.2, 0.3), Vec3::ZERO];
+        let mut normal = Image::new(2, 1);
+        normal.pixels = vec![Vec3::Z, Vec3::ZERO];
+        let aovs = crate::render::aov::Aovs { albedo, normal, depth: vec![4.5, f32::INFINITY] };
+        write_exr_with_aovs(&path, &color, &aovs, &[Aov::Albedo, Aov::Normal, Aov::Depth]).unwrap();
+        let image =
+            read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes();
+        let image = image.from_file(&path).unwrap();
+        let channel = |name: &str| -> Vec<f32> {
+            let c = image.layer_data.channel_data.list.iter().find(|c| c.name == Text::from(name)).expect(name);
+            c.sample_data.values_as_f32().collect()
+        };
+        assert_eq!(channel("Denoising Albedo.G"), vec![0.2, 0.0]);
+        assert_eq!(channel("Denoising Normal.Z"), vec![1.0, 0.0]);
+        assert_eq!(channel("Depth.Z"), vec![4.5, f32::INFINITY]);
+        assert_eq!(channel("R"), vec![1.0, 0.0], "NaN never reaches the picture");
+        let read_back = read_exr(&path).unwrap();
+        assert_eq!(read_back.pixels[0], Vec3::new(1.0, 2.0, 3.0));
+        assert!(write_exr_with_aovs(&dir.join("aov.png"), &color, &aovs, &[Aov::Depth]).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn png_and_exr_are_written_and_read_back() {

@@ -13,6 +13,12 @@ pub fn image_to_array<'py>(py: Python<'py>, image: &Image) -> PyResult<Bound<'py
     Ok(array.reshape([image.height as usize, image.width as usize, 3])?.into_any())
 }
 
+/// A depth image as a float32 array of shape (height, width).
+pub fn depth_to_array<'py>(py: Python<'py>, depth: &[f32], width: u32, height: u32) -> PyResult<Bound<'py, PyAny>> {
+    let array = PyArray1::from_slice(py, depth);
+    Ok(array.reshape([height as usize, width as usize])?.into_any())
+}
+
 /// An array of shape (height, width, 3) as an image.
 pub fn image_from_array(array: &PyReadonlyArray3<'_, f32>) -> PyResult<Image> {
     let shape = array.shape();

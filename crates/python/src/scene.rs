@@ -1,7 +1,7 @@
 //! `hk.load` and the `Scene` it returns: renders in one call or pass by pass.
 
 use crate::SceneError;
-use crate::convert::image_to_array;
+use crate::convert::{depth_to_array, image_to_array};
 use crate::edit::{Camera, Edited, Light};
 use crate::settings::{Request, request};
 use crate::worker::{Message, Worker};
@@ -59,9 +59,14 @@ impl Scene {
     /// seed: the same seed gives the same image whatever the thread count.
     /// threads: CPU threads (default: all cores).
     /// at: the time, in seconds, the scene's animations are posed at.
+    /// aovs: also return the images denoisers take: a dict with "color",
+    ///     "albedo" (the reflectance of the first surface seen through
+    ///     mirrors and glass), "normal" (its shading normal, world space,
+    ///     unit length) and "depth" (float32 (height, width): the distance
+    ///     along the camera ray, inf where nothing is hit).
     ///
     /// The GIL is released while rendering; Ctrl-C raises KeyboardInterrupt.
-    #[pyo3(signature = (renderer = "gpu", **settings), text_signature = "(renderer='gpu', *, spp=None, passes=None, time=None, target_error=None, photons=None, radius=None, resolution=None, seed=0, threads=None, at=0.0)")]
+    #[pyo3(signature = (renderer = "gpu", **settings), text_signature = "(renderer='gpu', *, spp=None, passes=None, time=None, target_error=None, photons=None, radius=None, resolution=None, seed=0, threads=None, at=0.0, aovs=False)")]
     fn render<'py>(
         &self,
         py: Python<'py>,
@@ -75,7 +80,15 @@ impl Scene {
             let message = worker.next(py);
             warn_each(py, &worker.take_notes())?;
             match message? {
-                Some(Message::Done(image)) => return image_to_array(py, &image),
+                Some(Message::Done(image, None)) => return image_to_array(py, &image),
+                Some(Message::Done(image, Some(aovs))) => {
+                    let dict = PyDict::new(py);
+                    dict.set_item("color", image_to_array(py, &image)?)?;
+                    dict.set_item("albedo", image_to_array(py, &aovs.albedo)?)?;
+                    dict.set_item("normal", image_to_array(py, &aovs.normal)?)?;
+                    dict.set_item("depth", depth_to_array(py, &aovs.depth, image.width, image.height)?)?;
+                    return Ok(dict.into_any());
+                }
                 Some(Message::Failed(e)) => return Err(PyRuntimeError::new_err(e)),
                 Some(Message::Pass(..)) => {}
                 None => return Err(PyRuntimeError::new_err("the render ended without an image")),

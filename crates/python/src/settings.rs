@@ -15,11 +15,13 @@ pub struct Request {
     pub resolution: Option<(u32, u32)>,
     pub threads: Option<usize>,
     pub at: f32,
+    /// Also the AOVs (albedo, normal, depth).
+    pub aovs: bool,
 }
 
 /// The keyword arguments `Scene.render` and `Scene.progressive` take.
 pub const KEYWORDS: &[&str] =
-    &["spp", "passes", "time", "target_error", "photons", "radius", "resolution", "seed", "threads", "at"];
+    &["spp", "passes", "time", "target_error", "photons", "radius", "resolution", "seed", "threads", "at", "aovs"];
 
 /// `renderer` and the keyword arguments, checked as the CLI checks its
 /// flags (the scene's own limits are checked once it is posed); an
@@ -56,6 +58,7 @@ pub fn request(renderer: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<R
     let seed: u64 = get(kwargs, "seed")?.unwrap_or(0);
     let threads: Option<usize> = get(kwargs, "threads")?;
     let at: f32 = get(kwargs, "at")?.unwrap_or(0.0);
+    let aovs: bool = get(kwargs, "aovs")?.unwrap_or(false);
     let bad = |m: String| Err(PyValueError::new_err(m));
     let Some(kind) = RendererKind::from_name(renderer) else {
         return bad(format!("renderer={renderer:?}: one of \"gpu\", \"photon-cpu\", \"path\", \"vcm\""));
@@ -85,5 +88,5 @@ pub fn request(renderer: &str, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<R
     let settings =
         RenderSettings { renderer: kind, spp, photons: photons.unwrap_or(defaults.photons), radius, seed, ..defaults };
     let plan = Plan { passes, time: time.map(Duration::from_secs_f64), target_error, ..Default::default() };
-    Ok(Request { settings, plan, resolution, threads, at })
+    Ok(Request { settings, plan, resolution, threads, at, aovs })
 }

@@ -6,6 +6,7 @@
 use crate::settings::Request;
 use hikari_core::progress::Silent;
 use hikari_core::render::Image;
+use hikari_core::render::aov::Aovs;
 use hikari_core::scene::Scene;
 use hikari_engine::{Log, PassReport, Session};
 use pyo3::prelude::*;
@@ -18,7 +19,8 @@ use std::time::Duration;
 /// end, or a failure.
 pub enum Message {
     Pass(PassReport, Option<Image>, Option<f64>),
-    Done(Image),
+    /// The image, and its AOVs where asked for.
+    Done(Image, Option<Aovs>),
     Failed(String),
 }
 
@@ -100,7 +102,8 @@ fn render(
             }
         }
         let outcome = session.finish()?;
-        let _ = sender.send(Message::Done(outcome.image));
+        let aovs = request.aovs.then(|| hikari_core::render::aov::render_aovs(scene));
+        let _ = sender.send(Message::Done(outcome.image, aovs));
         Ok(())
     };
     match request.threads {

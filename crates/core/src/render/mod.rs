@@ -1,6 +1,7 @@
 //! CPU renderers: `photon-cpu` (the seed's pipeline, CPU twin of the GPU
 //! renderer) and `path` (a path tracer for ground truth).
 
+pub mod aov;
 mod direct;
 mod image;
 pub mod path;
