@@ -12,6 +12,7 @@ the same settings give the same pixels. See docs/python.md.
 from ._hikari import (
     Camera,
     Light,
+    Material,
     Pass,
     Passes,
     Scene,
@@ -22,4 +23,4 @@ from ._hikari import (
     scenes,
 )
 
-__all__ = ["Camera", "Light", "Pass", "Passes", "Scene", "SceneError", "__version__", "load", "save", "scenes"]
+__all__ = ["Camera", "Light", "Material", "Pass", "Passes", "Scene", "SceneError", "__version__", "load", "save", "scenes"]

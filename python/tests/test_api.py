@@ -326,3 +326,33 @@ def test_depth_is_infinite_where_nothing_is_hit(tmp_path):
     path.write_text(WALL.replace("[-5.0, -5.0, 0.0]", "[20.0, 20.0, 0.0]"))  # the wall out of view
     out = hk.load(path).render("path", spp=1, aovs=True)
     assert np.isinf(out["depth"]).all() and (out["albedo"] == 0).all() and (out["normal"] == 0).all()
+
+
+def test_materials_edited_by_name():
+    scene = hk.load("cornell-box")
+    materials = scene.materials
+    assert materials, "cornell-box's materials have names"
+    name, material = next((n, m) for n, m in materials.items() if m.kind == "diffuse")
+    first = scene.render("path", **small(spp=2))
+    color = material.base_color
+    material.base_color = (0.9, 0.1, 0.1)
+    assert scene.materials[name].base_color == pytest.approx((0.9, 0.1, 0.1))
+    assert not np.array_equal(scene.render("path", **small(spp=2)), first)
+    material.base_color = color
+    assert np.array_equal(scene.render("path", **small(spp=2)), first), "put back: the first image"
+    assert material.metallic is None and material.roughness is None
+    with pytest.raises(ValueError, match="outside"):
+        material.base_color = (2.0, 0.0, 0.0)
+    with pytest.raises(ValueError, match="metallic"):
+        material.metallic = 0.5
+
+
+def test_gltf_materials_metallic_and_roughness():
+    scene = hk.load(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "showcase.glb")
+    pbr = [m for m in scene.materials.values() if m.kind == "pbr"]
+    assert pbr
+    pbr[0].roughness = 0.25
+    pbr[0].metallic = 1.0
+    assert (pbr[0].roughness, pbr[0].metallic) == (0.25, 1.0)
+    with pytest.raises(ValueError, match="roughness"):
+        pbr[0].roughness = 1.5

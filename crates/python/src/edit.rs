@@ -7,6 +7,7 @@ use crate::scene::Scene;
 use glam::Vec3;
 use hikari_core::camera::Camera as CoreCamera;
 use hikari_core::light::Light as CoreLight;
+use hikari_core::material::Material;
 use hikari_core::scene::{Pose, Scene as CoreScene};
 use pyo3::exceptions::{PyIndexError, PyValueError};
 use pyo3::prelude::*;
@@ -44,6 +45,19 @@ impl Edited {
         let mut posed = self.scene.posed(&pose);
         posed.camera = self.camera.clone();
         Arc::new(posed)
+    }
+
+    pub fn materials(&self) -> &[Material] {
+        &self.scene.materials
+    }
+
+    pub fn material_names(&self) -> &[Option<String>] {
+        &self.scene.names.materials
+    }
+
+    /// Material `index` replaced: the scene's own (posing copies them).
+    fn set_material(&mut self, index: usize, material: Material) {
+        Arc::make_mut(&mut self.scene).materials[index] = material;
     }
 
     fn set_camera(&mut self, camera: CoreCamera) {
@@ -244,4 +258,105 @@ fn has_position(light: &CoreLight) -> bool {
         light,
         CoreLight::Point { .. } | CoreLight::Spot { .. } | CoreLight::Sphere { .. } | CoreLight::Quad { .. }
     )
+}
+
+/// One of the scene's materials; setting a field changes the scene's.
+#[pyclass(module = "hikari_render", name = "Material", frozen)]
+pub struct MaterialView {
+    pub(crate) scene: Py<Scene>,
+    pub(crate) index: usize,
+}
+
+impl MaterialView {
+    fn get(&self) -> Material {
+        self.scene.get().state().materials()[self.index]
+    }
+
+    fn set(&self, material: Material) {
+        self.scene.get().state().set_material(self.index, material);
+    }
+}
+
+fn unit_interval(v: f32, what: &str) -> PyResult<f32> {
+    if (0.0..=1.0).contains(&v) { Ok(v) } else { Err(PyValueError::new_err(format!("{what}: {v} is outside 0 to 1"))) }
+}
+
+#[pymethods]
+impl MaterialView {
+    /// "diffuse", "mirror", "glass", "pbr" (glTF's metallic–roughness) or
+    /// "emitter" (an area light's body).
+    #[getter]
+    fn kind(&self) -> &'static str {
+        match self.get() {
+            Material::Diffuse { .. } => "diffuse",
+            Material::Mirror { .. } => "mirror",
+            Material::Glass { .. } => "glass",
+            Material::Pbr(_) => "pbr",
+            Material::Emitter => "emitter",
+        }
+    }
+
+    /// The base colour: a diffuse material's albedo, a mirror's
+    /// reflectance, a glTF material's base colour factor (times its
+    /// texture where it has one); None for glass and emitters.
+    #[getter]
+    fn base_color(&self) -> Option<(f32, f32, f32)> {
+        match self.get() {
+            Material::Diffuse { albedo, .. } => Some(tuple(albedo)),
+            Material::Mirror { reflectance } => Some(tuple(reflectance)),
+            Material::Pbr(b) => Some(tuple(b.base_color)),
+            Material::Glass { .. } | Material::Emitter => None,
+        }
+    }
+    #[setter]
+    fn set_base_color(&self, rgb: (f32, f32, f32)) -> PyResult<()> {
+        let c = vec3(rgb, "material.base_color")?;
+        if c.min_element() < 0.0 || c.max_element() > 1.0 {
+            return Err(PyValueError::new_err(format!("material.base_color: {rgb:?} is outside 0 to 1")));
+        }
+        let material = match self.get() {
+            Material::Diffuse { specular, .. } => Material::Diffuse { albedo: c, specular },
+            Material::Mirror { .. } => Material::Mirror { reflectance: c },
+            Material::Pbr(b) => Material::Pbr(hikari_core::bsdf::Bsdf { base_color: c, ..b }),
+            Material::Glass { .. } | Material::Emitter => {
+                return Err(PyValueError::new_err(format!("material.base_color: a {} has none", self.kind())));
+            }
+        };
+        self.set(material);
+        Ok(())
+    }
+
+    /// A glTF material's metallic factor; None for the others.
+    #[getter]
+    fn metallic(&self) -> Option<f32> {
+        if let Material::Pbr(b) = self.get() { Some(b.metallic) } else { None }
+    }
+    #[setter]
+    fn set_metallic(&self, v: f32) -> PyResult<()> {
+        let v = unit_interval(v, "material.metallic")?;
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.metallic: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(hikari_core::bsdf::Bsdf { metallic: v, ..b }));
+        Ok(())
+    }
+
+    /// A glTF material's perceptual roughness; None for the others.
+    #[getter]
+    fn roughness(&self) -> Option<f32> {
+        if let Material::Pbr(b) = self.get() { Some(b.roughness) } else { None }
+    }
+    #[setter]
+    fn set_roughness(&self, v: f32) -> PyResult<()> {
+        let v = unit_interval(v, "material.roughness")?;
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.roughness: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(hikari_core::bsdf::Bsdf { roughness: v, ..b }));
+        Ok(())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<hikari_render.Material {} {}: base_color={:?}>", self.index, self.kind(), self.base_color())
+    }
 }

@@ -48,6 +48,7 @@ fn _hikari(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_class::<edit::Camera>()?;
     m.add_class::<edit::Light>()?;
+    m.add_class::<edit::MaterialView>()?;
     m.add_class::<scene::Pass>()?;
     m.add_class::<scene::Passes>()?;
     Ok(())

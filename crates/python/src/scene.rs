@@ -2,7 +2,7 @@
 
 use crate::SceneError;
 use crate::convert::{depth_to_array, image_to_array};
-use crate::edit::{Camera, Edited, Light};
+use crate::edit::{Camera, Edited, Light, MaterialView};
 use crate::settings::{Request, request};
 use crate::worker::{Message, Worker};
 use hikari_core::scene::{LoadOptions, Scene as CoreScene};
@@ -127,6 +127,22 @@ impl Scene {
     fn lights(slf: Bound<'_, Self>) -> Vec<Light> {
         let count = slf.get().state().lights().len();
         (0..count).map(|index| Light { scene: slf.clone().unbind(), index }).collect()
+    }
+
+    /// The materials by name (a TOML material's `name`, a glTF
+    /// material's; "material N" for one without a name): set a material's
+    /// `base_color`, `metallic` or `roughness` and the next render uses it.
+    #[getter]
+    fn materials<'py>(slf: Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
+        let py = slf.py();
+        let names: Vec<Option<String>> = slf.get().state().material_names().to_vec();
+        let count = slf.get().state().materials().len();
+        let dict = PyDict::new(py);
+        for index in 0..count {
+            let name = names.get(index).cloned().flatten().unwrap_or_else(|| format!("material {index}"));
+            dict.set_item(name, MaterialView { scene: slf.clone().unbind(), index })?;
+        }
+        Ok(dict)
     }
 
     fn __repr__(&self) -> String {

@@ -71,6 +71,9 @@ pub struct Names {
     pub objects: Vec<(String, u32)>,
     /// Each light's name, if it has one (indexed like `Scene::lights`).
     pub lights: Vec<Option<String>>,
+    /// Each material's name, if it has one (indexed like `Scene::materials`:
+    /// a TOML material's `name`, a glTF material's).
+    pub materials: Vec<Option<String>>,
 }
 
 /// One moment of a scene: the animation time and the user's edits (lights

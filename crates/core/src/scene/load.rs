@@ -118,6 +118,7 @@ pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneEr
 
     let mut geometry = GeometryBuilder::default();
     let mut names = Names::default();
+    names.materials = desc.material.iter().map(|m| Some(m.get_ref().name.clone())).collect();
     // Animation targets, by name: objects and lights share one namespace.
     let mut targets: HashMap<String, Target> = HashMap::new();
     let mut name = |p: &Place, name: &Option<String>, target: Target| -> Result<Option<String>, SceneError> {
@@ -247,6 +248,8 @@ pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneEr
     });
     accel.set_alpha_mask(texturing.clone());
     crate::light::fit_distant_lights(&mut lights, accel.bounds());
+    // Area lights' bodies, after every named material.
+    names.materials.resize(materials.len(), None);
     Ok(Scene {
         source: file.to_string(),
         camera,
@@ -316,6 +319,8 @@ fn load_gltf_object(
             .map_err(|e| p.error(e.to_string()))?;
     let first_material = parts.materials.len() as u32;
     parts.materials.extend(asset.materials);
+    parts.names.materials.resize(first_material as usize, None);
+    parts.names.materials.extend(asset.material_names);
     // The file's images after those of earlier objects.
     let t = &mut *parts.texturing;
     let first_image = t.images.len() as u32;
@@ -884,6 +889,20 @@ intensity = [1.0, 1.0, 1.0]
         let s = parse(BASE, "test.toml", SceneFiles::beside(None)).unwrap();
         assert_eq!(s.accel.sphere_count(), 1);
         assert_eq!(s.lights.len(), 1);
+    }
+
+    /// Material names are kept, one per material (area lights' bodies
+    /// unnamed), for front ends that edit materials by name.
+    #[test]
+    fn material_names_are_kept() {
+        let s = parse(BASE, "test.toml", SceneFiles::beside(None)).unwrap();
+        assert_eq!(s.names.materials, vec![Some("white".to_string())]);
+        let caustic = Scene::load("cornell-caustic").unwrap();
+        assert_eq!(caustic.names.materials.len(), caustic.materials.len());
+        assert!(caustic.names.materials.last().unwrap().is_none(), "the sphere light's body");
+        let glb = Scene::load(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb")).unwrap();
+        assert_eq!(glb.names.materials.len(), glb.materials.len());
+        assert!(glb.names.materials.iter().flatten().count() >= 2, "{:?}", glb.names.materials);
     }
 
     #[test]

@@ -31,6 +31,8 @@ pub struct Converted {
     pub emissions: Vec<Option<Emission>>,
     /// What each material takes from textures (None: nothing, and opaque).
     pub textures: Vec<Option<MaterialTextures>>,
+    /// Each material's name in the file (None for the default material).
+    pub names: Vec<Option<String>>,
 }
 
 /// Converts every material, reading its textures from `images`.
@@ -96,6 +98,8 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             (material, emission)
         })
         .unzip();
+    let mut names: Vec<Option<String>> = doc.materials().map(|m| m.name().map(str::to_string)).collect();
+    names.push(None);
     // The specification's default material: metallic 1, roughness 1, white.
     materials.push(Material::Pbr(Bsdf::new(Rgb::ONE, 1.0, 1.0, 1.0)));
     emissions.push(None);
@@ -125,7 +129,7 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     if blended > 0 {
         notes.push(format!("{blended} material(s) with alphaMode BLEND are rendered opaque"));
     }
-    Converted { materials, emissions, textures }
+    Converted { materials, emissions, textures, names }
 }
 
 /// Each component made finite and clamped to [0, max] (the specification's

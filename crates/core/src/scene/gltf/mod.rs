@@ -48,6 +48,8 @@ pub struct Asset {
     /// One per glTF material, then the specification's default material
     /// (for primitives without one) last.
     pub materials: Vec<Material>,
+    /// Parallel to `materials`: each one's name in the file.
+    pub material_names: Vec<Option<String>>,
     /// Parallel to `materials`: what each takes from textures.
     pub material_textures: Vec<Option<MaterialTextures>>,
     /// The decoded images `material_textures` refer to.
@@ -160,7 +162,7 @@ pub fn asset_from_bytes(
     let mut notes = Vec::new();
     check_extensions(&gltf.document, &file, &mut notes)?;
     let images = textures::load(&gltf.document, &buffers, files, &file)?;
-    let materials::Converted { materials, emissions, textures } =
+    let materials::Converted { materials, emissions, textures, names: material_names } =
         materials::convert(&gltf.document, &images, &mut notes);
     let textured: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.is_textured())).collect();
     let mut walk = Walk {
@@ -172,6 +174,7 @@ pub fn asset_from_bytes(
         cache: HashMap::new(),
         asset: Asset {
             materials,
+            material_names,
             material_textures: textures,
             images: images.images,
             primitives: Vec::new(),
@@ -760,6 +763,7 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
     }
     crate::light::fit_distant_lights(&mut lights, accel.bounds());
     names.lights = light_names;
+    names.materials = std::mem::take(&mut asset.material_names);
     let camera = match asset.camera {
         Some(pose) => camera_from_pose(&pose).map_err(|m| error(&file, "cameras", m))?,
         None => {
