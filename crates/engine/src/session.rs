@@ -336,9 +336,8 @@ impl<'a> Session<'a> {
             let expected = expected_map_sizes(scene, s.photons, s.seed);
             if let Some(ctx) = open_gpu(scene, &gpu_settings, expected, &self.log) {
                 let adapter = ctx.describe();
-                let tracer = PhotonTracer::choose(s.trace, Some(&ctx), scene, self.log.clone());
+                let mut tracer = PhotonTracer::choose(s.trace, Some(&ctx), scene, self.log.clone());
                 let device = tracer.device();
-                let mut tracer = tracer;
                 // A shard's first pass builds the renderer (a shard with no passes: pass 1).
                 let first_pass = self.plan.shard.map_or(1, |sh| sh.index);
                 let first = tracer.trace(scene, &pass_trace_settings(s.photons, s.seed, first_pass), &Silent);
