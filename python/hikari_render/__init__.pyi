@@ -82,6 +82,8 @@ class Material:
     def roughness(self) -> float | None: ...
     @roughness.setter
     def roughness(self, value: float) -> None: ...
+    emission: Vec3
+    """RGB radiance, W/(m² sr); (0, 0, 0) where the material emits nothing (which cannot be changed)."""
 
 class Scene:
     """A loaded scene."""

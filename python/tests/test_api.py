@@ -347,6 +347,36 @@ def test_materials_edited_by_name():
         material.metallic = 0.5
 
 
+def test_every_light_and_emission_doubled_doubles_the_image():
+    scene = hk.load(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "showcase.glb")
+    emissive = [m for m in scene.materials.values() if max(m.emission) > 0]
+    assert emissive, "showcase.glb's glowing strip"
+    # The emissive meshes are lights too: doubled through their material.
+    lights = [light for light in scene.lights if light.kind != "mesh"]
+    assert lights
+    for renderer, kw in [("photon-cpu", dict(passes=1, photons=3000)), ("path", dict(spp=2))]:
+        before = scene.render(renderer, **small(**kw))
+        colors, emissions = [light.color for light in lights], [m.emission for m in emissive]
+        for light, c in zip(lights, colors):
+            light.color = tuple(2 * x for x in c)
+        for material, e in zip(emissive, emissions):
+            material.emission = tuple(2 * x for x in e)
+        assert [m.emission for m in emissive] == [tuple(2 * x for x in e) for e in emissions]
+        doubled = scene.render(renderer, **small(**kw))
+        for light, c in zip(lights, colors):
+            light.color = c
+        for material, e in zip(emissive, emissions):
+            material.emission = e
+        assert np.allclose(doubled, 2 * before, rtol=1e-4, atol=1e-6), renderer
+        assert np.array_equal(scene.render(renderer, **small(**kw)), before), "put back: the first image"
+    plain = next(m for m in scene.materials.values() if m.kind == "pbr" and max(m.emission) == 0)
+    assert plain.emission == (0.0, 0.0, 0.0)
+    with pytest.raises(ValueError, match="emits no light"):
+        plain.emission = (1.0, 1.0, 1.0)
+    with pytest.raises(ValueError, match="negative"):
+        emissive[0].emission = (-1.0, 0.0, 0.0)
+
+
 def test_gltf_materials_metallic_and_roughness():
     scene = hk.load(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "showcase.glb")
     pbr = [m for m in scene.materials.values() if m.kind == "pbr"]

@@ -60,6 +60,18 @@ impl Edited {
         Arc::make_mut(&mut self.scene).materials[index] = material;
     }
 
+    /// The lights that surfaces of material `index` emit (a glTF emissive
+    /// material's meshes, an area light's body), in the scene's order.
+    pub fn lights_emitted_by(&self, index: usize) -> Vec<usize> {
+        let mut lights: Vec<usize> = (self.scene.surfaces.iter())
+            .filter(|s| s.material as usize == index)
+            .filter_map(|s| s.emitter.map(|e| e as usize))
+            .collect();
+        lights.sort_unstable();
+        lights.dedup();
+        lights
+    }
+
     fn set_camera(&mut self, camera: CoreCamera) {
         if !self.scene.is_animated() {
             Arc::make_mut(&mut self.scene).camera = camera.clone();
@@ -353,6 +365,44 @@ impl MaterialView {
             return Err(PyValueError::new_err(format!("material.roughness: a {} has none", self.kind())));
         };
         self.set(Material::Pbr(hikari_core::bsdf::Bsdf { roughness: v, ..b }));
+        Ok(())
+    }
+
+    /// The RGB radiance (W/(m² sr)) the material's surfaces emit: a glTF
+    /// emissive factor times its strength (an emissive texture's mean where
+    /// it has one, the texture's pattern kept), an area light's body's
+    /// radiance; (0, 0, 0) for a material that emits nothing. Setting it
+    /// changes the lights its surfaces are (as `scene.lights[i].color`
+    /// does); a material that emits nothing in the loaded scene cannot be
+    /// made to (its surfaces are no lights: export it emissive instead).
+    #[getter]
+    fn emission(&self) -> (f32, f32, f32) {
+        let scene = self.scene.get();
+        let state = scene.state();
+        let first = state.lights_emitted_by(self.index).first().map(|&i| state.lights()[i].emission());
+        tuple(first.unwrap_or(Vec3::ZERO))
+    }
+    #[setter]
+    fn set_emission(&self, rgb: (f32, f32, f32)) -> PyResult<()> {
+        let c = vec3(rgb, "material.emission")?;
+        if c.min_element() < 0.0 {
+            return Err(PyValueError::new_err(format!("material.emission: {rgb:?} has a negative channel")));
+        }
+        let scene = self.scene.get();
+        let mut state = scene.state();
+        let lights = state.lights_emitted_by(self.index);
+        if lights.is_empty() {
+            let name = state.material_names().get(self.index).cloned().flatten();
+            let which = name.map_or(format!("material {}", self.index), |n| format!("material '{n}'"));
+            return Err(PyValueError::new_err(format!(
+                "material.emission: {which} emits no light in the loaded scene, so its surfaces are no lights \
+                 to brighten (make it emissive in the file)"
+            )));
+        }
+        for i in lights {
+            let light = state.lights()[i].with_emission(c);
+            state.set_light(i, light);
+        }
         Ok(())
     }
 
