@@ -9,17 +9,18 @@ use crate::files::{DroppedFile, scene_from_files};
 use crate::input::CameraInput;
 use crate::options::PageOptions;
 use crate::page;
-use crate::photons::{Job, PhotonSet, Tracing};
+use crate::photons::{Job, Tracing};
 use hikari_core::scene::{Pose, Scene, builtin};
-use hikari_gpu::accumulate::{AccumulatePass, NoiseReading};
+use hikari_gpu::accumulate::NoiseReading;
 use hikari_gpu::present::PresentPass;
 use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
 use hikari_viewer::clock::AnimationClock;
 use hikari_viewer::frame_stats::FrameStats;
+use hikari_viewer::frames::{Frames, wants_photons};
 use hikari_viewer::orbit::Orbit;
 use hikari_viewer::panel::{Controls, Panel, Readouts, rect_of};
-use hikari_viewer::settings::{controls_for_scene, gpu_settings, restart_for_edits, set_pass};
-use hikari_viewer::surface::{next_frame, shown_texture};
+use hikari_viewer::settings::controls_for_scene;
+use hikari_viewer::surface::next_frame;
 use std::cell::RefCell;
 use std::rc::{Rc, Weak};
 use std::sync::Arc;
@@ -53,15 +54,9 @@ pub struct Gpu {
     pub ctx: GpuContext,
     present: PresentPass,
     panel: Panel,
-    /// The renderer and the mean, once the scene's first photon set came.
-    pub view: Option<View>,
-}
-
-pub struct View {
-    /// Shared with the frame task while a frame renders (`Rc::get_mut`
-    /// works between frames, when the task has dropped its handle).
-    renderer: Rc<GpuRenderer>,
-    pub mean: AccumulatePass,
+    /// The renderer of the set on screen and the mean of its frames, once
+    /// the scene's first photon set came.
+    pub frames: Option<Frames>,
 }
 
 pub struct Viewer {
@@ -72,7 +67,6 @@ pub struct Viewer {
     orbit: Orbit,
     input: CameraInput,
     controls: Controls,
-    applied: Controls,
     pub readouts: Readouts,
     clock: AnimationClock,
     stats: FrameStats,
@@ -81,8 +75,6 @@ pub struct Viewer {
     started: Option<Instant>,
     pub gpu: Option<Gpu>,
     tracing: Option<Tracing>,
-    /// The photon set on screen.
-    shown: Option<PhotonSet>,
     /// The pose and count last asked of the tracer.
     requested: Option<(Pose, u64)>,
     /// Whether the renderer must be made anew (a new scene, a new size).
@@ -132,7 +124,6 @@ impl Viewer {
             input: CameraInput::new(scene.diagonal()),
             base: Arc::new(scene),
             scene_name,
-            applied: controls.clone(),
             controls,
             readouts: Readouts::default(),
             clock: AnimationClock::new(0.0, None),
@@ -141,7 +132,6 @@ impl Viewer {
             started: None,
             gpu: None,
             tracing: None,
-            shown: None,
             requested: None,
             rebuild: true,
             frame_in_flight: false,
@@ -157,7 +147,7 @@ impl Viewer {
 
     /// Frames in the mean on screen.
     pub fn frames_in_mean(&self) -> u32 {
-        self.gpu.as_ref().and_then(|g| g.view.as_ref()).map_or(0, |v| v.mean.count())
+        self.gpu.as_ref().and_then(|g| g.frames.as_ref()).map_or(0, |f| f.mean.count())
     }
 
     /// Where photon sets are traced now ("" before the adapter answered).
@@ -180,7 +170,6 @@ impl Viewer {
             page::set_status(&format!("{name}: {note}"));
         }
         self.controls = controls_for_scene(&scene, self.controls.exposure, self.controls.photons, false);
-        self.applied = self.controls.clone();
         self.orbit = Orbit::new(&scene.camera);
         self.input = CameraInput::new(scene.diagonal());
         self.base = Arc::new(scene);
@@ -239,8 +228,9 @@ impl Viewer {
         if done {
             return;
         }
-        let shown_is_newest = self.shown.as_ref().is_some_and(|s| s.id + 1 == tracing.next_id());
-        if changed || shown_is_newest || self.rebuild {
+        let frames = self.gpu.as_ref().and_then(|g| g.frames.as_ref());
+        let shown_is_newest = frames.is_some_and(|f| f.shown().id + 1 == tracing.next_id());
+        if wants_photons(self.requested.as_ref(), &pose, photons, shown_is_newest) || self.rebuild {
             let seed = self.options.seed.wrapping_add(tracing.next_id());
             tracing.request(Job { pose: pose.clone(), photons, seed });
             self.requested = Some((pose, photons));
@@ -280,66 +270,27 @@ impl Viewer {
             .map(|why| format!("{why}: photons are traced on the CPU, at most {} a set", crate::photons::CPU_PHOTONS));
         let (width, height) = (gpu.config.width, gpu.config.height);
         let camera = self.orbit.camera(width, height);
-        let mut fresh = false;
-        // A new scene (or size): a renderer of its first set.
+        // A new scene: a renderer of its first set.
         if self.rebuild {
             let Some(set) = new_set.take() else {
                 self.ask_for_photons();
                 return Ok(None);
             };
-            let mut scene = Scene::clone(&set.scene);
-            scene.camera = camera.clone();
-            let r = &mut self.readouts;
-            r.diagonal = scene.diagonal();
-            r.has_media = !scene.media.is_empty();
-            r.has_regions = hikari_gpu::media::GpuMedia::has_regions(&scene);
-            r.light_names = self.base.names.lights.clone();
-            r.objects = self.base.names.objects.clone();
-            let settings = gpu_settings(&scene, &self.applied, &gpu.ctx);
-            let mut renderer = GpuRenderer::new(gpu.ctx.clone(), &scene, &set.traced, settings)?;
-            set_pass(&mut renderer, &self.applied, 1)?;
-            let mean = AccumulatePass::new(&gpu.ctx.device, renderer.resolved());
-            gpu.view = Some(View { renderer: Rc::new(renderer), mean });
-            self.shown = Some(set);
+            gpu.frames = None; // the last scene's targets go first
+            gpu.frames = Some(Frames::new(gpu.ctx.clone(), set, camera.clone(), &self.controls, &mut self.readouts)?);
             self.rebuild = false;
             page::set_status("");
-            fresh = true;
         }
-        let view = gpu.view.as_mut().expect("built above");
-        let renderer = Rc::get_mut(&mut view.renderer).expect("no frame holds the renderer between frames");
-        let moved = camera.position != renderer.camera().position || camera.look_at != renderer.camera().look_at;
-        if moved {
-            renderer.set_camera(&camera)?;
-            view.mean.reset();
+        let frames = gpu.frames.as_mut().expect("built above");
+        let update = frames.update(&camera, &self.controls, new_set, &mut self.readouts)?;
+        if let Some((photons, why)) = update.refused {
+            // A set the adapter cannot hold: the last one stays and sets get smaller.
+            let cap = (photons * 3 / 4).max(1);
+            self.controls.photons = self.controls.photons.min(cap);
+            self.readouts.warning = Some(format!("{why}; photons per set lowered to {cap}"));
         }
-        let mut restart = false;
-        if let Some(radii_changed) = restart_for_edits(renderer, &self.controls, &self.applied) {
-            if radii_changed && !fresh && new_set.is_none() {
-                let shown = self.shown.as_ref().expect("a photon set is drawn");
-                renderer.set_photons(&shown.scene, &shown.traced)?;
-            }
-            view.mean.reset();
-            restart = true;
-        }
-        if self.controls != self.applied {
-            self.applied = self.controls.clone();
-        }
-        if let Some(set) = new_set {
-            let same_scene = self.shown.as_ref().is_some_and(|s| s.pose == set.pose);
-            let pass = if same_scene { view.mean.count() + 1 } else { 1 };
-            set_pass(renderer, &self.applied, pass)?;
-            if same_scene {
-                renderer.set_photons(&set.scene, &set.traced)?;
-            } else {
-                renderer.set_scene(&set.scene, &set.traced)?;
-                view.mean.reset();
-            }
-            self.shown = Some(set);
-            fresh = true;
-        }
-        let unattended_done = self.options.frames.is_some_and(|n| view.mean.count() >= n);
-        let render = !unattended_done && (moved || fresh || restart || view.mean.count() == 0);
-        let renderer = render.then(|| view.renderer.clone());
+        let unattended_done = self.options.frames.is_some_and(|n| frames.mean.count() >= n);
+        let renderer = (update.render && !unattended_done).then(|| frames.shared_renderer());
         self.ask_for_photons();
         Ok(renderer)
     }
@@ -368,7 +319,7 @@ impl Viewer {
     /// The mean's noise estimate to read back, at the frames it is due.
     fn noise_reading(&self) -> Option<(GpuContext, NoiseReading)> {
         let gpu = self.gpu.as_ref()?;
-        let mean = &gpu.view.as_ref()?.mean;
+        let mean = &gpu.frames.as_ref()?.mean;
         mean.noise_due().then(|| (gpu.ctx.clone(), mean.noise_reading()))
     }
 
@@ -376,15 +327,10 @@ impl Viewer {
     /// mean with the panel.
     fn finish(&mut self, rendered: bool) -> Result<(), GpuError> {
         let Some(gpu) = &mut self.gpu else { return Ok(()) };
-        let Some(view) = &mut gpu.view else { return Ok(()) };
+        let Some(frames) = &mut gpu.frames else { return Ok(()) };
         let ctx = &gpu.ctx;
         if rendered {
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            view.mean.record(&ctx.queue, &mut encoder);
-            ctx.queue.submit([encoder.finish()]);
-            if view.mean.count() == 1 {
-                self.readouts.noise = None;
-            }
+            frames.accumulate(&mut self.readouts);
         }
         // The rates, before the panel shows them. Frame rate counts rendered
         // frames: a frame that only presents the mean again (its photon set
@@ -406,37 +352,19 @@ impl Viewer {
         let received = self.tracing.as_ref().map_or(0, |t| t.received);
         self.readouts.sets_per_second = if elapsed > 0.0 { received as f64 / elapsed } else { 0.0 };
         let Some(texture) = next_frame(&gpu.surface, &ctx.device, &gpu.config)? else { return Ok(()) };
-        let target = texture.texture.create_view(&Default::default());
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let shown = shown_texture(self.controls.mode, &view.renderer, &view.mean)?;
-        gpu.present.record(
-            &ctx.device,
-            &ctx.queue,
-            &mut encoder,
-            shown,
-            &target,
-            self.controls.exposure,
-            self.controls.mode,
-        );
-        self.readouts.frames_in_mean = view.mean.count();
-        let size = [gpu.config.width, gpu.config.height];
         let mut asked = None;
         let scene_name = self.scene_name.clone();
         let error = self.error.clone();
         let page_rects = &mut self.page_rects;
-        gpu.panel.draw(
+        frames.present(
+            texture,
+            &mut gpu.present,
+            &mut gpu.panel,
             &gpu.window,
-            &ctx.device,
-            &ctx.queue,
-            &mut encoder,
-            &target,
-            size,
             &mut self.controls,
-            &self.readouts,
+            &mut self.readouts,
             |ui| asked = page_widgets(ui, &scene_name, error.as_deref(), page_rects),
-        );
-        ctx.queue.submit([encoder.finish()]);
-        ctx.queue.present(texture);
+        )?;
         ctx.check()?;
         self.actions.extend(asked);
         Ok(())
@@ -470,7 +398,7 @@ impl Viewer {
     /// The device and the mean's texture, for reading it back.
     pub fn mean_texture(&self) -> Option<(GpuContext, wgpu::Texture)> {
         let gpu = self.gpu.as_ref()?;
-        Some((gpu.ctx.clone(), gpu.view.as_ref()?.mean.mean.clone()))
+        Some((gpu.ctx.clone(), gpu.frames.as_ref()?.mean.mean.clone()))
     }
 
     fn resized(&mut self, width: u32, height: u32) {
@@ -483,20 +411,10 @@ impl Viewer {
         gpu.surface.configure(&gpu.ctx.device, &gpu.config);
         // The renderer's targets are of the canvas's size: made anew from
         // the set on screen.
-        if let (Some(view), Some(shown)) = (&mut gpu.view, &self.shown) {
-            let mut scene = Scene::clone(&shown.scene);
-            scene.camera = self.orbit.camera(width, height);
-            let settings = gpu_settings(&scene, &self.applied, &gpu.ctx);
-            match GpuRenderer::new(gpu.ctx.clone(), &scene, &shown.traced, settings) {
-                Ok(mut renderer) => {
-                    if let Err(e) = set_pass(&mut renderer, &self.applied, 1) {
-                        page::show_error(&e.to_string());
-                    }
-                    view.mean = AccumulatePass::new(&gpu.ctx.device, renderer.resolved());
-                    view.renderer = Rc::new(renderer);
-                }
-                Err(e) => page::show_error(&e.to_string()),
-            }
+        if let Some(frames) = &mut gpu.frames
+            && let Err(e) = frames.resize(self.orbit.camera(width, height), &mut self.readouts)
+        {
+            page::show_error(&e.to_string());
         }
     }
 }
@@ -639,7 +557,7 @@ async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
     v.readouts.adapter = ctx.describe();
     web_sys::console::log_1(&format!("hikari: {} on {}", v.scene_name, ctx.describe()).into());
     page::set_status(&format!("tracing photons of {} on {}…", v.scene_name, ctx.describe()));
-    v.gpu = Some(Gpu { window: window.clone(), surface, config, ctx, present, panel, view: None });
+    v.gpu = Some(Gpu { window: window.clone(), surface, config, ctx, present, panel, frames: None });
     window.request_redraw();
     Ok(())
 }

@@ -46,15 +46,15 @@ use glam::Vec3;
 use hikari_core::output::write_image;
 use hikari_core::scene::{Pose, Scene, builtin};
 use hikari_engine::tracer::{PhotonTracer, TraceDevice};
-use hikari_gpu::accumulate::AccumulatePass;
+use hikari_gpu::GpuContext;
 use hikari_gpu::present::PresentPass;
-use hikari_gpu::{GpuContext, GpuError, GpuRenderer};
 use hikari_viewer::clock::AnimationClock;
 use hikari_viewer::frame_stats::FrameStats;
+use hikari_viewer::frames::{Frames, wants_photons};
 use hikari_viewer::orbit::Orbit;
 use hikari_viewer::panel::{Controls, Panel, Readouts};
-use hikari_viewer::settings::{controls_for_scene, gpu_settings, restart_for_edits, set_pass};
-use hikari_viewer::surface::{next_frame, shown_texture};
+use hikari_viewer::settings::controls_for_scene;
+use hikari_viewer::surface::next_frame;
 use photon_sets::{Job, PhotonSet, PhotonSets};
 use scene_watch::SceneWatch;
 use std::path::PathBuf;
@@ -151,10 +151,9 @@ struct Session {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
-    renderer: GpuRenderer,
+    /// The renderer of the set on screen and the mean of its frames.
+    frames: Frames,
     present: PresentPass,
-    /// The mean of the frames since the camera or the scene last changed.
-    mean: AccumulatePass,
     panel: Panel,
 }
 
@@ -163,8 +162,6 @@ struct Viewer {
     /// The scene as loaded (poses are made from it).
     base: Arc<Scene>,
     orbit: Orbit,
-    /// The photon set on screen, with the posed scene it was traced in.
-    shown: Option<PhotonSet>,
     /// The background tracer, and the pose and count last asked of it.
     photon_sets: Option<PhotonSets>,
     requested: Option<(Pose, u64)>,
@@ -198,9 +195,8 @@ struct Viewer {
     watch: SceneWatch,
     /// The error of the last reload that failed, shown in the title.
     reload_error: Option<String>,
-    /// What the panel edits, and what the renderer was last given.
+    /// What the panel edits.
     controls: Controls,
-    applied: Controls,
     readouts: Readouts,
     last_timing: Option<Instant>,
     screenshots: u32,
@@ -222,7 +218,6 @@ impl Viewer {
             watch,
             orbit: Orbit::new(&scene.camera),
             base: Arc::new(scene),
-            shown: None,
             photon_sets: None,
             requested: None,
             clock,
@@ -246,7 +241,6 @@ impl Viewer {
             fly_speed,
             last_fly: None,
             reload_error: None,
-            applied: controls.clone(),
             controls,
             readouts: Readouts::default(),
             last_timing: None,
@@ -271,8 +265,8 @@ impl Viewer {
     }
 
     /// Starts the tracing thread for the scene as loaded and waits for its
-    /// first set (the scene at the clock's time), which it puts on screen.
-    fn start_tracing(&mut self) -> Result<()> {
+    /// first set (the scene at the clock's time), the first on screen.
+    fn start_tracing(&mut self) -> Result<PhotonSet> {
         // The tracer opens its own device: tracing runs beside the frames.
         let ctx = match self.args.trace {
             TraceDevice::Cpu => None,
@@ -290,9 +284,8 @@ impl Viewer {
         let first = self.photon_sets.as_mut().expect("started").next(true)?.expect("the first set");
         self.first_trace_seconds = first.seconds;
         self.received(&first);
-        self.shown = Some(first);
         self.sets_used = 1;
-        Ok(())
+        Ok(first)
     }
 
     /// Asks for a set of `pose` with the panel's photon count.
@@ -348,33 +341,15 @@ impl Viewer {
         })?;
         let config = hikari_viewer::surface::surface_config(format, width, height);
         ctx.scoped(|| surface.configure(&ctx.device, &config))?;
-        if self.shown.is_none() {
-            self.clock.tick(Instant::now());
-            self.start_tracing()?;
-        }
+        self.clock.tick(Instant::now());
+        let first = self.start_tracing()?;
         eprintln!("view: {} on {}", self.args.scene, ctx.describe());
         let present = PresentPass::new(&ctx.device, format);
         let panel = Panel::new(&window, &ctx.device, format);
         self.readouts.adapter = ctx.describe();
-        let renderer = self.renderer(ctx, width, height)?;
-        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        Ok(Session { window, surface, config, renderer, present, mean, panel })
-    }
-
-    /// A renderer for frames of `width × height` from the orbit's camera,
-    /// of the set on screen.
-    fn renderer(&mut self, ctx: GpuContext, width: u32, height: u32) -> Result<GpuRenderer> {
-        let shown = self.shown.as_ref().expect("a photon set is traced before the renderer is built");
-        let mut scene = Scene::clone(&shown.scene);
-        scene.camera = self.orbit.camera(width, height);
-        let r = &mut self.readouts;
-        r.diagonal = scene.diagonal();
-        r.has_media = !scene.media.is_empty();
-        r.has_regions = hikari_gpu::media::GpuMedia::has_regions(&scene);
-        r.light_names = self.base.names.lights.clone();
-        r.objects = self.base.names.objects.clone();
-        let settings = gpu_settings(&scene, &self.applied, &ctx);
-        Ok(GpuRenderer::new(ctx, &scene, &shown.traced, settings)?)
+        let camera = self.orbit.camera(width, height);
+        let frames = Frames::new(ctx, first, camera, &self.controls, &mut self.readouts)?;
+        Ok(Session { window, surface, config, frames, present, panel })
     }
 
     /// Reloads the scene file when it changed (checked four times a second).
@@ -398,20 +373,19 @@ impl Viewer {
         self.reload_error = None;
         self.readouts.reload_error = None;
         let Some(session) = self.session.take() else { return Ok(()) };
-        let Session { window, surface, config, renderer, present, panel, .. } = session;
-        let ctx = renderer.ctx.clone();
-        drop(renderer);
+        let Session { window, surface, config, frames, present, panel } = session;
+        let ctx = frames.renderer().ctx.clone();
+        drop(frames);
         // The new scene with the current camera and settings (its own
         // lights and objects, unedited), from a new tracing thread (the old
         // one ends when its channels close).
         let fresh = controls_for(&scene, &self.args);
         (self.controls.lights, self.controls.offsets) = (fresh.lights, fresh.offsets);
-        self.applied = self.controls.clone();
         self.base = Arc::new(scene);
-        self.start_tracing()?;
-        let renderer = self.renderer(ctx, config.width, config.height)?;
-        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
+        let first = self.start_tracing()?;
+        let camera = self.orbit.camera(config.width, config.height);
+        let frames = Frames::new(ctx, first, camera, &self.controls, &mut self.readouts)?;
+        self.session = Some(Session { window, surface, config, frames, present, panel });
         self.camera_moved();
         eprintln!("view: reloaded {}", self.args.scene);
         Ok(())
@@ -433,18 +407,6 @@ impl Viewer {
         self.camera_moved();
     }
 
-    /// Builds the renderer anew (a setting that sizes its targets changed).
-    fn rebuild(&mut self) -> Result<()> {
-        let Some(session) = self.session.take() else { return Ok(()) };
-        let Session { window, surface, config, renderer, present, panel, .. } = session;
-        let ctx = renderer.ctx.clone();
-        drop(renderer);
-        let renderer = self.renderer(ctx, config.width, config.height)?;
-        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
-        Ok(())
-    }
-
     /// Asks the tracer for what this frame needs: the new pose when the
     /// clock or an edit moved anything (or the photon count changed), else
     /// (nothing pending) the next set of the pose on screen, to converge.
@@ -453,17 +415,20 @@ impl Viewer {
             return Ok(()); // the first frame draws the set the renderer was built with
         }
         let pose = self.pose();
-        let photons = self.controls.photons;
-        let changed = self.requested.as_ref().is_none_or(|(p, n)| *p != pose || *n != photons);
-        let idle = match (&self.photon_sets, &self.shown) {
-            (Some(sets), Some(shown)) => sets.newest() == Some(shown.id),
+        let idle = match (&self.photon_sets, &self.session) {
+            (Some(sets), Some(session)) => sets.newest() == Some(session.frames.shown().id),
             _ => false,
         };
-        if changed || idle { self.request(pose) } else { Ok(()) }
+        if wants_photons(self.requested.as_ref(), &pose, self.controls.photons, idle) {
+            self.request(pose)
+        } else {
+            Ok(())
+        }
     }
 
-    /// Renders (when the camera moved, a setting changed or a new photon
-    /// set came), adds the frame to the mean, and presents the mean.
+    /// One turn of the frame loop (`hikari_viewer::frames`): renders when
+    /// the camera moved, a setting changed or a new photon set came, adds
+    /// the frame to the mean, and presents the mean.
     fn frame(&mut self) -> Result<()> {
         self.watch()?;
         self.fly();
@@ -473,10 +438,6 @@ impl Viewer {
         }
         self.readouts.time = self.base.is_animated().then(|| self.clock.time());
         self.ask_for_photons()?;
-        if self.controls.volume_slices != self.applied.volume_slices {
-            self.applied.volume_slices = self.controls.volume_slices;
-            self.rebuild()?;
-        }
         let new_set = match (&mut self.photon_sets, self.last_frame) {
             (Some(sets), Some(_)) => sets.next(self.args.frames.is_some())?,
             _ => None,
@@ -488,122 +449,55 @@ impl Viewer {
             self.received(set);
         }
         let Some(session) = &mut self.session else { return Ok(()) };
-        let (width, height) = (session.config.width, session.config.height);
-        let camera = self.orbit.camera(width, height);
-        let moved = camera.position != session.renderer.camera().position
-            || camera.look_at != session.renderer.camera().look_at;
-        if moved {
-            session.renderer.set_camera(&camera)?;
-            session.mean.reset();
+        let camera = self.orbit.camera(session.config.width, session.config.height);
+        let update = session.frames.update(&camera, &self.controls, new_set, &mut self.readouts)?;
+        if update.drew_new_set {
+            self.sets_used += 1;
         }
-        let (c, a) = (&self.controls, &self.applied);
-        let restart = match restart_for_edits(&mut session.renderer, c, a) {
-            Some(radii_changed) => {
-                if radii_changed && new_set.is_none() {
-                    // The specular pass's grids are cells of the radii.
-                    let shown = self.shown.as_ref().expect("a photon set is drawn");
-                    session.renderer.set_photons(&shown.scene, &shown.traced)?;
-                }
-                session.mean.reset();
-                true
-            }
-            None => false,
-        };
-        if *c != *a {
-            self.applied = c.clone();
+        // A set the adapter cannot hold: the last one stays and sets get smaller.
+        if let Some((photons, why)) = update.refused {
+            let cap = (photons * 3 / 4).max(1);
+            self.budget.cap = cap;
+            self.controls.photons = self.controls.photons.min(cap);
+            let warning = format!("{why}; photons per set lowered to {cap}");
+            eprintln!("view: {warning}");
+            self.readouts.warning = Some(warning);
         }
-        let mut fresh = false;
-        if let Some(set) = new_set {
-            let same_scene = self.shown.as_ref().is_some_and(|s| s.pose == set.pose);
-            // The frame this set draws is pass k of the mean (k = 1 after any
-            // change): progressive radii and a sub-pixel jitter for pass k, so
-            // the mean converges as `render --passes` does (docs/progressive.md).
-            let pass = if same_scene { session.mean.count() + 1 } else { 1 };
-            set_pass(&mut session.renderer, &self.controls, pass)?;
-            let applied = if same_scene {
-                session.renderer.set_photons(&set.scene, &set.traced)
-            } else {
-                session.renderer.set_scene(&set.scene, &set.traced)
-            };
-            match applied {
-                Ok(()) => {
-                    if !same_scene {
-                        session.mean.reset();
-                    }
-                    self.shown = Some(set);
-                    self.sets_used += 1;
-                    fresh = true;
-                }
-                // A set the adapter cannot hold (checked before anything
-                // changed): the last one stays and sets get smaller.
-                Err(GpuError::TooLarge(why)) => {
-                    let cap = (set.photons * 3 / 4).max(1);
-                    self.budget.cap = cap;
-                    self.controls.photons = self.controls.photons.min(cap);
-                    let warning = format!("{why}; photons per set lowered to {cap}");
-                    eprintln!("view: {warning}");
-                    self.readouts.warning = Some(warning);
-                }
-                Err(e) => return Err(e.into()),
-            }
-        }
-        if moved || fresh || restart || session.mean.count() == 0 {
+        if update.render {
+            let renderer = session.frames.renderer();
             // Every 2 s (panel shown) the frame itself is the timed one.
             let timing_due = session.panel.visible && self.last_timing.is_none_or(|t| t.elapsed().as_secs_f64() > 2.0);
             if timing_due {
                 self.last_timing = Some(Instant::now());
-                let (times, timestamps) = session.renderer.render_timed()?;
+                let (times, timestamps) = renderer.render_timed()?;
                 self.readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
                 self.readouts.timestamps = timestamps;
                 // What the LOD kept, read back with the timing (a stall every 2 s, not every frame).
-                let (global, caustic) = session.renderer.drawn_photons()?;
-                let volume = if self.readouts.has_media { session.renderer.drawn_volume_photons()? } else { 0 };
+                let (global, caustic) = renderer.drawn_photons()?;
+                let volume = if self.readouts.has_media { renderer.drawn_volume_photons()? } else { 0 };
                 self.readouts.drawn = Some([global, caustic, volume]);
             } else {
-                session.renderer.render()?;
+                renderer.render()?;
             }
-            let ctx = &session.renderer.ctx;
-            let mut encoder = ctx.device.create_command_encoder(&Default::default());
-            session.mean.record(&ctx.queue, &mut encoder);
-            ctx.queue.submit([encoder.finish()]);
-            if session.mean.count() == 1 {
-                self.readouts.noise = None;
-            } else if session.mean.noise_due() {
-                self.readouts.noise = session.mean.read_noise(ctx)?;
+            session.frames.accumulate(&mut self.readouts);
+            let mean = &session.frames.mean;
+            if mean.count() > 1 && mean.noise_due() {
+                self.readouts.noise = mean.read_noise(&session.frames.renderer().ctx)?;
             }
         }
-        let ctx = &session.renderer.ctx;
+        let ctx = session.frames.renderer().ctx.clone();
         let Some(texture) = next_frame(&session.surface, &ctx.device, &session.config)? else { return Ok(()) };
         let scopes = ctx.error_scopes();
-        let view = texture.texture.create_view(&Default::default());
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        let shown = shown_texture(self.controls.mode, &session.renderer, &session.mean)?;
-        session.present.record(
-            &ctx.device,
-            &ctx.queue,
-            &mut encoder,
-            shown,
-            &view,
-            self.controls.exposure,
-            self.controls.mode,
-        );
-        self.readouts.frames_in_mean = session.mean.count();
-        let size = [session.config.width, session.config.height];
-        let panel = &mut session.panel;
-        panel.draw(
+        let (present, panel) = (&mut session.present, &mut session.panel);
+        session.frames.present(
+            texture,
+            present,
+            panel,
             &session.window,
-            &ctx.device,
-            &ctx.queue,
-            &mut encoder,
-            &view,
-            size,
             &mut self.controls,
-            &self.readouts,
+            &mut self.readouts,
             |_| {},
-        );
-        ctx.queue.submit([encoder.finish()]);
-        session.window.pre_present_notify();
-        ctx.queue.present(texture);
+        )?;
         scopes.finish()?;
 
         let now = Instant::now();
@@ -617,7 +511,7 @@ impl Viewer {
             self.camera_latencies.push((now - edit).as_secs_f64());
         }
         // Pose requests up to the set on screen have reached it.
-        let on_screen = self.shown.as_ref().map_or(0, |s| s.id);
+        let on_screen = session.frames.shown().id;
         let (done, waiting): (Vec<_>, Vec<_>) = self.pending_poses.drain(..).partition(|(id, _)| *id <= on_screen);
         self.pending_poses = waiting;
         self.pose_latencies.extend(done.iter().map(|(_, t)| (now - *t).as_secs_f64()));
@@ -628,7 +522,7 @@ impl Viewer {
             self.readouts.sets_per_second =
                 if elapsed > 0.0 { self.photon_sets.as_ref().map_or(0, |s| s.received) as f64 / elapsed } else { 0.0 };
             self.readouts.edit_latency_ms = mean(&self.pose_latencies).map(|s| s * 1e3);
-            let frames = session.mean.count();
+            let frames = session.frames.mean.count();
             let error = self.reload_error.as_ref().map_or(String::new(), |e| format!(" — error: {e}"));
             session
                 .window
@@ -642,7 +536,7 @@ impl Viewer {
     fn screenshot(&self, path: &std::path::Path) -> Result<()> {
         let Some(session) = &self.session else { return Ok(()) };
         let mut image = hikari_core::render::Image::new(session.config.width, session.config.height);
-        for (pixel, value) in image.pixels.iter_mut().zip(session.renderer.read(&session.mean.mean)?) {
+        for (pixel, value) in image.pixels.iter_mut().zip(session.frames.renderer().read(&session.frames.mean.mean)?) {
             let v = value.truncate();
             *pixel = if v.is_finite() { v } else { Vec3::ZERO };
         }
@@ -655,20 +549,15 @@ impl Viewer {
         if size.width == 0 || size.height == 0 {
             return Ok(());
         }
-        let Some(session) = self.session.take() else { return Ok(()) };
+        let Some(session) = &mut self.session else { return Ok(()) };
         if (size.width, size.height) == (session.config.width, session.config.height) {
-            self.session = Some(session);
             return Ok(());
         }
-        let Session { window, surface, mut config, renderer, present, panel, .. } = session;
-        config.width = size.width;
-        config.height = size.height;
-        let ctx = renderer.ctx.clone();
-        drop(renderer);
-        surface.configure(&ctx.device, &config);
-        let renderer = self.renderer(ctx, size.width, size.height)?;
-        let mean = AccumulatePass::new(&renderer.ctx.device, renderer.resolved());
-        self.session = Some(Session { window, surface, config, renderer, present, mean, panel });
+        session.config.width = size.width;
+        session.config.height = size.height;
+        let ctx = session.frames.renderer().ctx.clone();
+        session.surface.configure(&ctx.device, &session.config);
+        session.frames.resize(self.orbit.camera(size.width, size.height), &mut self.readouts)?;
         Ok(())
     }
 
@@ -723,7 +612,7 @@ impl Viewer {
             }
             Key::Character(c) if c.eq_ignore_ascii_case("t") => {
                 if let Some(s) = &self.session {
-                    let (times, timestamps) = s.renderer.render_timed()?;
+                    let (times, timestamps) = s.frames.renderer().render_timed()?;
                     let parts: Vec<String> =
                         times.iter().map(|(stage, t)| format!("{} {:.2} ms", stage.name(), t * 1e3)).collect();
                     let how = if timestamps { "GPU timestamps" } else { "wall clock" };
