@@ -27,6 +27,12 @@ const webgpuFlags = [
   "--enable-unsafe-swiftshader",
   "--ignore-gpu-blocklist",
 ];
+// HIKARI_BROWSER=stock: Chromium as a user's is, with only the flag that
+// headless Chromium needs to expose WebGPU at all. Headless, it composites
+// the page in software and cannot present a WebGPU canvas: the page copies
+// its frames into a 2D canvas (crates/web/src/canvas_copy.rs).
+const stock = process.env.HIKARI_BROWSER === "stock";
+const browserFlags = stock ? ["--enable-unsafe-webgpu"] : webgpuFlags;
 const quietFlags = [
   "--no-sandbox",
   "--no-first-run",
@@ -100,7 +106,7 @@ try {
     result.message = await page.textContent("#no-webgpu");
     result.canvasHidden = await page.evaluate(() => getComputedStyle(document.getElementById("hikari-canvas")).display === "none");
   } else {
-    browser = await chromium.launch({ executablePath: chromiumPath, args: [...quietFlags, ...webgpuFlags] });
+    browser = await chromium.launch({ executablePath: chromiumPath, args: [...quietFlags, ...browserFlags] });
     if (scenario === "converge") {
       // The default scene, 3000 photons a set, 30 frames: the mean and
       // how long the first frame took (HIKARI_SCENE, HIKARI_FRAMES and
@@ -122,6 +128,17 @@ try {
       });
       await writeMean(`web-${frames}.f32`, await readMean(page));
       result.error = await page.evaluate(() => window.hikari.lastError());
+      // Where the frames went, and (through a 2D canvas) how many of its
+      // pixels are lit: what the user sees, not only the mean.
+      result.presentation = await page.evaluate(() => window.hikari.presentation());
+      result.copyLit = await page.evaluate(() => {
+        const copy = document.getElementById("hikari-copy");
+        if (!copy) return null;
+        const { data } = copy.getContext("2d").getImageData(0, 0, copy.width, copy.height);
+        let lit = 0;
+        for (let i = 0; i < data.length; i += 4) lit += Math.max(data[i], data[i + 1], data[i + 2]) > 40 ? 1 : 0;
+        return lit / (data.length / 4);
+      });
     } else if (scenario === "drop") {
       // A .glb dropped on the page renders; a broken one shows its error
       // and leaves the scene as it was.

@@ -49,6 +49,12 @@ fn drive(scenario: &str, dir: &Path, env: &[(&str, &Path)]) -> Option<serde_json
     Some(result)
 }
 
+/// Whether the driver runs Chromium with only `--enable-unsafe-webgpu`
+/// (`HIKARI_BROWSER=stock`), not with the SwiftShader flags.
+fn stock_browser() -> bool {
+    std::env::var("HIKARI_BROWSER").is_ok_and(|b| b == "stock")
+}
+
 /// Chromium's SwiftShader Vulkan driver (Debian's chromium package).
 const SWIFTSHADER_ICD: &str = "/usr/lib/chromium/vk_swiftshader_icd.json";
 
@@ -126,6 +132,16 @@ fn page_against_native_render(name: &str, scene: Option<&str>, frames: &str, tra
     assert_eq!(result["error"], "");
     assert_eq!(result["tracer"], trace.to_uppercase(), "where the page traced its photons");
     assert_eq!(result["status"], "", "the status line stays after the frames were drawn");
+    // Chromium as a user's is (HIKARI_BROWSER=stock, scripts/web.sh test
+    // runs the tests both ways) cannot present a WebGPU canvas headless:
+    // the frames reach the page through a 2D canvas, and they are lit.
+    if stock_browser() {
+        assert_eq!(result["presentation"], "copy", "{result}");
+        let lit = result["copyLit"].as_f64().expect("the 2D canvas's pixels");
+        assert!(lit > 0.5, "{lit} of the 2D canvas's pixels lit");
+    } else {
+        assert_eq!(result["presentation"], "surface", "{result}");
+    }
     let (width, height, web) = read_mean(&dir.join(format!("web-{frames}.f32")));
     assert_eq!((width, height), (48, 36));
     // The same renderer natively on the same driver: Chromium's own

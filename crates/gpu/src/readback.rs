@@ -26,12 +26,19 @@ pub fn read_rgba_layers(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec
     (0..texture.depth_or_array_layers()).map(|layer| read_rgba_layer(ctx, texture, layer)).collect()
 }
 
-/// A 2D `Rgba8Unorm` texture's bytes, row-major, row 0 at the top.
+/// A 2D `Rgba8Unorm` (or `Rgba8UnormSrgb`) texture's bytes, row-major,
+/// row 0 at the top.
 pub fn read_rgba8(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>, GpuError> {
-    if texture.format() != wgpu::TextureFormat::Rgba8Unorm {
+    wait_for(read_rgba8_async(ctx, texture))
+}
+
+/// `read_rgba8` without blocking.
+pub async fn read_rgba8_async(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>, GpuError> {
+    use wgpu::TextureFormat::{Rgba8Unorm, Rgba8UnormSrgb};
+    if !matches!(texture.format(), Rgba8Unorm | Rgba8UnormSrgb) {
         return Err(GpuError::Readback(format!("not Rgba8Unorm: {:?}", texture.format())));
     }
-    wait_for(read_rows(ctx, texture, 0, 4))
+    read_rows(ctx, texture, 0, 4).await
 }
 
 /// One layer of a 2D (array) texture.
@@ -106,7 +113,9 @@ async fn map_read(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, Gp
     // Natively the callback runs inside the device's poll; in a browser
     // the map is a promise that resolves once the work is done.
     ctx.wait()?;
-    answer.await.map_err(|e| error(&e))?;
+    // A map fails when the device is lost meanwhile (a browser gives no
+    // reason with it): the loss, recorded by then, is the error to report.
+    answer.await.map_err(|e| ctx.check().err().unwrap_or_else(|| error(&e)))?;
     ctx.check()?;
     let bytes = slice.get_mapped_range().map_err(|e| error(&e))?.to_vec();
     buffer.unmap();

@@ -204,17 +204,33 @@ impl Frames {
         readouts: &mut Readouts,
         widgets: impl FnOnce(&mut egui::Ui),
     ) -> Result<(), GpuError> {
+        self.draw(&frame.texture, present, panel, window, controls, readouts, widgets)?;
+        window.pre_present_notify();
+        self.renderer.ctx.queue.present(frame);
+        Ok(())
+    }
+
+    /// As `present`, into `target` (of `present`'s format), not presented.
+    #[allow(clippy::too_many_arguments)]
+    pub fn draw(
+        &self,
+        target: &wgpu::Texture,
+        present: &mut PresentPass,
+        panel: &mut Panel,
+        window: &Window,
+        controls: &mut Controls,
+        readouts: &mut Readouts,
+        widgets: impl FnOnce(&mut egui::Ui),
+    ) -> Result<(), GpuError> {
         let ctx = &self.renderer.ctx;
-        let target = frame.texture.create_view(&Default::default());
+        let size = [target.width(), target.height()];
+        let target = target.create_view(&Default::default());
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let shown = shown_texture(controls.mode, &self.renderer, &self.mean)?;
         present.record(&ctx.device, &ctx.queue, &mut encoder, shown, &target, controls.exposure, controls.mode);
         readouts.frames_in_mean = self.mean.count();
-        let size = [frame.texture.width(), frame.texture.height()];
         panel.draw(window, &ctx.device, &ctx.queue, &mut encoder, &target, size, controls, readouts, widgets);
         ctx.queue.submit([encoder.finish()]);
-        window.pre_present_notify();
-        ctx.queue.present(frame);
         Ok(())
     }
 }

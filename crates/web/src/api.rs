@@ -21,6 +21,14 @@ pub fn adapter() -> String {
     with_viewer(|v| v.readouts.adapter.clone()).unwrap_or_default()
 }
 
+/// Where frames go: "surface" (the canvas's WebGPU surface), "copy" (read
+/// back into a 2D canvas, where the browser cannot present a WebGPU
+/// canvas), "" before WebGPU answered.
+#[wasm_bindgen]
+pub fn presentation() -> String {
+    with_viewer(|v| v.presentation().to_string()).unwrap_or_default()
+}
+
 /// Where photons are traced: "GPU" (the compute-shader tracer), "CPU"
 /// (the page's thread, where the GPU tracer cannot run), "" before the first set.
 #[wasm_bindgen]

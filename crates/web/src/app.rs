@@ -5,6 +5,7 @@
 //! the frame to the running mean and presents the mean with the panel. A
 //! hidden tab gets no animation frames, so it renders nothing.
 
+use crate::canvas_copy::CanvasCopy;
 use crate::files::{DroppedFile, scene_from_files};
 use crate::input::CameraInput;
 use crate::options::PageOptions;
@@ -46,10 +47,14 @@ enum Action {
     SavePng,
 }
 
-/// The device and the canvas's surface, once WebGPU answered.
+/// The device and where frames go, once WebGPU answered.
 pub struct Gpu {
     pub window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
+    /// Frames go to the canvas's WebGPU surface, or (where the browser
+    /// cannot present one) through a copy into a 2D canvas.
+    surface: Option<wgpu::Surface<'static>>,
+    copy: Option<CanvasCopy>,
+    /// The frames' size and format.
     config: wgpu::SurfaceConfiguration,
     pub ctx: GpuContext,
     present: PresentPass,
@@ -148,6 +153,15 @@ impl Viewer {
     /// Frames in the mean on screen.
     pub fn frames_in_mean(&self) -> u32 {
         self.gpu.as_ref().and_then(|g| g.frames.as_ref()).map_or(0, |f| f.mean.count())
+    }
+
+    /// Where frames go now: see `api::presentation`.
+    pub fn presentation(&self) -> &'static str {
+        match &self.gpu {
+            Some(gpu) if gpu.surface.is_some() => "surface",
+            Some(_) => "copy",
+            None => "",
+        }
     }
 
     /// Where photon sets are traced now ("" before the adapter answered).
@@ -263,7 +277,8 @@ impl Viewer {
         }
         let tracing = self.tracing.as_ref().expect("made above");
         self.readouts.photon_sets = tracing.received;
-        self.readouts.adapter = format!("{}; photons traced on the {}", gpu.ctx.describe(), tracing.device());
+        let copied = if gpu.copy.is_some() { format!("; {}", crate::canvas_copy::NOTE) } else { String::new() };
+        self.readouts.adapter = format!("{}; photons traced on the {}{copied}", gpu.ctx.describe(), tracing.device());
         self.readouts.warning = tracing
             .gpu_failed
             .as_ref()
@@ -324,10 +339,11 @@ impl Viewer {
     }
 
     /// Adds the rendered frame (if one was) to the mean and presents the
-    /// mean with the panel.
-    fn finish(&mut self, rendered: bool) -> Result<(), GpuError> {
-        let Some(gpu) = &mut self.gpu else { return Ok(()) };
-        let Some(frames) = &mut gpu.frames else { return Ok(()) };
+    /// mean with the panel; where frames go through a 2D canvas, returns
+    /// the target to read back into it.
+    fn finish(&mut self, rendered: bool) -> Result<Option<(GpuContext, wgpu::Texture)>, GpuError> {
+        let Some(gpu) = &mut self.gpu else { return Ok(None) };
+        let Some(frames) = &mut gpu.frames else { return Ok(None) };
         let ctx = &gpu.ctx;
         if rendered {
             frames.accumulate(&mut self.readouts);
@@ -351,23 +367,54 @@ impl Viewer {
         let elapsed = self.started.map_or(0.0, |s| (now - s).as_secs_f64());
         let received = self.tracing.as_ref().map_or(0, |t| t.received);
         self.readouts.sets_per_second = if elapsed > 0.0 { received as f64 / elapsed } else { 0.0 };
-        let Some(texture) = next_frame(&gpu.surface, &ctx.device, &gpu.config)? else { return Ok(()) };
         let mut asked = None;
         let scene_name = self.scene_name.clone();
         let error = self.error.clone();
         let page_rects = &mut self.page_rects;
-        frames.present(
-            texture,
-            &mut gpu.present,
-            &mut gpu.panel,
-            &gpu.window,
-            &mut self.controls,
-            &mut self.readouts,
-            |ui| asked = page_widgets(ui, &scene_name, error.as_deref(), page_rects),
-        )?;
+        let widgets = |ui: &mut egui::Ui| asked = page_widgets(ui, &scene_name, error.as_deref(), page_rects);
+        let (present, panel, window) = (&mut gpu.present, &mut gpu.panel, &gpu.window);
+        let mut copy = None;
+        if let Some(surface) = &gpu.surface {
+            let Some(texture) = next_frame(surface, &ctx.device, &gpu.config)? else { return Ok(None) };
+            frames.present(texture, present, panel, window, &mut self.controls, &mut self.readouts, widgets)?;
+        } else if let Some(canvas) = &gpu.copy {
+            frames.draw(&canvas.target, present, panel, window, &mut self.controls, &mut self.readouts, widgets)?;
+            copy = Some((ctx.clone(), canvas.target.clone()));
+        }
         ctx.check()?;
         self.actions.extend(asked);
-        Ok(())
+        Ok(copy)
+    }
+
+    /// The device was lost while frames went to the canvas's WebGPU
+    /// surface: where that is the browser failing to present one (see
+    /// `canvas_copy`), the page starts again with a new device, its frames
+    /// copied into a 2D canvas. Whether it was is not told (the browser
+    /// gives no reason), so any first loss does; a loss after that is an
+    /// error on the page. Returns whether the page starts again.
+    fn start_again_without_surface(&mut self, viewer: &Shared) -> bool {
+        let Some(gpu) = &self.gpu else { return false };
+        let lost = gpu.ctx.check().err().is_some_and(|e| e.to_string().contains("device lost"));
+        if gpu.surface.is_none() || !lost {
+            return false;
+        }
+        let window = gpu.window.clone();
+        web_sys::console::log_1(
+            &format!("hikari: the WebGPU canvas lost its device; {}", crate::canvas_copy::NOTE).into(),
+        );
+        self.gpu = None;
+        self.tracing = None;
+        self.requested = None;
+        self.rebuild = true;
+        self.frame_in_flight = false;
+        let viewer = viewer.clone();
+        wasm_bindgen_futures::spawn_local(async move {
+            if let Err(e) = open_gpu(viewer.clone(), window, Output::Copy).await {
+                page::set_status("");
+                viewer.borrow_mut().show_error(e);
+            }
+        });
+        true
     }
 
     /// Reads the mean back and offers it as a PNG download (tone-mapped
@@ -408,7 +455,12 @@ impl Viewer {
         }
         gpu.config.width = width;
         gpu.config.height = height;
-        gpu.surface.configure(&gpu.ctx.device, &gpu.config);
+        if let Some(surface) = &gpu.surface {
+            surface.configure(&gpu.ctx.device, &gpu.config);
+        }
+        if let Some(copy) = &mut gpu.copy {
+            copy.resize(&gpu.ctx.device, width, height);
+        }
         // The renderer's targets are of the canvas's size: made anew from
         // the set on screen.
         if let Some(frames) = &mut gpu.frames
@@ -482,35 +534,45 @@ fn png_bytes(width: u32, height: u32, pixels: &[glam::Vec4], exposure: f32) -> R
 /// Renders one frame of `viewer`: see the module's comment.
 async fn frame(viewer: Shared) {
     let prepared = viewer.borrow_mut().prepare();
-    let outcome = match prepared {
-        Ok(Some(renderer)) => {
-            let rendered = if viewer.borrow_mut().timing_due() {
-                renderer.render_timed_async().await.map(|(times, timestamps)| {
+    let outcome = async {
+        let rendered = match prepared? {
+            Some(renderer) => {
+                if viewer.borrow_mut().timing_due() {
+                    let (times, timestamps) = renderer.render_timed_async().await?;
                     let readouts = &mut viewer.borrow_mut().readouts;
                     readouts.passes = times.iter().map(|(stage, t)| (stage.name(), t * 1e3)).collect();
                     readouts.timestamps = timestamps;
-                })
-            } else {
-                renderer.render_async().await
-            };
-            drop(renderer);
-            let finished = rendered.and_then(|()| viewer.borrow_mut().finish(true));
-            // The noise estimate, when the mean asks for one (read back
-            // without holding the viewer: input goes on meanwhile).
-            let reading = viewer.borrow().noise_reading();
-            match (finished, reading) {
-                (Ok(()), Some((ctx, reading))) => {
-                    reading.read_async(&ctx).await.map(|noise| viewer.borrow_mut().readouts.noise = noise)
+                } else {
+                    renderer.render_async().await?;
                 }
-                (finished, _) => finished,
+                true
+            }
+            None => false,
+        };
+        let copy = viewer.borrow_mut().finish(rendered)?;
+        if let Some((ctx, target)) = copy {
+            let pixels = hikari_gpu::readback::read_rgba8_async(&ctx, &target).await?;
+            let v = viewer.borrow();
+            if let Some(canvas) = v.gpu.as_ref().and_then(|g| g.copy.as_ref()) {
+                canvas.show(target.width(), pixels).map_err(GpuError::Failed)?;
             }
         }
-        Ok(None) => viewer.borrow_mut().finish(false),
-        Err(e) => Err(e),
-    };
+        // The noise estimate, when the mean asks for one (read back
+        // without holding the viewer: input goes on meanwhile).
+        let reading = if rendered { viewer.borrow().noise_reading() } else { None };
+        if let Some((ctx, reading)) = reading {
+            let noise = reading.read_async(&ctx).await?;
+            viewer.borrow_mut().readouts.noise = noise;
+        }
+        Ok::<(), GpuError>(())
+    }
+    .await;
     let mut v = viewer.borrow_mut();
     v.frame_in_flight = false;
     if let Err(e) = outcome {
+        if v.start_again_without_surface(&viewer) {
+            return;
+        }
         // A GPU error stops the frames (never a silently wrong image).
         v.show_error(format!("{e}"));
         return;
@@ -523,12 +585,31 @@ async fn frame(viewer: Shared) {
 /// Windows narrower than this (CSS pixels) open with the panel folded.
 const PHONE_WIDTH: f32 = 600.0;
 
-/// Opens WebGPU on the canvas.
-async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
+/// Where the page's frames go.
+#[derive(Clone, Copy, PartialEq)]
+enum Output {
+    /// The canvas's WebGPU surface.
+    Surface,
+    /// A 2D canvas, each frame read back into it (`canvas_copy`).
+    Copy,
+}
+
+/// Opens WebGPU for frames to `output`.
+async fn open_gpu(viewer: Shared, window: Arc<Window>, output: Output) -> Result<(), String> {
+    use winit::platform::web::WindowExtWebSys;
     page::set_status("opening WebGPU…");
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle());
-    let surface = instance.create_surface(window.clone()).map_err(|e| format!("cannot draw in the canvas: {e}"))?;
-    let ctx = match GpuContext::for_surface_async(&instance, &surface).await {
+    let surface = match output {
+        Output::Surface => {
+            Some(instance.create_surface(window.clone()).map_err(|e| format!("cannot draw in the canvas: {e}"))?)
+        }
+        Output::Copy => None,
+    };
+    let opened = match &surface {
+        Some(surface) => GpuContext::for_surface_async(&instance, surface).await,
+        None => GpuContext::new_async().await,
+    };
+    let ctx = match opened {
         Ok(ctx) => ctx,
         // `navigator.gpu` without an adapter (WebGPU switched off, or a
         // blocklisted GPU): as good as no WebGPU.
@@ -540,14 +621,25 @@ async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
     };
     let size = window.inner_size();
     let (width, height) = (size.width.max(1), size.height.max(1));
-    let format = surface
-        .get_capabilities(&ctx.adapter)
-        .formats
-        .first()
-        .copied()
-        .ok_or_else(|| format!("the canvas offers no surface format on {}", ctx.describe()))?;
+    let (format, copy) = match &surface {
+        Some(surface) => {
+            let format = surface
+                .get_capabilities(&ctx.adapter)
+                .formats
+                .first()
+                .copied()
+                .ok_or_else(|| format!("the canvas offers no surface format on {}", ctx.describe()))?;
+            (format, None)
+        }
+        None => {
+            let canvas = window.canvas().ok_or("the page's canvas is gone")?;
+            (CanvasCopy::FORMAT, Some(CanvasCopy::new(&ctx.device, &canvas, width, height)?))
+        }
+    };
     let config = hikari_viewer::surface::surface_config(format, width, height);
-    surface.configure(&ctx.device, &config);
+    if let Some(surface) = &surface {
+        surface.configure(&ctx.device, &config);
+    }
     let present = PresentPass::new(&ctx.device, format);
     let mut panel = Panel::new(&window, &ctx.device, format);
     let mut v = viewer.borrow_mut();
@@ -557,7 +649,7 @@ async fn open_gpu(viewer: Shared, window: Arc<Window>) -> Result<(), String> {
     v.readouts.adapter = ctx.describe();
     web_sys::console::log_1(&format!("hikari: {} on {}", v.scene_name, ctx.describe()).into());
     page::set_status(&format!("tracing photons of {} on {}…", v.scene_name, ctx.describe()));
-    v.gpu = Some(Gpu { window: window.clone(), surface, config, ctx, present, panel, frames: None });
+    v.gpu = Some(Gpu { window: window.clone(), surface, copy, config, ctx, present, panel, frames: None });
     window.request_redraw();
     Ok(())
 }
@@ -587,7 +679,7 @@ impl ApplicationHandler for Page {
         };
         let viewer = self.viewer.clone();
         wasm_bindgen_futures::spawn_local(async move {
-            if let Err(e) = open_gpu(viewer.clone(), window).await {
+            if let Err(e) = open_gpu(viewer.clone(), window, Output::Surface).await {
                 page::set_status("");
                 viewer.borrow_mut().show_error(e);
             }
