@@ -105,7 +105,8 @@ impl Frames {
     /// the mean started over.
     pub fn resize(&mut self, camera: Camera, readouts: &mut Readouts) -> Result<(), GpuError> {
         let ctx = self.renderer.ctx.clone();
-        // The old renderer's targets go before the new ones are made.
+        // The old renderer lives until the new one is made (a frame in
+        // flight on the page may hold it): both sets of targets, briefly.
         self.renderer = Rc::new(renderer_for(ctx.clone(), &self.shown, camera.clone(), &self.applied, readouts)?);
         self.mean = AccumulatePass::new(&ctx.device, self.renderer.resolved());
         Ok(())
