@@ -52,6 +52,20 @@ for entry in "${gpu_tests[@]}"; do
     (cd "$dir" && WGPU_BACKEND=gl "$exe")
 done
 
+# The browser tests again in Chromium as a user's is (#43): only
+# --enable-unsafe-webgpu, no SwiftShader flags. Headless, it cannot present
+# a WebGPU canvas, and the page shows its frames through a 2D canvas.
+echo "Browser tests in stock Chromium (HIKARI_BROWSER=stock)"
+mapfile -t web_tests < <(bash scripts/test-executables.sh crates/cli web "$@")
+if [ ${#web_tests[@]} -ne 1 ]; then
+    echo "found no browser test executable to run again" >&2
+    exit 1
+fi
+read -r dir exe <<<"${web_tests[0]}"
+# Not yet in this configuration (#43's note): the phone-sized page, whose
+# tap on the folded panel is lost in most runs there (cause not found).
+(cd "$dir" && HIKARI_BROWSER=stock "$exe" --test-threads 1 --skip a_phone_sized_window_shows_the_image_and_a_folded_panel)
+
 # One render split across a real one-node Slurm (#20): a job array of
 # shards and its dependent merge, compared with the single run. Installs
 # slurm-wlm and munge; skipped, loudly, only where Slurm cannot start.

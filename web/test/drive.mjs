@@ -75,7 +75,14 @@ async function until(page, predicate, seconds, arg) {
   await page.waitForFunction(predicate, arg, { timeout: seconds * 1000, polling: 100 });
 }
 
-const hikariReady = () => window.hikari && window.hikari.framesInMean && window.hikari.framesInMean() > 0;
+// Frames are in the mean. In stock mode, in the 2D-canvas copy: the page
+// draws a few frames to its WebGPU canvas before the browser destroys that
+// device, and input during the restart would reach the old page state.
+// (Each predicate runs in the page, so it stands alone.)
+const framesShown = () => window.hikari && window.hikari.framesInMean && window.hikari.framesInMean() > 0;
+const framesCopied = () =>
+  window.hikari && window.hikari.framesInMean && window.hikari.framesInMean() > 0 && window.hikari.presentation() === "copy";
+const hikariReady = stock ? framesCopied : framesShown;
 
 async function readMean(page) {
   const values = await page.evaluate(async () => Array.from(await window.hikari.readMean()));

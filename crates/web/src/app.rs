@@ -607,7 +607,7 @@ async fn open_gpu(viewer: Shared, window: Arc<Window>, output: Output) -> Result
     };
     let opened = match &surface {
         Some(surface) => GpuContext::for_surface_async(&instance, surface).await,
-        None => GpuContext::new_async().await,
+        None => open_after_loss().await,
     };
     let ctx = match opened {
         Ok(ctx) => ctx,
@@ -652,6 +652,27 @@ async fn open_gpu(viewer: Shared, window: Arc<Window>, output: Output) -> Result
     v.gpu = Some(Gpu { window: window.clone(), surface, copy, config, ctx, present, panel, frames: None });
     window.request_redraw();
     Ok(())
+}
+
+/// A new device after the canvas's was lost. Chromium's GPU process may
+/// still be restarting then: its adapter request answers none ("A valid
+/// external Instance reference no longer exists") for a moment, so the
+/// request is made again a few times, waiting longer each time (up to
+/// about 12 s in all), before the page says there is no WebGPU.
+async fn open_after_loss() -> Result<GpuContext, GpuError> {
+    let mut wait_ms = 100;
+    loop {
+        match GpuContext::new_async().await {
+            Err(GpuError::NoAdapter(why)) if wait_ms <= 6_400 => {
+                web_sys::console::log_1(
+                    &format!("hikari: no adapter yet ({why}); asking again in {wait_ms} ms").into(),
+                );
+                page::sleep(wait_ms).await;
+                wait_ms *= 2;
+            }
+            other => return other,
+        }
+    }
 }
 
 /// winit's handler: the canvas's events and redraws.

@@ -168,3 +168,12 @@ pub fn on_files(open: impl Fn(Vec<DroppedFile>) + 'static) -> Result<(), JsValue
     }
     Ok(())
 }
+
+/// Resolves after `ms` milliseconds (the browser's timer; the page's other
+/// tasks run meanwhile).
+pub async fn sleep(ms: i32) {
+    let promise = js_sys::Promise::new(&mut |resolve, _| {
+        let _ = window().set_timeout_with_callback_and_timeout_and_arguments_0(&resolve, ms);
+    });
+    let _ = wasm_bindgen_futures::JsFuture::from(promise).await;
+}
