@@ -331,6 +331,40 @@ pub mod gltf_textures {
         (b, roots)
     }
 
+    /// `KHR_texture_transform`'s offset, rotation (radians) and scale of
+    /// `transformed_checker_glb`.
+    pub const TRANSFORM: ([f32; 2], f32, [f32; 2]) = ([0.5, 1.0], std::f32::consts::FRAC_PI_2, [2.0, 1.0]);
+
+    /// One Lambertian quad, x and y in [0, 1] at z = 0 under the white sky,
+    /// texture coordinates (x, 1 − y), with the grey checker in base colour
+    /// (REPEAT) through `KHR_texture_transform` (`TRANSFORM`), which the
+    /// file marks required, as Blender does: the image is read at
+    /// (v + 0.5, 1 − 2u) = (1.5 − y, 1 − 2x).
+    pub fn transformed_checker_glb() -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let image = b.image(&grey_checker([255; 4]), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let m = b.material(&PbrMaterial { specular: 0.0, base_color_texture: Some(t), ..Default::default() });
+        let root = quad(&mut b, Vec3::Y, Vec3::X, -Vec3::Y, 1.0, m);
+        let (mut root, bin) = b.finish(vec![root]);
+        let (offset, rotation, scale) = TRANSFORM;
+        let info = root.materials[0].pbr_metallic_roughness.base_color_texture.as_mut().unwrap();
+        info.extensions = Some(json::extensions::texture::Info {
+            texture_transform: Some(json::extensions::texture::TextureTransform {
+                offset: json::extensions::texture::TextureTransformOffset(offset),
+                rotation: json::extensions::texture::TextureTransformRotation(rotation),
+                scale: json::extensions::texture::TextureTransformScale(scale),
+                tex_coord: None,
+                extras: Default::default(),
+            }),
+            others: Default::default(),
+        });
+        for list in [&mut root.extensions_used, &mut root.extensions_required] {
+            list.push("KHR_texture_transform".into());
+        }
+        crate::scene::gltf::export::glb(&root, bin)
+    }
+
     /// `checker_glb` as a `.gltf` with its buffer and image in files of
     /// their own, as exporters write them: (name, bytes) of
     /// `checker.gltf`, `checker.bin` and `checker texture.png` (its URI

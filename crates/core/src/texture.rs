@@ -21,7 +21,7 @@
 //! mip level.
 
 use crate::material::{Material, Rgb};
-use glam::{Vec2, Vec4, Vec4Swizzles};
+use glam::{Affine2, Vec2, Vec4, Vec4Swizzles};
 
 /// How texture coordinates outside [0, 1] wrap (glTF's `wrapS`, `wrapT`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -164,11 +164,38 @@ impl Image {
     }
 }
 
-/// A texture: an image of [`Texturing::images`] read through a sampler.
+/// A texture: an image of [`Texturing::images`] read through a sampler,
+/// at texture coordinates moved by `transform` first.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TextureRef {
     pub image: u32,
     pub sampler: Sampler,
+    /// `KHR_texture_transform` (identity without it): the coordinates the
+    /// image is read at are `transform` of the surface's.
+    pub transform: Affine2,
+}
+
+impl TextureRef {
+    /// Image `image` through `sampler`, coordinates untransformed.
+    pub fn new(image: u32, sampler: Sampler) -> TextureRef {
+        TextureRef { image, sampler, transform: Affine2::IDENTITY }
+    }
+
+    /// The coordinates the image is read at, for surface coordinates `uv`.
+    pub fn image_uv(&self, uv: Vec2) -> Vec2 {
+        self.transform.transform_point2(uv)
+    }
+}
+
+/// `KHR_texture_transform`'s matrix, translation × rotation × scale: a
+/// coordinate is scaled, rotated by `rotation` radians and then offset.
+/// The rotation turns (u, v) to (u cos r + v sin r, −u sin r + v cos r):
+/// with v pointing down the image, that turns the image clockwise, as the
+/// extension says (its example, offset (0, 1), rotation π/2, scale ½,
+/// shows the image's lower-left quadrant; a test checks it).
+pub fn uv_transform(offset: Vec2, rotation: f32, scale: Vec2) -> Affine2 {
+    let (sin, cos) = rotation.sin_cos();
+    Affine2::from_cols(Vec2::new(cos, -sin) * scale.x, Vec2::new(sin, cos) * scale.y, offset)
 }
 
 /// What a material takes from textures (glTF's metallic–roughness model);
@@ -274,7 +301,7 @@ impl Texturing {
 
     fn lookup(&self, texture: Option<TextureRef>, uv: Option<Vec2>) -> Option<Vec4> {
         let (texture, uv) = (texture?, uv?);
-        Some(self.images[texture.image as usize].sample(uv, texture.sampler))
+        Some(self.images[texture.image as usize].sample(texture.image_uv(uv), texture.sampler))
     }
 
     /// Is any material a MASK cut-out (so the BVH must test alpha)?
@@ -342,14 +369,17 @@ impl Texturing {
         let Some(t) = self.textures(material) else { return ns };
         let (Some(normal), Some(uvs)) = (t.normal, self.uvs.triangle(prim)) else { return ns };
         let uv = self.uvs.at(prim, b).unwrap_or_default();
-        let texel = self.images[normal.image as usize].sample(uv, normal.sampler);
+        let texel = self.images[normal.image as usize].sample(normal.image_uv(uv), normal.sampler);
         let local = glam::Vec3::new(
             (2.0 * texel.x - 1.0) * t.normal_scale,
             (2.0 * texel.y - 1.0) * t.normal_scale,
             2.0 * texel.z - 1.0,
         );
         let (e1, e2) = (corners[1] - corners[0], corners[2] - corners[0]);
-        let (d1, d2) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+        // The frame follows the image's axes: the coordinates as the
+        // texture transform moves them.
+        let (d1, d2) =
+            (normal.transform.transform_vector2(uvs[1] - uvs[0]), normal.transform.transform_vector2(uvs[2] - uvs[0]));
         let det = d1.x * d2.y - d2.x * d1.y;
         if det.abs() < 1e-20 {
             return ns;
@@ -397,6 +427,32 @@ mod tests {
         // Halfway between centres: the mean.
         let mid = img.sample(Vec2::new(0.5, 0.375), s);
         assert!((mid - Vec4::new(0.5, 0.25, 0.0, 1.0)).abs().max_element() < 1e-6, "{mid}");
+    }
+
+    /// The extension's own example: offset (0, 1), rotation π/2, scale ½
+    /// "utilizes only the lower left quadrant of the source image, rotated
+    /// clockwise 90°": the surface's corners land on that quadrant's
+    /// (u ∈ [0, ½], v ∈ [½, 1], v down the image), its top-left corner
+    /// (0, 0) on the quadrant's bottom-left (0, 1).
+    #[test]
+    fn the_texture_transform_of_the_extensions_example() {
+        let t = TextureRef {
+            transform: uv_transform(Vec2::new(0.0, 1.0), std::f32::consts::FRAC_PI_2, Vec2::splat(0.5)),
+            ..TextureRef::new(0, Sampler::default())
+        };
+        for (uv, want) in [
+            (Vec2::new(0.0, 0.0), Vec2::new(0.0, 1.0)),
+            (Vec2::new(1.0, 0.0), Vec2::new(0.0, 0.5)),
+            (Vec2::new(0.0, 1.0), Vec2::new(0.5, 1.0)),
+            (Vec2::new(1.0, 1.0), Vec2::new(0.5, 0.5)),
+        ] {
+            let got = t.image_uv(uv);
+            assert!((got - want).length() < 1e-6, "{uv} -> {got}, want {want}");
+        }
+        // Scale before rotation, offset last: (2u, v) turned, then moved.
+        let t = uv_transform(Vec2::new(0.5, 1.0), std::f32::consts::FRAC_PI_2, Vec2::new(2.0, 1.0));
+        let got = t.transform_point2(Vec2::new(0.25, 0.5));
+        assert!((got - Vec2::new(1.0, 0.5)).length() < 1e-6, "{got}");
     }
 
     #[test]

@@ -186,6 +186,7 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
 }
 
 pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
+    let views = scene.texturing.as_deref().map(crate::textures::TextureViews::of).unwrap_or_default();
     scene
         .surfaces
         .iter()
@@ -235,9 +236,9 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 glossy: glossy.is_some() as u32,
                 emission_per_texel: per_texel.to_array(),
                 alpha_cutoff: textures.alpha_cutoff.unwrap_or(-1.0),
-                base_color_texture: crate::textures::texture_ref(textures.base_color),
-                metallic_roughness_texture: crate::textures::texture_ref(textures.metallic_roughness),
-                emissive_texture: crate::textures::texture_ref(textures.emissive),
+                base_color_texture: views.reference(textures.base_color),
+                metallic_roughness_texture: views.reference(textures.metallic_roughness),
+                emissive_texture: views.reference(textures.emissive),
                 alpha_factor: if textures.alpha_cutoff.is_some() { textures.alpha_factor } else { 1.0 },
             }
         })

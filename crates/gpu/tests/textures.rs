@@ -5,9 +5,9 @@
 
 use glam::{Vec2, Vec4};
 use hikari_core::sampling::Rng;
-use hikari_core::texture::{ColorSpace, Image, MaterialTextures, Sampler, TextureRef, Texturing, Wrap};
+use hikari_core::texture::{ColorSpace, Image, MaterialTextures, Sampler, TextureRef, Texturing, Wrap, uv_transform};
 use hikari_gpu::test_support::{run_kernel_on, test_context};
-use hikari_gpu::textures::{TEXTURES, mip_chain, pack, texture_ref};
+use hikari_gpu::textures::{TEXTURES, TextureViews, mip_chain, pack};
 
 /// An image of random 8-bit texels, decoded from `space` as the loader does.
 fn random_image(rng: &mut Rng, width: u32, height: u32, space: ColorSpace) -> Image {
@@ -21,16 +21,30 @@ fn wgsl_texture_samples_match_the_cpu() {
     let mut rng = Rng::for_item(21, 0);
     let colour = random_image(&mut rng, 7, 5, ColorSpace::Srgb);
     let data = random_image(&mut rng, 4, 9, ColorSpace::Linear);
-    let reference = |image: u32| TextureRef { image, sampler: Sampler::default() };
+    let reference = |image: u32| TextureRef::new(image, Sampler::default());
+    // KHR_texture_transform: one transform per image, read by a second material.
+    let transforms = [
+        uv_transform(Vec2::new(0.25, -1.5), 0.7, Vec2::new(2.5, -0.75)),
+        uv_transform(Vec2::new(0.0, 1.0), std::f32::consts::FRAC_PI_2, Vec2::splat(0.5)),
+    ];
+    let transformed = |image: u32| TextureRef { transform: transforms[image as usize], ..reference(image) };
     let texturing = Texturing {
         images: vec![colour.clone(), data.clone()],
-        materials: vec![Some(MaterialTextures {
-            base_color: Some(reference(0)),
-            metallic_roughness: Some(reference(1)),
-            ..Default::default()
-        })],
+        materials: vec![
+            Some(MaterialTextures {
+                base_color: Some(reference(0)),
+                metallic_roughness: Some(reference(1)),
+                ..Default::default()
+            }),
+            Some(MaterialTextures {
+                base_color: Some(transformed(0)),
+                metallic_roughness: Some(transformed(1)),
+                ..Default::default()
+            }),
+        ],
         ..Default::default()
     };
+    let views = TextureViews::of(&texturing);
     let mut words = pack(&texturing, None);
     let wraps = [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat];
     // Per query: texture reference, level, u, v; then four outputs.
@@ -41,9 +55,10 @@ fn wgsl_texture_samples_match_the_cpu() {
         let sampler = Sampler { wrap_s: wraps[i % 3], wrap_t: wraps[(i / 3) % 3] };
         let uv = (Vec2::new(rng.next_f32(), rng.next_f32()) - 0.5) * 8.0;
         let level = (i / 9 % 2) as u32;
-        let t = texture_ref(Some(TextureRef { image, sampler }));
+        let texture = if i % 5 < 2 { transformed(image) } else { reference(image) };
+        let t = views.reference(Some(TextureRef { sampler, ..texture }));
         words.extend([t, level, uv.x.to_bits(), uv.y.to_bits(), 0, 0, 0, 0]);
-        queries.push((image, sampler, uv, level));
+        queries.push((image, sampler, texture.image_uv(uv), level));
     }
     let main = format!(
         "let q = {first_query}u + 8u * id.x; if (q >= arrayLength(&texture_data)) {{ return; }}\n\
@@ -77,19 +92,50 @@ fn wgsl_texture_samples_match_the_cpu() {
 /// (radiance 1 from the open sky).
 #[test]
 fn a_checker_texture_shows_on_the_gpu_as_on_the_cpu() {
+    use hikari_core::test_scenes::gltf_textures::{checker_glb, load};
+    // Both quads (x from 0 to 3, y from 0 to 1) fill the width.
+    let scene = load("gpu-checker", &checker_glb());
+    gbuffer_shows_the_cpus_albedo("a_checker_texture_shows_on_the_gpu_as_on_the_cpu", scene, 1.5, 16.0, (96, 32), 1500);
+}
+
+/// The checker through `KHR_texture_transform` (offset, rotation, scale):
+/// the G-buffer (mip levels picked from the transformed footprint) and
+/// the image show the CPU's albedo.
+#[test]
+fn a_transformed_texture_shows_on_the_gpu_as_on_the_cpu() {
+    use hikari_core::test_scenes::gltf_textures::{load, transformed_checker_glb};
+    let scene = load("gpu-checker-transform", &transformed_checker_glb());
+    gbuffer_shows_the_cpus_albedo(
+        "a_transformed_texture_shows_on_the_gpu_as_on_the_cpu",
+        scene,
+        0.5,
+        14.0,
+        (48, 48),
+        1500,
+    );
+}
+
+/// Renders `scene` (Lambertian quads in z = 0 under the white sky, y from
+/// 0 to 1) seen from z = 4 above x = `centre_x` with vertical field of
+/// view `fov`: every pixel that sees a quad holds the CPU's albedo in the
+/// G-buffer and shows it in the image; at least `min_pixels` see one.
+fn gbuffer_shows_the_cpus_albedo(
+    name: &str,
+    mut scene: hikari_core::scene::Scene,
+    centre_x: f32,
+    fov: f32,
+    (width, height): (u32, u32),
+    min_pixels: usize,
+) {
     use glam::Vec3;
     use hikari_core::material::Material;
     use hikari_core::photon::{TraceSettings, trace_photons};
     use hikari_core::progress::Silent;
     use hikari_core::render::photon_cpu::PhotonCpuSettings;
-    use hikari_core::test_scenes::gltf_textures::{checker_glb, load};
-    let mut scene = load("gpu-checker", &checker_glb());
-    // Both quads (x from 0 to 3, y from 0 to 1) fill the width.
-    let (width, height) = (96, 32);
-    let eye = Vec3::new(1.5, 0.5, 4.0);
+    let eye = Vec3::new(centre_x, 0.5, 4.0);
     scene.camera =
-        hikari_core::camera::Camera::new(eye, Vec3::new(1.5, 0.5, 0.0), Vec3::Y, 16.0, width, height).unwrap();
-    let ctx = test_context("a_checker_texture_shows_on_the_gpu_as_on_the_cpu");
+        hikari_core::camera::Camera::new(eye, Vec3::new(centre_x, 0.5, 0.0), Vec3::Y, fov, width, height).unwrap();
+    let ctx = test_context(name);
     let traced = trace_photons(&scene, &TraceSettings { photons: 2_000, ..Default::default() }, &Silent);
     let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
     let settings = hikari_gpu::GpuSettings { area_light_samples: 16, ..hikari_gpu::GpuSettings::new(global, caustic) };
@@ -114,8 +160,8 @@ fn a_checker_texture_shows_on_the_gpu_as_on_the_cpu() {
             textured += 1;
         }
     }
-    eprintln!("checker: {textured} textured pixels, worst albedo difference {worst:e}");
-    assert!(textured > 1500, "{textured} pixels see the quads");
+    eprintln!("{name}: {textured} textured pixels, worst albedo difference {worst:e}");
+    assert!(textured > min_pixels, "{textured} pixels see the quads");
 }
 
 /// A cut-out quad (alpha a 2×2 checker, cut-off 0.5) over a floor under a

@@ -16,8 +16,12 @@
 //! * `[0]` image count, `[1]` word offset of the texture coordinates (0:
 //!   none), `[2]` word offset of the sky image's sampling block (0: none;
 //!   `sky_block`, in the photon tracer's buffer only), `[3]` unused.
-//! * per image, `IMAGE_WORDS` words from `HEADER_WORDS`: width, height,
-//!   level count, 1 if sRGB-encoded, then the word offset of each level.
+//! * per texture view (`TextureViews`: each image, then each image with a
+//!   `KHR_texture_transform` a material reads it through), `VIEW_WORDS`
+//!   words from `HEADER_WORDS`: width, height, level count, 1 if
+//!   sRGB-encoded, the transform's six f32 (its columns: x axis, y axis,
+//!   translation), then the word offset of each level (a view shares its
+//!   image's levels).
 //! * the levels' texels, row by row from the top, `pack4x8unorm` order
 //!   (r in the low byte).
 //! * per BVH primitive (`FlatBvh::prims` order), its three vertices' (u, v)
@@ -25,7 +29,7 @@
 
 use hikari_core::geometry::FlatBvh;
 use hikari_core::scene::Scene;
-use hikari_core::texture::{ColorSpace, Image, TextureRef, Texturing, Wrap};
+use hikari_core::texture::{ColorSpace, Image, Sampler, TextureRef, Texturing, Wrap};
 
 /// The texture lookups; the includer declares `texture_data`.
 pub static TEXTURES: crate::wgsl::Module =
@@ -42,22 +46,69 @@ pub static SURFACE_POINT: crate::wgsl::Module = crate::wgsl::Module {
 /// A surface without this texture (`GpuSurface`'s texture fields).
 pub const NO_TEXTURE: u32 = u32::MAX;
 const HEADER_WORDS: usize = 4;
-/// Width, height, levels, sRGB, then up to `MAX_LEVELS` level offsets.
-const IMAGE_WORDS: usize = 4 + MAX_LEVELS;
+/// Width, height, levels, sRGB, the transform, then up to `MAX_LEVELS`
+/// level offsets.
+const VIEW_WORDS: usize = 4 + TRANSFORM_WORDS + MAX_LEVELS;
+const TRANSFORM_WORDS: usize = 6;
 /// Levels of a 32768-texel side: more than any adapter draws.
 const MAX_LEVELS: usize = 16;
 
-/// A texture reference as `GpuSurface` holds it: the image index in bits
+/// A texture reference as `GpuSurface` holds it: the view index in bits
 /// 0–23, wrap s in 24–25 and wrap t in 26–27 (0 repeat, 1 clamp to edge,
-/// 2 mirrored repeat); `NO_TEXTURE` for None.
-pub fn texture_ref(texture: Option<TextureRef>) -> u32 {
+/// 2 mirrored repeat).
+pub fn texture_ref(view: u32, sampler: Sampler) -> u32 {
     let wrap = |w: Wrap| match w {
         Wrap::Repeat => 0,
         Wrap::ClampToEdge => 1,
         Wrap::MirroredRepeat => 2,
     };
-    texture
-        .map_or(NO_TEXTURE, |t| (t.image & 0x00ff_ffff) | wrap(t.sampler.wrap_s) << 24 | wrap(t.sampler.wrap_t) << 26)
+    (view & 0x00ff_ffff) | wrap(sampler.wrap_s) << 24 | wrap(sampler.wrap_t) << 26
+}
+
+/// The images as the shaders read them: view `i` is image `i` with its
+/// coordinates untransformed, then one view per other (image, transform)
+/// pair the materials read (`KHR_texture_transform`), in the order the
+/// materials name them. A transformed view costs a header, not texels.
+#[derive(Clone, Debug, Default)]
+pub struct TextureViews {
+    images: u32,
+    transformed: Vec<(u32, glam::Affine2)>,
+}
+
+impl TextureViews {
+    pub fn of(texturing: &Texturing) -> TextureViews {
+        let mut views = TextureViews { images: texturing.images.len() as u32, transformed: Vec::new() };
+        for m in texturing.materials.iter().flatten() {
+            for t in [m.base_color, m.metallic_roughness, m.emissive, m.normal].into_iter().flatten() {
+                if t.transform != glam::Affine2::IDENTITY && !views.transformed.contains(&(t.image, t.transform)) {
+                    views.transformed.push((t.image, t.transform));
+                }
+            }
+        }
+        views
+    }
+
+    fn count(&self) -> usize {
+        self.images as usize + self.transformed.len()
+    }
+
+    /// Each view's image and transform.
+    fn iter(&self) -> impl Iterator<Item = (u32, glam::Affine2)> + '_ {
+        (0..self.images).map(|i| (i, glam::Affine2::IDENTITY)).chain(self.transformed.iter().copied())
+    }
+
+    /// `texture` as `GpuSurface` holds it (`texture_ref` of its view);
+    /// `NO_TEXTURE` for None.
+    pub fn reference(&self, texture: Option<TextureRef>) -> u32 {
+        let Some(t) = texture else { return NO_TEXTURE };
+        let view = if t.transform == glam::Affine2::IDENTITY {
+            t.image
+        } else {
+            let at = self.transformed.iter().position(|&v| v == (t.image, t.transform));
+            self.images + at.expect("TextureViews::of saw every material's textures") as u32
+        };
+        texture_ref(view, t.sampler)
+    }
 }
 
 /// How each image is encoded: sRGB where some material reads it as colour
@@ -156,23 +207,37 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
     }
     let spaces = color_spaces(texturing);
     let images = &texturing.images;
-    let mut words = vec![0u32; HEADER_WORDS + IMAGE_WORDS * images.len()];
-    words[0] = images.len() as u32;
+    let views = TextureViews::of(texturing);
+    let mut words = vec![0u32; HEADER_WORDS + VIEW_WORDS * views.count()];
+    words[0] = views.count() as u32;
+    // The images' levels, and where each starts.
+    let mut level_offsets = Vec::with_capacity(images.len());
     for (i, image) in images.iter().enumerate() {
-        let header = HEADER_WORDS + IMAGE_WORDS * i;
         let chain = mip_chain(image);
-        words[header] = image.width();
-        words[header + 1] = image.height();
-        words[header + 2] = 1 + chain.len() as u32;
-        words[header + 3] = (spaces[i] == ColorSpace::Srgb) as u32;
-        for (level, texels) in std::iter::once(image).chain(chain.iter()).enumerate() {
-            words[header + 4 + level] = words.len() as u32;
+        let mut offsets = Vec::with_capacity(1 + chain.len());
+        for texels in std::iter::once(image).chain(chain.iter()) {
+            offsets.push(words.len() as u32);
             for y in 0..texels.height() as usize {
                 for x in 0..texels.width() as usize {
                     words.push(encode(texels.texel(x, y), spaces[i]));
                 }
             }
         }
+        level_offsets.push(offsets);
+    }
+    for (v, (image, transform)) in views.iter().enumerate() {
+        let header = HEADER_WORDS + VIEW_WORDS * v;
+        let i = image as usize;
+        words[header] = images[i].width();
+        words[header + 1] = images[i].height();
+        words[header + 2] = level_offsets[i].len() as u32;
+        words[header + 3] = (spaces[i] == ColorSpace::Srgb) as u32;
+        let columns = [transform.matrix2.x_axis, transform.matrix2.y_axis, transform.translation];
+        for (k, value) in columns.iter().flat_map(|c| c.to_array()).enumerate() {
+            words[header + 4 + k] = value.to_bits();
+        }
+        let levels = header + 4 + TRANSFORM_WORDS;
+        words[levels..levels + level_offsets[i].len()].copy_from_slice(&level_offsets[i]);
     }
     if let Some(bvh) = bvh.filter(|_| !texturing.uvs.is_empty()) {
         words[1] = words.len() as u32;
@@ -229,7 +294,8 @@ pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
         })
         .sum();
     let uvs = if texturing.uvs.is_empty() { 0 } else { primitives as u64 * 24 };
-    4 * (HEADER_WORDS + IMAGE_WORDS * texturing.images.len()) as u64 + 4 * texels + uvs + sky_bytes(scene)
+    let views = TextureViews::of(texturing).count();
+    4 * (HEADER_WORDS + VIEW_WORDS * views) as u64 + 4 * texels + uvs + sky_bytes(scene)
 }
 
 #[cfg(test)]
@@ -264,10 +330,30 @@ mod tests {
     }
 
     #[test]
-    fn texture_references_pack_image_and_wraps() {
-        use hikari_core::texture::Sampler;
-        let t = TextureRef { image: 7, sampler: Sampler { wrap_s: Wrap::MirroredRepeat, wrap_t: Wrap::ClampToEdge } };
-        assert_eq!(texture_ref(Some(t)), 7 | 2 << 24 | 1 << 26);
-        assert_eq!(texture_ref(None), NO_TEXTURE);
+    fn texture_references_pack_view_and_wraps() {
+        use hikari_core::texture::{MaterialTextures, uv_transform};
+        let sampler = Sampler { wrap_s: Wrap::MirroredRepeat, wrap_t: Wrap::ClampToEdge };
+        let plain = TextureRef::new(7, sampler);
+        let scaled = TextureRef { transform: uv_transform(glam::Vec2::ZERO, 0.0, glam::Vec2::splat(4.0)), ..plain };
+        let other = TextureRef { transform: uv_transform(glam::Vec2::X, 0.0, glam::Vec2::ONE), ..plain };
+        let texturing = Texturing {
+            images: vec![Image::new(1, 1, vec![Vec4::ONE]).unwrap(); 8],
+            materials: vec![
+                Some(MaterialTextures { base_color: Some(scaled), emissive: Some(plain), ..Default::default() }),
+                Some(MaterialTextures { normal: Some(other), metallic_roughness: Some(scaled), ..Default::default() }),
+            ],
+            ..Default::default()
+        };
+        let views = TextureViews::of(&texturing);
+        // Untransformed: the image's own view; each transform once, after the images.
+        assert_eq!(views.reference(Some(plain)), 7 | 2 << 24 | 1 << 26);
+        assert_eq!(views.reference(Some(scaled)), 8 | 2 << 24 | 1 << 26);
+        assert_eq!(views.reference(Some(other)), 9 | 2 << 24 | 1 << 26);
+        assert_eq!(views.reference(None), NO_TEXTURE);
+        let words = pack(&texturing, None);
+        assert_eq!(words[0], 10, "views");
+        let header = HEADER_WORDS + VIEW_WORDS * 8;
+        assert_eq!(f32::from_bits(words[header + 4]), 4.0, "x axis scaled");
+        assert_eq!(words[header + 4 + TRANSFORM_WORDS], words[HEADER_WORDS + VIEW_WORDS * 7 + 4 + TRANSFORM_WORDS]);
     }
 }

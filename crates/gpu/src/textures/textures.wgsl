@@ -5,7 +5,8 @@
 
 const NO_TEXTURE: u32 = 0xffffffffu;
 const TEXTURE_HEADER_WORDS: u32 = 4u;
-const TEXTURE_IMAGE_WORDS: u32 = 20u;
+const TEXTURE_VIEW_WORDS: u32 = 26u;
+const TEXTURE_TRANSFORM_WORDS: u32 = 6u;
 
 // hikari_core::texture::srgb_to_linear.
 fn srgb_to_linear(c: f32) -> f32 {
@@ -48,16 +49,38 @@ fn load_texel(offset: u32, width: u32, x: i32, y: i32, srgb: bool) -> vec4<f32> 
     return vec4<f32>(srgb_to_linear(v.x), srgb_to_linear(v.y), srgb_to_linear(v.z), v.w);
 }
 
-// Level `level` of the image texture `t` refers to, at `uv` (Image::sample).
+// The header of the view texture `t` reads.
+fn texture_header(t: u32) -> u32 {
+    return TEXTURE_HEADER_WORDS + TEXTURE_VIEW_WORDS * (t & 0x00ffffffu);
+}
+
+// The linear part of the view's KHR_texture_transform (TextureRef::transform).
+fn texture_linear(header: u32) -> mat2x2<f32> {
+    let m = header + 4u;
+    return mat2x2<f32>(
+        vec2<f32>(bitcast<f32>(texture_data[m]), bitcast<f32>(texture_data[m + 1u])),
+        vec2<f32>(bitcast<f32>(texture_data[m + 2u]), bitcast<f32>(texture_data[m + 3u])),
+    );
+}
+
+// Surface coordinates to the image's (TextureRef::image_uv).
+fn texture_image_uv(header: u32, uv: vec2<f32>) -> vec2<f32> {
+    let m = header + 4u;
+    let offset = vec2<f32>(bitcast<f32>(texture_data[m + 4u]), bitcast<f32>(texture_data[m + 5u]));
+    return texture_linear(header) * uv + offset;
+}
+
+// Level `level` of the image texture `t` refers to, at surface
+// coordinates `uv_in` (TextureRef::image_uv, then Image::sample).
 fn sample_level(t: u32, uv_in: vec2<f32>, level: u32) -> vec4<f32> {
-    let header = TEXTURE_HEADER_WORDS + TEXTURE_IMAGE_WORDS * (t & 0x00ffffffu);
+    let header = texture_header(t);
     let wrap_s = (t >> 24u) & 3u;
     let wrap_t = (t >> 26u) & 3u;
     let width = max(texture_data[header] >> level, 1u);
     let height = max(texture_data[header + 1u] >> level, 1u);
     let srgb = texture_data[header + 3u] != 0u;
-    let offset = texture_data[header + 4u + level];
-    var uv = uv_in;
+    let offset = texture_data[header + 4u + TEXTURE_TRANSFORM_WORDS + level];
+    var uv = texture_image_uv(header, uv_in);
     // Non-finite coordinates read (0, 0), as on the CPU.
     if (!(abs(uv.x) <= 3.4e38) || !(abs(uv.y) <= 3.4e38)) {
         uv = vec2<f32>(0.0);
@@ -90,10 +113,12 @@ fn sample_texture(t: u32, uv: vec2<f32>) -> vec4<f32> {
 // footprint's larger side (the CPU averages a minified texture over its
 // many samples per pixel instead).
 fn sample_texture_footprint(t: u32, uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>) -> vec4<f32> {
-    let header = TEXTURE_HEADER_WORDS + TEXTURE_IMAGE_WORDS * (t & 0x00ffffffu);
+    let header = texture_header(t);
     let size = vec2<f32>(f32(texture_data[header]), f32(texture_data[header + 1u]));
     let levels = texture_data[header + 2u];
-    let footprint = max(length(dx * size), length(dy * size));
+    // The footprint in the image: the transform scales it too.
+    let linear = texture_linear(header);
+    let footprint = max(length(linear * dx * size), length(linear * dy * size));
     let lod = clamp(log2(max(footprint, 1.0)), 0.0, f32(levels - 1u));
     if (!(lod > 0.0)) {
         return sample_level(t, uv, 0u);

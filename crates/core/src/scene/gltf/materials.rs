@@ -50,13 +50,17 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let pbr = m.pbr_metallic_roughness();
             unread_maps += m.occlusion_texture().is_some() as usize;
             normal_mapped += m.normal_texture().is_some() as usize;
-            let normal = m.normal_texture().and_then(|n| images.normal(&n));
+            let normal_json =
+                m.index().and_then(|i| doc.as_json().materials.get(i)).and_then(|m| m.normal_texture.as_ref());
+            let normal = m.normal_texture().zip(normal_json).and_then(|(n, json)| images.normal(&n, json));
             let read = [
-                pbr.base_color_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Srgb))),
-                pbr.metallic_roughness_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Linear))),
-                m.emissive_texture().map(|i| (i.tex_coord(), images.texture(&i, ColorSpace::Srgb))),
+                pbr.base_color_texture().map(|i| (tex_coord(&i), images.texture(&i, ColorSpace::Srgb))),
+                pbr.metallic_roughness_texture().map(|i| (tex_coord(&i), images.texture(&i, ColorSpace::Linear))),
+                m.emissive_texture().map(|i| (tex_coord(&i), images.texture(&i, ColorSpace::Srgb))),
             ];
-            other_sets += read.iter().flatten().any(|(set, _)| *set != 0) as usize;
+            let normal_set =
+                m.normal_texture().zip(normal_json).map_or(0, |(n, json)| super::textures::normal_tex_coord(&n, json));
+            other_sets += (read.iter().flatten().any(|(set, _)| *set != 0) || normal_set != 0) as usize;
             let [base_color, metallic_roughness, emissive] = read.map(|r| r.and_then(|(_, t)| t));
             blended += (m.alpha_mode() == gltf::material::AlphaMode::Blend) as usize;
             let alpha_cutoff =
@@ -136,4 +140,10 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
 /// ranges; validation has already rejected most values outside them).
 fn sane(v: Vec3, max: f32) -> Vec3 {
     Vec3::from(v.to_array().map(|x| if x.is_finite() { x.clamp(0.0, max) } else { 0.0 }))
+}
+
+/// The texture coordinate set a texture reads: `KHR_texture_transform`'s
+/// texCoord where it has one, else the texture info's.
+fn tex_coord(info: &gltf::texture::Info) -> u32 {
+    info.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord())
 }

@@ -41,6 +41,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_specular",
+    "KHR_texture_transform",
 ];
 
 /// A glTF file in world space.
@@ -157,9 +158,15 @@ pub fn asset_from_bytes(
     if file.to_ascii_lowercase().ends_with(".glb") && !bytes.starts_with(b"glTF") {
         return Err(error(&file, "", "not a binary glTF file: it does not start with the `glTF` magic bytes"));
     }
-    let gltf = parse(bytes, &file)?;
+    let (gltf, skipped_channels) = parse(bytes, &file)?;
     let buffers = load_buffers(&gltf, files, &file)?;
     let mut notes = Vec::new();
+    if skipped_channels > 0 {
+        notes.push(format!(
+            "{skipped_channels} animation channel(s) target no node (an extension such as KHR_animation_pointer \
+             names what they animate, which hikari does not read): ignored"
+        ));
+    }
     check_extensions(&gltf.document, &file, &mut notes)?;
     let images = textures::load(&gltf.document, &buffers, files, &file)?;
     let materials::Converted { materials, emissions, textures, names: material_names } =
@@ -229,9 +236,22 @@ pub fn asset_from_bytes(
     Ok(walk.asset)
 }
 
-/// Parses and validates the JSON (of a `.gltf`, or of a `.glb`'s first chunk).
-fn parse(bytes: &[u8], file: &str) -> Result<gltf::Gltf, SceneError> {
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| match e {
+/// Parses and validates the JSON (of a `.gltf`, or of a `.glb`'s first
+/// chunk); also returns how many animation channels without a target node
+/// were left out.
+fn parse(bytes: &[u8], file: &str) -> Result<(gltf::Gltf, usize), SceneError> {
+    let parsed = gltf::Gltf::from_slice_without_validation(bytes);
+    // The `gltf-json` crate requires a channel's target node, which glTF
+    // 2.0 makes optional (extensions name other targets): such channels
+    // are taken out of the JSON, and the file parsed again.
+    let (parsed, skipped) = match parsed {
+        Err(gltf::Error::Deserialize(_)) => match without_nodeless_channels(bytes) {
+            Some((gltf, skipped)) => (Ok(gltf), skipped),
+            None => (parsed, 0),
+        },
+        other => (other, 0),
+    };
+    let gltf::Gltf { document, blob } = parsed.map_err(|e| match e {
         gltf::Error::Deserialize(json) => SceneError {
             file: file.to_string(),
             position: (json.line() > 0).then(|| (json.line(), json.column())),
@@ -243,16 +263,56 @@ fn parse(bytes: &[u8], file: &str) -> Result<gltf::Gltf, SceneError> {
     })?;
     let root = document.into_json();
     check_indices(&root, file)?;
-    let document = gltf::Document::from_json(root).map_err(|e| match e {
-        gltf::Error::Validation(problems) => {
-            let (path, problem) = &problems[0];
-            let more =
-                if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
-            error(file, path.to_string(), format!("{problem}{more}"))
+    let problems = validation_problems(&root);
+    if let Some((path, problem)) = problems.first() {
+        let more =
+            if problems.len() > 1 { format!(" (and {} more problems)", problems.len() - 1) } else { String::new() };
+        return Err(error(file, path.to_string(), format!("{problem}{more}")));
+    }
+    let document = gltf::Document::from_json_without_validation(root);
+    Ok((gltf::Gltf { document, blob }, skipped))
+}
+
+/// The file with its animation channels that name no target node left
+/// out, and how many there were; None where there are none, or the JSON
+/// does not parse even so.
+fn without_nodeless_channels(bytes: &[u8]) -> Option<(gltf::Gltf, usize)> {
+    use gltf::json::Value;
+    let (json, blob) = if bytes.starts_with(b"glTF") {
+        let glb = gltf::binary::Glb::from_slice(bytes).ok()?;
+        (glb.json.into_owned(), glb.bin.map(|b| b.into_owned()))
+    } else {
+        (bytes.to_vec(), None)
+    };
+    let mut value: Value = gltf::json::deserialize::from_slice(&json).ok()?;
+    let mut skipped = 0;
+    for animation in value.get_mut("animations")?.as_array_mut()? {
+        if let Some(channels) = animation.get_mut("channels").and_then(Value::as_array_mut) {
+            let before = channels.len();
+            channels.retain(|c| c.get("target").is_some_and(|t| t.get("node").is_some()));
+            skipped += before - channels.len();
         }
-        other => error(file, "", other.to_string()),
-    })?;
-    Ok(gltf::Gltf { document, blob })
+    }
+    if skipped == 0 {
+        return None;
+    }
+    let root: gltf::json::Root = gltf::json::deserialize::from_value(value).ok()?;
+    Some((gltf::Gltf { document: gltf::Document::from_json_without_validation(root), blob }, skipped))
+}
+
+/// The `gltf-json` crate's validation problems, less one it gets wrong:
+/// an accessor without a buffer view is valid, its elements zeros (glTF
+/// 2.0, 3.6.2.1 and the validator's own test files), but the crate wants
+/// one unless the accessor is sparse.
+fn validation_problems(root: &gltf::json::Root) -> Vec<(gltf::json::Path, gltf::json::validation::Error)> {
+    use gltf::json::validation::{Error, Validate};
+    let mut problems = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| problems.push((path(), error)));
+    problems.retain(|(path, error)| {
+        let text = path.to_string();
+        !(matches!(error, Error::Missing) && text.starts_with("accessors[") && text.ends_with("].bufferView"))
+    });
+    problems
 }
 
 /// The `gltf-json` crate's validation reads each primitive's `POSITION`

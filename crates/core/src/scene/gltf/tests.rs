@@ -285,14 +285,14 @@ fn indices_beyond_the_vertices_are_refused() {
 #[test]
 fn unused_optional_extensions_are_one_note() {
     let (mut root, bin) = valid();
-    root.extensions_used.push("KHR_texture_transform".into());
+    root.extensions_used.push("KHR_materials_sheen".into());
     root.extensions_used.push("KHR_materials_clearcoat".into());
     let dir = folder("optional");
     let path = write(&dir, "o.glb", &glb(&root, bin));
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
     let ext_notes: Vec<&String> = scene.notes.iter().filter(|n| n.contains("extensions ignored")).collect();
     assert_eq!(ext_notes.len(), 1);
-    assert_says(ext_notes[0], &["KHR_texture_transform", "KHR_materials_clearcoat"]);
+    assert_says(ext_notes[0], &["KHR_materials_sheen", "KHR_materials_clearcoat"]);
 }
 
 #[test]
@@ -452,4 +452,88 @@ fn a_gltf_reads_its_buffer_and_image_from_its_folder_or_given_files() {
     let e =
         scene_from_bytes(&files[0].1, "checker.gltf", SceneFiles::None, &options, silent).err().unwrap().to_string();
     assert_says(&e, &["checker.gltf", "buffers[0]", "not read from a folder"]);
+}
+
+/// Valid files the glTF-Validator's own tests hold, written here as a
+/// `.gltf` by hand: an accessor without a buffer view (its elements zeros),
+/// a sparse `POSITION` on top of one (two vertices replaced: the triangle
+/// (0,0,0), (1,0,0), (0,1,0)), and an animation channel that names no node
+/// (`KHR_animation_pointer`), left out with a note while its neighbour, on
+/// node 0, still moves the triangle up 2 over 1 s.
+#[test]
+fn validator_edge_cases_load() {
+    let mut bin: Vec<u8> = Vec::new();
+    bin.extend([1u16, 2].iter().flat_map(|i| i.to_le_bytes())); // 0: sparse indices
+    bin.extend([1.0f32, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|v| v.to_le_bytes())); // 4: sparse values
+    bin.extend([0u32, 1, 2].iter().flat_map(|i| i.to_le_bytes())); // 28: indices
+    bin.extend([0.0f32, 1.0].iter().flat_map(|v| v.to_le_bytes())); // 40: key times
+    bin.extend([0.0f32, 0.0, 0.0, 0.0, 0.0, 2.0].iter().flat_map(|v| v.to_le_bytes())); // 48: translations
+    let json = r#"{
+      "asset": {"version": "2.0"},
+      "extensionsUsed": ["KHR_animation_pointer"],
+      "buffers": [{"uri": "e.bin", "byteLength": 72}],
+      "bufferViews": [
+        {"buffer": 0, "byteOffset": 0, "byteLength": 4},
+        {"buffer": 0, "byteOffset": 4, "byteLength": 24},
+        {"buffer": 0, "byteOffset": 28, "byteLength": 12},
+        {"buffer": 0, "byteOffset": 40, "byteLength": 8},
+        {"buffer": 0, "byteOffset": 48, "byteLength": 24}
+      ],
+      "accessors": [
+        {"count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0],
+         "sparse": {"count": 2, "indices": {"bufferView": 0, "componentType": 5123}, "values": {"bufferView": 1}}},
+        {"bufferView": 2, "count": 3, "type": "SCALAR", "componentType": 5125},
+        {"bufferView": 3, "count": 2, "type": "SCALAR", "componentType": 5126, "min": [0], "max": [1]},
+        {"bufferView": 4, "count": 2, "type": "VEC3", "componentType": 5126},
+        {"count": 4, "type": "VEC3", "componentType": 5126}
+      ],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+      "nodes": [{"mesh": 0}],
+      "animations": [{
+        "samplers": [{"input": 2, "output": 3}],
+        "channels": [
+          {"sampler": 0, "target": {"node": 0, "path": "translation"}},
+          {"sampler": 0, "target": {"path": "translation",
+            "extensions": {"KHR_animation_pointer": {"pointer": "/nodes/0/translation"}}}}
+        ]
+      }],
+      "scenes": [{"nodes": [0]}],
+      "scene": 0
+    }"#;
+    let dir = folder("validator-edge-cases");
+    write(&dir, "e.bin", &bin);
+    let path = write(&dir, "e.gltf", json.as_bytes());
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    let notes: Vec<&String> = scene.notes.iter().filter(|n| n.contains("animation channel")).collect();
+    assert_eq!(notes.len(), 1, "{:?}", scene.notes);
+    assert_says(notes[0], &["1 animation channel", "no node", "ignored"]);
+    let vertices = |s: &crate::scene::Scene| s.accel.triangles().next().map(|(t, _)| t.v).unwrap();
+    assert_eq!(vertices(&scene.at_time(0.0)), [Vec3::ZERO, Vec3::X, Vec3::Y]);
+    let up = vertices(&scene.at_time(0.5));
+    assert!((up[1] - Vec3::new(1.0, 0.0, 1.0)).length() < 1e-5, "{up:?}");
+}
+
+/// A sparse accessor's index beyond its elements, and indices that do not
+/// increase, are located errors.
+#[test]
+fn bad_sparse_indices_are_located_errors() {
+    for (indices, expected) in [([1u16, 3], "sparse index 3"), ([2u16, 1], "do not increase")] {
+        let mut bin: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        bin.extend([1.0f32, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|v| v.to_le_bytes()));
+        let json = r#"{
+          "asset": {"version": "2.0"},
+          "buffers": [{"uri": "s.bin", "byteLength": 28}],
+          "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 4}, {"buffer": 0, "byteOffset": 4, "byteLength": 24}],
+          "accessors": [{"count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0],
+            "sparse": {"count": 2, "indices": {"bufferView": 0, "componentType": 5123}, "values": {"bufferView": 1}}}],
+          "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+          "nodes": [{"mesh": 0}],
+          "scenes": [{"nodes": [0]}]
+        }"#;
+        let dir = folder(&format!("sparse-{}", indices[1]));
+        write(&dir, "s.bin", &bin);
+        let path = write(&dir, "s.gltf", json.as_bytes());
+        let e = crate::scene::Scene::load(path.to_str().unwrap()).err().expect("refused");
+        assert_says(&e.to_string(), &["s.gltf", "POSITION", expected]);
+    }
 }

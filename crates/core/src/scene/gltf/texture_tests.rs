@@ -66,6 +66,32 @@ fn a_checker_texture_is_looked_up_where_the_ray_hits() {
     assert!(close(albedo_at(&scene, 2.875, 0.125), texel[3]));
 }
 
+/// `KHR_texture_transform`, required by the file as Blender writes it, is
+/// read: the checker is read at (1.5 − y, 1 − 2x) (offset (½, 1), rotation
+/// π/2, scale (2, 1), worked by hand), so texel centres show where the
+/// hand computation puts them, the image repeated twice across x; the
+/// untransformed texel (at (x, 1 − y)) and the opposite rotation would
+/// show others.
+#[test]
+fn a_texture_transform_moves_the_checker() {
+    use crate::test_scenes::gltf_textures::transformed_checker_glb;
+    let scene = load("checker-transform", &transformed_checker_glb());
+    assert!(scene.notes.iter().all(|n| !n.contains("KHR_texture_transform")), "{:?}", scene.notes);
+    let texel = GREYS.map(|g| srgb_to_linear(g as f32 / 255.0));
+    // (x, y) → image (u', v') → texel (0: top-left, 1: top-right, 2, 3).
+    for (x, y, t) in [
+        (0.125, 0.25, 2), // (1.25, 0.75) → (0.25, 0.75)
+        (0.375, 0.75, 1), // (0.75, 0.25)
+        (0.125, 0.75, 3), // (0.75, 0.75)
+        (0.375, 0.25, 0), // (1.25, 0.25) → (0.25, 0.25)
+        (0.625, 0.25, 2), // (1.25, −0.25) → (0.25, 0.75)
+        (0.875, 0.75, 1), // (0.75, −0.75) → (0.75, 0.25)
+    ] {
+        let a = albedo_at(&scene, x, y);
+        assert!((a - texel[t]).abs() < 1e-5, "({x}, {y}): {a} vs texel {t} = {}", texel[t]);
+    }
+}
+
 /// Under the white sky (radiance 1) a Lambertian point shows its albedo:
 /// the texel, in the path tracer and in photon-cpu.
 #[test]

@@ -21,16 +21,34 @@ impl Images {
     /// The texture `info` reads in `space`; None if it reads a texture
     /// coordinate set other than 0 (the caller notes it) or has no image.
     pub fn texture(&self, info: &gltf::texture::Info, space: ColorSpace) -> Option<TextureRef> {
-        self.reference(&info.texture(), info.tex_coord(), space)
+        let transform = info.texture_transform().map(|t| Transform {
+            offset: t.offset(),
+            rotation: t.rotation(),
+            scale: t.scale(),
+            tex_coord: t.tex_coord(),
+        });
+        self.reference(&info.texture(), info.tex_coord(), transform, space)
     }
 
     /// A material's normal texture (linear data), with its `scale`.
-    pub fn normal(&self, info: &gltf::material::NormalTexture) -> Option<(TextureRef, f32)> {
-        Some((self.reference(&info.texture(), info.tex_coord(), ColorSpace::Linear)?, info.scale()))
+    pub fn normal(
+        &self,
+        info: &gltf::material::NormalTexture,
+        json: &gltf::json::material::NormalTexture,
+    ) -> Option<(TextureRef, f32)> {
+        let transform = json.extensions.as_ref().and_then(|e| e.others.get(TRANSFORM)).and_then(Transform::from_json);
+        Some((self.reference(&info.texture(), info.tex_coord(), transform, ColorSpace::Linear)?, info.scale()))
     }
 
-    fn reference(&self, texture: &gltf::Texture, tex_coord: u32, space: ColorSpace) -> Option<TextureRef> {
-        if tex_coord != 0 {
+    fn reference(
+        &self,
+        texture: &gltf::Texture,
+        tex_coord: u32,
+        transform: Option<Transform>,
+        space: ColorSpace,
+    ) -> Option<TextureRef> {
+        // The extension's texCoord, where it has one, replaces the texture's.
+        if transform.as_ref().and_then(|t| t.tex_coord).unwrap_or(tex_coord) != 0 {
             return None;
         }
         let image = *self.index.get(&(texture.source().index(), space))?;
@@ -40,7 +58,54 @@ impl Images {
             gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
         };
         let sampler = texture.sampler();
-        Some(TextureRef { image, sampler: Sampler { wrap_s: wrap(sampler.wrap_s()), wrap_t: wrap(sampler.wrap_t()) } })
+        let mut reference =
+            TextureRef::new(image, Sampler { wrap_s: wrap(sampler.wrap_s()), wrap_t: wrap(sampler.wrap_t()) });
+        if let Some(t) = transform {
+            reference.transform = t.matrix();
+        }
+        Some(reference)
+    }
+}
+
+/// The texture coordinate set a normal texture reads (the transform's
+/// texCoord where it has one).
+pub fn normal_tex_coord(info: &gltf::material::NormalTexture, json: &gltf::json::material::NormalTexture) -> u32 {
+    let transform = json.extensions.as_ref().and_then(|e| e.others.get(TRANSFORM)).and_then(Transform::from_json);
+    transform.and_then(|t| t.tex_coord).unwrap_or(info.tex_coord())
+}
+
+/// The extension's name, as it appears in a texture info's `extensions`.
+pub const TRANSFORM: &str = "KHR_texture_transform";
+
+/// A texture info's `KHR_texture_transform`.
+struct Transform {
+    offset: [f32; 2],
+    rotation: f32,
+    scale: [f32; 2],
+    tex_coord: Option<u32>,
+}
+
+impl Transform {
+    /// The extension as raw JSON (the `gltf` crate parses it on
+    /// `textureInfo`s only, not on a normal texture's); None where it is
+    /// not an object of the extension's fields.
+    fn from_json(value: &gltf::json::Value) -> Option<Transform> {
+        let parsed: gltf::json::extensions::texture::TextureTransform =
+            gltf::json::deserialize::from_value(value.clone()).ok()?;
+        Some(Transform {
+            offset: parsed.offset.0,
+            rotation: parsed.rotation.0,
+            scale: parsed.scale.0,
+            tex_coord: parsed.tex_coord,
+        })
+    }
+
+    /// The matrix; non-finite values (a broken file) as the extension's
+    /// defaults, so that no coordinate becomes NaN.
+    fn matrix(&self) -> glam::Affine2 {
+        let finite = |v: [f32; 2], default: f32| glam::Vec2::from(v.map(|x| if x.is_finite() { x } else { default }));
+        let rotation = if self.rotation.is_finite() { self.rotation } else { 0.0 };
+        crate::texture::uv_transform(finite(self.offset, 0.0), rotation, finite(self.scale, 1.0))
     }
 }
 
@@ -55,12 +120,15 @@ fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::Texture<'a>,
                 used.push((format!("{at}.{name}"), texture, space));
             }
         };
-        let info = |i: Option<gltf::texture::Info<'a>>| i.map(|i| (i.texture(), i.tex_coord()));
+        let info = |i: Option<gltf::texture::Info<'a>>| {
+            i.map(|i| (i.texture(), i.texture_transform().and_then(|t| t.tex_coord()).unwrap_or(i.tex_coord())))
+        };
         push("pbrMetallicRoughness.baseColorTexture", info(pbr.base_color_texture()), ColorSpace::Srgb);
         let mr = info(pbr.metallic_roughness_texture());
         push("pbrMetallicRoughness.metallicRoughnessTexture", mr, ColorSpace::Linear);
         push("emissiveTexture", info(m.emissive_texture()), ColorSpace::Srgb);
-        let normal = m.normal_texture().map(|n| (n.texture(), n.tex_coord()));
+        let json = m.index().and_then(|i| doc.as_json().materials.get(i)).and_then(|m| m.normal_texture.as_ref());
+        let normal = m.normal_texture().zip(json).map(|(n, json)| (n.texture(), normal_tex_coord(&n, json)));
         push("normalTexture", normal, ColorSpace::Linear);
     }
     used
