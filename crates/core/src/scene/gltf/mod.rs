@@ -233,7 +233,41 @@ pub fn asset_from_bytes(
             walk.without_uvs
         ));
     }
+    walk.asset.notes.extend(unread_deformations(&scene));
     Ok(walk.asset)
+}
+
+/// Notes for the deformations hikari does not read yet: nodes whose mesh
+/// is bent by a skin, meshes with morph targets. Their meshes are drawn
+/// undeformed, which must never pass without a word.
+fn unread_deformations(scene: &gltf::Scene) -> Vec<String> {
+    let (mut skinned, mut morphed) = (0, 0);
+    let mut stack: Vec<gltf::Node> = scene.nodes().collect();
+    let mut seen = std::collections::HashSet::new();
+    while let Some(node) = stack.pop() {
+        if !seen.insert(node.index()) {
+            continue;
+        }
+        if let Some(mesh) = node.mesh() {
+            skinned += node.skin().is_some() as usize;
+            morphed += mesh.primitives().any(|p| p.morph_targets().next().is_some()) as usize;
+        }
+        stack.extend(node.children());
+    }
+    let mut notes = Vec::new();
+    if skinned > 0 {
+        notes.push(format!(
+            "{skinned} skinned mesh(es) (glTF skins: an armature's bend) are drawn in their bind shape, not posed: \
+             skins are not read yet"
+        ));
+    }
+    if morphed > 0 {
+        notes.push(format!(
+            "{morphed} mesh(es) with morph targets (shape keys) are drawn in their base shape: morph targets are \
+             not read yet"
+        ));
+    }
+    notes
 }
 
 /// Parses and validates the JSON (of a `.gltf`, or of a `.glb`'s first

@@ -537,3 +537,32 @@ fn bad_sparse_indices_are_located_errors() {
         assert_says(&e.to_string(), &["s.gltf", "POSITION", expected]);
     }
 }
+
+/// A skinned mesh and a mesh with morph targets, neither read yet, are
+/// each named in a note (never drawn undeformed in silence).
+#[test]
+fn unread_skins_and_morph_targets_are_noted() {
+    let mut bin: Vec<u8> = Vec::new();
+    bin.extend([0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|v| v.to_le_bytes()));
+    let json = r#"{
+      "asset": {"version": "2.0"},
+      "buffers": [{"uri": "d.bin", "byteLength": 36}],
+      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+      "accessors": [{"bufferView": 0, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0]}],
+      "meshes": [
+        {"primitives": [{"attributes": {"POSITION": 0}}]},
+        {"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}], "weights": [0.5]}
+      ],
+      "skins": [{"joints": [2]}],
+      "nodes": [{"mesh": 0, "skin": 0}, {"mesh": 1}, {"name": "bone"}],
+      "scenes": [{"nodes": [0, 1, 2]}]
+    }"#;
+    let dir = folder("deformations");
+    write(&dir, "d.bin", &bin);
+    let path = write(&dir, "d.gltf", json.as_bytes());
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    let skin = scene.notes.iter().find(|n| n.contains("skinned")).expect("a note on the skin");
+    assert_says(skin, &["1 skinned mesh", "not read yet"]);
+    let morph = scene.notes.iter().find(|n| n.contains("morph targets")).expect("a note on the morph targets");
+    assert_says(morph, &["1 mesh(es) with morph targets", "not read yet"]);
+}
