@@ -18,8 +18,8 @@
 //!   `sky_block`, in the photon tracer's buffer only), `[3]` unused.
 //! * per texture view (`TextureViews`: each image, then each image with a
 //!   `KHR_texture_transform` a material reads it through), `VIEW_WORDS`
-//!   words from `HEADER_WORDS`: width, height, level count, 1 if
-//!   sRGB-encoded, the transform's six f32 (its columns: x axis, y axis,
+//!   words from `HEADER_WORDS`: width, height, level count, flags (bit 0:
+//!   sRGB-encoded, bit 1: transformed), the transform's six f32 (its columns: x axis, y axis,
 //!   translation), then the word offset of each level (a view shares its
 //!   image's levels).
 //! * the levels' texels, row by row from the top, `pack4x8unorm` order
@@ -231,7 +231,8 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
         words[header] = images[i].width();
         words[header + 1] = images[i].height();
         words[header + 2] = level_offsets[i].len() as u32;
-        words[header + 3] = (spaces[i] == ColorSpace::Srgb) as u32;
+        let transformed = transform != glam::Affine2::IDENTITY;
+        words[header + 3] = (spaces[i] == ColorSpace::Srgb) as u32 | (transformed as u32) << 1;
         let columns = [transform.matrix2.x_axis, transform.matrix2.y_axis, transform.translation];
         for (k, value) in columns.iter().flat_map(|c| c.to_array()).enumerate() {
             words[header + 4 + k] = value.to_bits();

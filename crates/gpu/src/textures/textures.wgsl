@@ -63,8 +63,17 @@ fn texture_linear(header: u32) -> mat2x2<f32> {
     );
 }
 
+// Header word 3: bit 0 the image is sRGB-encoded, bit 1 the view has a
+// transform (without one its coordinates are the surface's: a branch that
+// a scene without transforms takes the same way everywhere).
+const TEXTURE_SRGB: u32 = 1u;
+const TEXTURE_TRANSFORMED: u32 = 2u;
+
 // Surface coordinates to the image's (TextureRef::image_uv).
 fn texture_image_uv(header: u32, uv: vec2<f32>) -> vec2<f32> {
+    if ((texture_data[header + 3u] & TEXTURE_TRANSFORMED) == 0u) {
+        return uv;
+    }
     let m = header + 4u;
     let offset = vec2<f32>(bitcast<f32>(texture_data[m + 4u]), bitcast<f32>(texture_data[m + 5u]));
     return texture_linear(header) * uv + offset;
@@ -78,7 +87,7 @@ fn sample_level(t: u32, uv_in: vec2<f32>, level: u32) -> vec4<f32> {
     let wrap_t = (t >> 26u) & 3u;
     let width = max(texture_data[header] >> level, 1u);
     let height = max(texture_data[header + 1u] >> level, 1u);
-    let srgb = texture_data[header + 3u] != 0u;
+    let srgb = (texture_data[header + 3u] & TEXTURE_SRGB) != 0u;
     let offset = texture_data[header + 4u + TEXTURE_TRANSFORM_WORDS + level];
     var uv = texture_image_uv(header, uv_in);
     // Non-finite coordinates read (0, 0), as on the CPU.
@@ -116,9 +125,12 @@ fn sample_texture_footprint(t: u32, uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>)
     let header = texture_header(t);
     let size = vec2<f32>(f32(texture_data[header]), f32(texture_data[header + 1u]));
     let levels = texture_data[header + 2u];
-    // The footprint in the image: the transform scales it too.
-    let linear = texture_linear(header);
-    let footprint = max(length(linear * dx * size), length(linear * dy * size));
+    // The footprint in the image: a transform scales it too.
+    var footprint = max(length(dx * size), length(dy * size));
+    if ((texture_data[header + 3u] & TEXTURE_TRANSFORMED) != 0u) {
+        let linear = texture_linear(header);
+        footprint = max(length(linear * dx * size), length(linear * dy * size));
+    }
     let lod = clamp(log2(max(footprint, 1.0)), 0.0, f32(levels - 1u));
     if (!(lod > 0.0)) {
         return sample_level(t, uv, 0u);
