@@ -9,6 +9,7 @@
 
 mod accessors;
 mod animations;
+mod deform;
 pub mod export;
 mod materials;
 mod textures;
@@ -195,6 +196,9 @@ pub fn asset_from_bytes(
         visited: vec![false; gltf.document.nodes().len()],
         ignored_range: false,
         without_uvs: 0,
+        node_worlds: Vec::new(),
+        skinned: 0,
+        unweighted: 0,
         progress,
     };
     let scene = gltf
@@ -203,6 +207,7 @@ pub fn asset_from_bytes(
         .or_else(|| gltf.document.scenes().next())
         .ok_or_else(|| error(&file, "scenes", "the file has no scene to render"))?;
     let world = Mat4::from(world_from_file);
+    walk.node_worlds = deform::node_worlds(&gltf.document, &scene, world);
     progress.begin("reading meshes", placed_primitives(&scene));
     let walked = scene.nodes().try_for_each(|node| walk.node(&node, world, &mut Vec::new()));
     progress.end();
@@ -233,41 +238,18 @@ pub fn asset_from_bytes(
             walk.without_uvs
         ));
     }
-    walk.asset.notes.extend(unread_deformations(&scene));
+    if walk.skinned > 0 && gltf.document.animations().next().is_some() {
+        walk.asset.notes.push(format!(
+            "{} skinned mesh(es) are posed as the file's node transforms stand: animations do not bend them yet",
+            walk.skinned
+        ));
+    }
+    if walk.unweighted > 0 {
+        walk.asset
+            .notes
+            .push(format!("{} skinned vertices have no joint weights: placed by their mesh's node", walk.unweighted));
+    }
     Ok(walk.asset)
-}
-
-/// Notes for the deformations hikari does not read yet: nodes whose mesh
-/// is bent by a skin, meshes with morph targets. Their meshes are drawn
-/// undeformed, which must never pass without a word.
-fn unread_deformations(scene: &gltf::Scene) -> Vec<String> {
-    let (mut skinned, mut morphed) = (0, 0);
-    let mut stack: Vec<gltf::Node> = scene.nodes().collect();
-    let mut seen = std::collections::HashSet::new();
-    while let Some(node) = stack.pop() {
-        if !seen.insert(node.index()) {
-            continue;
-        }
-        if let Some(mesh) = node.mesh() {
-            skinned += node.skin().is_some() as usize;
-            morphed += mesh.primitives().any(|p| p.morph_targets().next().is_some()) as usize;
-        }
-        stack.extend(node.children());
-    }
-    let mut notes = Vec::new();
-    if skinned > 0 {
-        notes.push(format!(
-            "{skinned} skinned mesh(es) (glTF skins: an armature's bend) are drawn in their bind shape, not posed: \
-             skins are not read yet"
-        ));
-    }
-    if morphed > 0 {
-        notes.push(format!(
-            "{morphed} mesh(es) with morph targets (shape keys) are drawn in their base shape: morph targets are \
-             not read yet"
-        ));
-    }
-    notes
 }
 
 /// Parses and validates the JSON (of a `.gltf`, or of a `.glb`'s first
@@ -459,6 +441,7 @@ fn check_extensions(doc: &gltf::Document, file: &str, notes: &mut Vec<String>) -
 
 /// A primitive's triangles in the file's own space, shared by every node
 /// that instances its mesh.
+#[derive(Clone)]
 struct LocalPrimitive {
     positions: Vec<Vec3>,
     normals: Option<Vec<Vec3>>,
@@ -484,6 +467,12 @@ struct Walk<'a> {
     ignored_range: bool,
     /// Primitives of textured materials without `TEXCOORD_0`.
     without_uvs: usize,
+    /// Every node's world transform (what skins read).
+    node_worlds: Vec<Option<Mat4>>,
+    /// Nodes whose mesh a skin bends.
+    skinned: usize,
+    /// Skinned vertices without joint weights (placed by their node).
+    unweighted: usize,
     progress: &'a dyn Progress,
 }
 
@@ -521,9 +510,11 @@ impl Walk<'_> {
         let name = node.name().map(str::to_string);
         path.push(node.index());
         if let Some(mesh) = node.mesh() {
+            self.skinned += node.skin().is_some() as usize;
             for primitive in mesh.primitives() {
                 let local = self.local_primitive(&mesh, &primitive)?;
-                let (triangles, uvs) = place_triangles(&local, &world);
+                let (local, placement, node_path) = self.deformed(node, &mesh, &primitive, local, world, path)?;
+                let (triangles, uvs) = place_triangles(&local, &placement);
                 if let Some(v) = triangles.iter().flat_map(|t| t.v).find(|v| v.abs().max_element() > MAX_COORD) {
                     return Err(error(
                         self.file,
@@ -533,7 +524,6 @@ impl Walk<'_> {
                 }
                 let material = local.material;
                 let emission = self.emissions[material as usize];
-                let node_path = path.clone();
                 self.asset.primitives.push(Primitive {
                     name: name.clone(),
                     triangles,
@@ -558,6 +548,34 @@ impl Walk<'_> {
         }
         path.pop();
         Ok(())
+    }
+
+    /// `local` under `node` morphed by its weights (the node's, else the
+    /// mesh's) and bent by its skin, with the transform that places it and
+    /// the node path that moves it: a skinned primitive is in world space
+    /// already and does not follow its node's motion.
+    fn deformed(
+        &mut self,
+        node: &gltf::Node,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+        local: std::rc::Rc<LocalPrimitive>,
+        world: Mat4,
+        path: &[usize],
+    ) -> Result<(std::rc::Rc<LocalPrimitive>, Mat4, Vec<usize>), SceneError> {
+        let at = format!("nodes[{}] (meshes[{}].primitives[{}])", node.index(), mesh.index(), primitive.index());
+        let weights = node.weights().or(mesh.weights()).unwrap_or(&[]);
+        let mut local = local;
+        if primitive.morph_targets().next().is_some() && weights.iter().any(|&w| w != 0.0) {
+            local = std::rc::Rc::new(
+                deform::morph(&local, primitive, weights, self.buffers).map_err(|m| error(self.file, &at, m))?,
+            );
+        }
+        let Some(skin) = node.skin() else { return Ok((local, world, path.to_vec())) };
+        let (skinned, unweighted) = deform::skin(&local, primitive, &skin, &self.node_worlds, world, self.buffers)
+            .map_err(|m| error(self.file, &at, m))?;
+        self.unweighted += unweighted;
+        Ok((std::rc::Rc::new(skinned), Mat4::IDENTITY, Vec::new()))
     }
 
     /// Keeps the camera if it is the one asked for by its own or its

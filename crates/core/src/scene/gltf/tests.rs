@@ -538,31 +538,68 @@ fn bad_sparse_indices_are_located_errors() {
     }
 }
 
-/// A skinned mesh and a mesh with morph targets, neither read yet, are
-/// each named in a note (never drawn undeformed in silence).
+/// A skin bends a triangle and a morph target reshapes one, computed by
+/// hand: joint A stays, joint B turns 90° about z around (0, 0, 2) (its
+/// node at (0, 0, 2) turned, its inverse bind matrix back by 2); vertex 1
+/// follows B alone, vertex 2 half A and half B; the skinned mesh's own
+/// node (moved by 10 in x) does not place it. The morphed triangle's
+/// vertex 1 rises by its target's delta (0, 0, 1) × the node's weight ½
+/// (which replaces the mesh's 1), and its node moves it by 5 in y.
 #[test]
-fn unread_skins_and_morph_targets_are_noted() {
-    let mut bin: Vec<u8> = Vec::new();
-    bin.extend([0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0].iter().flat_map(|v| v.to_le_bytes()));
-    let json = r#"{
-      "asset": {"version": "2.0"},
-      "buffers": [{"uri": "d.bin", "byteLength": 36}],
-      "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
-      "accessors": [{"bufferView": 0, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0]}],
-      "meshes": [
-        {"primitives": [{"attributes": {"POSITION": 0}}]},
-        {"primitives": [{"attributes": {"POSITION": 0}, "targets": [{"POSITION": 0}]}], "weights": [0.5]}
+fn skins_and_morph_targets_deform_meshes() {
+    let floats = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let mut bin = floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]); // 0: positions
+    bin.extend([0u8, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0]); // 36: joints
+    bin.extend(floats(&[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.0, 0.0])); // 48: weights
+    let mut shifted = Mat4::IDENTITY.to_cols_array();
+    shifted[14] = -2.0;
+    bin.extend(floats(&Mat4::IDENTITY.to_cols_array())); // 96: inverse bind matrices
+    bin.extend(floats(&shifted));
+    bin.extend(floats(&[0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])); // 224: morph deltas
+    let s = std::f32::consts::FRAC_1_SQRT_2;
+    let json = format!(
+        r#"{{
+      "asset": {{"version": "2.0"}},
+      "buffers": [{{"uri": "d.bin", "byteLength": 260}}],
+      "bufferViews": [
+        {{"buffer": 0, "byteOffset": 0, "byteLength": 36}},
+        {{"buffer": 0, "byteOffset": 36, "byteLength": 12}},
+        {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
+        {{"buffer": 0, "byteOffset": 96, "byteLength": 128}},
+        {{"buffer": 0, "byteOffset": 224, "byteLength": 36}}
       ],
-      "skins": [{"joints": [2]}],
-      "nodes": [{"mesh": 0, "skin": 0}, {"mesh": 1}, {"name": "bone"}],
-      "scenes": [{"nodes": [0, 1, 2]}]
-    }"#;
+      "accessors": [
+        {{"bufferView": 0, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0]}},
+        {{"bufferView": 1, "count": 3, "type": "VEC4", "componentType": 5121}},
+        {{"bufferView": 2, "count": 3, "type": "VEC4", "componentType": 5126}},
+        {{"bufferView": 3, "count": 2, "type": "MAT4", "componentType": 5126}},
+        {{"bufferView": 4, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [0, 0, 1]}}
+      ],
+      "meshes": [
+        {{"primitives": [{{"attributes": {{"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}}}]}},
+        {{"primitives": [{{"attributes": {{"POSITION": 0}}, "targets": [{{"POSITION": 4}}]}}], "weights": [1.0]}}
+      ],
+      "skins": [{{"joints": [1, 2], "inverseBindMatrices": 3}}],
+      "nodes": [
+        {{"mesh": 0, "skin": 0, "translation": [10, 0, 0]}},
+        {{"name": "A"}},
+        {{"name": "B", "translation": [0, 0, 2], "rotation": [0, 0, {s}, {s}]}},
+        {{"mesh": 1, "weights": [0.5], "translation": [0, 5, 0]}}
+      ],
+      "scenes": [{{"nodes": [0, 1, 2, 3]}}]
+    }}"#
+    );
     let dir = folder("deformations");
     write(&dir, "d.bin", &bin);
     let path = write(&dir, "d.gltf", json.as_bytes());
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
-    let skin = scene.notes.iter().find(|n| n.contains("skinned")).expect("a note on the skin");
-    assert_says(skin, &["1 skinned mesh", "not read yet"]);
-    let morph = scene.notes.iter().find(|n| n.contains("morph targets")).expect("a note on the morph targets");
-    assert_says(morph, &["1 mesh(es) with morph targets", "not read yet"]);
+    let triangle = |surface: u32| scene.accel.triangles().find(|(_, id)| *id == surface).map(|(t, _)| t.v).unwrap();
+    let close = |got: [Vec3; 3], want: [Vec3; 3]| got.iter().zip(want).all(|(g, w)| (*g - w).length() < 1e-5);
+    let skinned = triangle(0);
+    let want = [Vec3::ZERO, Vec3::Y, Vec3::new(-0.5, 0.5, 0.0)];
+    assert!(close(skinned, want), "skinned {skinned:?}, by hand {want:?}");
+    let morphed = triangle(1);
+    let want = [Vec3::new(0.0, 5.0, 0.0), Vec3::new(1.0, 5.0, 0.5), Vec3::new(0.0, 6.0, 0.0)];
+    assert!(close(morphed, want), "morphed {morphed:?}, by hand {want:?}");
+    assert!(scene.notes.iter().all(|n| !n.contains("skinned") && !n.contains("morph")), "{:?}", scene.notes);
 }
