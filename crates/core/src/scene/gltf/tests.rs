@@ -247,10 +247,10 @@ fn broken_files_are_located_errors() {
 
     // An extension hikari does not read, required.
     let mut r = root.clone();
-    r.extensions_used.push("KHR_draco_mesh_compression".into());
-    r.extensions_required.push("KHR_draco_mesh_compression".into());
+    r.extensions_used.push("KHR_materials_pbrSpecularGlossiness".into());
+    r.extensions_required.push("KHR_materials_pbrSpecularGlossiness".into());
     let e = error_of("extension", &[("x.glb", &glb(&r, bin.clone()))]);
-    assert_says(&e, &["extensionsRequired[0]", "KHR_draco_mesh_compression"]);
+    assert_says(&e, &["extensionsRequired[0]", "KHR_materials_pbrSpecularGlossiness"]);
 
     // Lines are not surfaces.
     let mut r = root.clone();

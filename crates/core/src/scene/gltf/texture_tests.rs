@@ -303,3 +303,38 @@ fn a_normal_texture_bends_the_path_tracers_normals() {
     let photon = renderer.radiance(&look, 0, &mut rng).x;
     assert!((photon - flat).abs() < 1e-4 * flat, "photon-cpu ignores the map: {photon} vs {flat}");
 }
+
+/// `EXT_texture_webp` as gltfpack `-tw` writes it: required, the texture's
+/// only image a WebP one (no PNG `source`). The grey checker, losslessly
+/// WebP-encoded, shows the same texels at their centres as the PNG one.
+#[test]
+fn a_webp_texture_reads_as_the_png_one() {
+    use crate::test_scenes::gltf_textures::quad;
+    use image::ImageEncoder;
+    let rgba: Vec<u8> = GREYS.iter().flat_map(|&g| [g, g, g, 255]).collect();
+    let mut webp = Vec::new();
+    image::codecs::webp::WebPEncoder::new_lossless(&mut webp)
+        .write_image(&rgba, 2, 2, image::ExtendedColorType::Rgba8)
+        .unwrap();
+    let mut b = GltfBuilder::new();
+    let image = b.image(&webp, "image/webp");
+    let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    let m = b.material(&PbrMaterial { specular: 0.0, base_color_texture: Some(t), ..Default::default() });
+    let node = quad(&mut b, Vec3::Y, Vec3::X, -Vec3::Y, 1.0, m);
+    let (mut root, bin) = b.finish(vec![node]);
+    let texture = &mut root.textures[0];
+    texture.source = gltf::json::Index::new(u32::MAX); // written as absent
+    let extension = format!(r#"{{"{}": {{"source": {}}}}}"#, textures::WEBP, image.value());
+    texture.extensions = Some(gltf::json::deserialize::from_str(&extension).unwrap());
+    root.extensions_used.push(textures::WEBP.into());
+    root.extensions_required.push(textures::WEBP.into());
+    let json: gltf::json::Value = gltf::json::deserialize::from_slice(&root.to_vec().unwrap()).unwrap();
+    assert!(json["textures"][0].get("source").is_none(), "{}", json["textures"][0]);
+    let scene = load("webp", &glb(&root, bin));
+    assert!(scene.notes.iter().all(|n| !n.contains("EXT_texture_webp")), "{:?}", scene.notes);
+    let texel = GREYS.map(|g| srgb_to_linear(g as f32 / 255.0));
+    for (x, y, t) in [(0.25, 0.75, 0), (0.75, 0.75, 1), (0.25, 0.25, 2), (0.75, 0.25, 3)] {
+        let a = albedo_at(&scene, x, y);
+        assert!((a - texel[t]).abs() < 1e-5, "({x}, {y}): {a} vs texel {t} = {}", texel[t]);
+    }
+}

@@ -8,7 +8,6 @@ use crate::scene::SceneError;
 use crate::scene::files::SceneFiles;
 use crate::texture::{ColorSpace, Image, Sampler, TextureRef, Wrap};
 use std::collections::HashMap;
-use std::path::Path;
 
 /// The decoded images, by (glTF image index, colour space).
 #[derive(Default)]
@@ -51,7 +50,7 @@ impl Images {
         if transform.as_ref().and_then(|t| t.tex_coord).unwrap_or(tex_coord) != 0 {
             return None;
         }
-        let image = *self.index.get(&(texture.source().index(), space))?;
+        let image = *self.index.get(&(image_index(texture), space))?;
         let wrap = |w: gltf::texture::WrappingMode| match w {
             gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
             gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
@@ -109,6 +108,17 @@ impl Transform {
     }
 }
 
+/// The extension that gives a texture a WebP image.
+pub const WEBP: &str = "EXT_texture_webp";
+
+/// The image a texture shows: its `EXT_texture_webp` source where it has
+/// one (hikari decodes WebP), else its `source` (which validation made sure
+/// it has where it has no WebP one).
+fn image_index(texture: &gltf::Texture) -> usize {
+    let webp = texture.extensions().and_then(|e| e.get(WEBP)).and_then(|w| w.get("source")).and_then(|s| s.as_u64());
+    webp.map_or_else(|| texture.source().index(), |s| s as usize)
+}
+
 /// The textures each material reads, with the glTF path that reads them.
 fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::Texture<'a>, ColorSpace)> {
     let mut used = Vec::new();
@@ -144,12 +154,15 @@ pub fn load(
 ) -> Result<Images, SceneError> {
     let mut out = Images::default();
     for (used_at, texture, space) in used_textures(doc) {
-        let image = texture.source();
-        let key = (image.index(), space);
+        let index = image_index(&texture);
+        let key = (index, space);
         if out.index.contains_key(&key) {
             continue;
         }
-        let at = format!("images[{}] (read by {used_at})", image.index());
+        let at = format!("images[{index}] (read by {used_at})");
+        let image = doc.images().nth(index).ok_or_else(|| {
+            error(file, format!("textures[{}]", texture.index()), format!("image {index} does not exist"))
+        })?;
         let decoded = decode(doc, &image, buffers, files).map_err(|m| error(file, &at, m))?;
         let texels =
             to_image(&decoded, space).ok_or_else(|| error(file, &at, "has a pixel format hikari cannot read"))?;
@@ -181,7 +194,7 @@ fn image_data(image: image::DynamicImage) -> Option<gltf::image::Data> {
     Some(gltf::image::Data { pixels: image.into_bytes(), format, width, height })
 }
 
-/// One image's pixels, after checking what the `gltf` crate would panic on.
+/// One image's pixels (PNG, JPEG or WebP, told apart by their bytes).
 fn decode(
     doc: &gltf::Document,
     image: &gltf::image::Image,
@@ -189,28 +202,30 @@ fn decode(
     files: SceneFiles,
 ) -> Result<gltf::image::Data, String> {
     let json = &doc.as_json().images[image.index()];
-    let (what, base) = match (&json.buffer_view, &json.uri) {
+    let (what, bytes) = match (&json.buffer_view, &json.uri) {
         (Some(view), _) => {
             if json.mime_type.is_none() {
                 return Err("is stored in a buffer view but has no mimeType".into());
             }
             let view = doc.views().nth(view.value()).ok_or("refers to a buffer view that does not exist")?;
-            let length = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
-            if view.offset().checked_add(view.length()).is_none_or(|end| end > length) {
-                return Err(format!("reads bufferViews[{}], beyond its buffer's {length} bytes", view.index()));
-            }
-            (format!("the image in bufferViews[{}]", view.index()), None)
+            let buffer = buffers.get(view.buffer().index()).map_or(&[][..], |b| &b[..]);
+            let end = view.offset().checked_add(view.length()).filter(|&end| end <= buffer.len());
+            let Some(end) = end else {
+                return Err(format!("reads bufferViews[{}], beyond its buffer's {} bytes", view.index(), buffer.len()));
+            };
+            (format!("the image in bufferViews[{}]", view.index()), buffer[view.offset()..end].to_vec())
         }
-        // The crate reads data URIs only when given a folder, which they do not use.
-        (None, Some(uri)) if uri.starts_with("data:") => ("its data URI".to_string(), Some(Path::new("."))),
-        (None, Some(uri)) => {
-            let bytes = files.read(uri, true)?;
-            let decoded = image::load_from_memory(&bytes).map_err(|e| format!("cannot read \"{uri}\": {e}"))?;
-            return image_data(decoded).ok_or_else(|| format!("\"{uri}\" has a pixel format hikari cannot read"));
+        (None, Some(uri)) if uri.starts_with("data:") => {
+            let source = gltf::buffer::Source::Uri(uri);
+            let data = gltf::buffer::Data::from_source_and_blob(source, None, &mut None)
+                .map_err(|e| format!("cannot read its data URI: {e}"))?;
+            ("its data URI".to_string(), data.0)
         }
+        (None, Some(uri)) => (format!("\"{uri}\""), files.read(uri, true)?),
         (None, None) => return Err("has neither a uri nor a bufferView".into()),
     };
-    gltf::image::Data::from_source(image.source(), base, buffers).map_err(|e| format!("cannot read {what}: {e}"))
+    let decoded = image::load_from_memory(&bytes).map_err(|e| format!("cannot read {what}: {e}"))?;
+    image_data(decoded).ok_or_else(|| format!("{what} has a pixel format hikari cannot read"))
 }
 
 /// The `gltf` crate's pixels as a linear image.
