@@ -13,7 +13,7 @@ use crate::photons::PhotonBuffer;
 use crate::readback::read_rgba;
 use crate::resolve::ResolvePass;
 use crate::scene_upload::SceneBuffers;
-use crate::shadow::light_samples::GpuLights;
+use crate::shadow::light_samples::{GpuLights, LightSource};
 use crate::shadow::{ShadowMaps, ShadowPass};
 use crate::specular::{SpecularInputs, SpecularPass};
 use crate::splat::depth_tiles::DepthTiles;
@@ -161,6 +161,10 @@ pub struct GpuRenderer {
     /// geometry and lights alone, so frames of a scene that stands still
     /// (progressive passes, camera moves) draw them once, not every frame.
     shadows_drawn: std::cell::Cell<bool>,
+    /// The scene's lights, from which each progressive pass draws its own
+    /// shadow-mapped samples, and the pass the samples now bound are of.
+    light_source: LightSource,
+    light_pass: std::cell::Cell<u32>,
     direct_pass: DirectPass,
     direct_binding: crate::direct::DirectBinding,
     specular_pass: SpecularPass,
@@ -419,6 +423,8 @@ impl GpuRenderer {
             direct_pass,
             shadow_scene: shadow_pass.bind_scene(device, &scene_buffers),
             shadows_drawn: std::cell::Cell::new(false),
+            light_source: LightSource::of(scene),
+            light_pass: std::cell::Cell::new(1),
             shadow_pass,
             scene: scene_buffers,
             global_lod: lod_pass
@@ -531,6 +537,8 @@ impl GpuRenderer {
             self.splat_pass.bind(device, &self.targets.gbuffer, &self.scene.surfaces, &self.depth_tiles.tiles);
         self.bounds = scene.accel.bounds();
         let lights = GpuLights::new(scene, self.settings.area_light_samples);
+        self.light_source = LightSource::of(scene);
+        self.light_pass.set(1);
         self.shadows_drawn.set(false);
         if !self.targets.shadow_maps.update(queue, &lights, self.bounds) {
             self.targets.shadow_maps =
@@ -814,6 +822,28 @@ impl GpuRenderer {
         self.ctx.wait()
     }
 
+    /// Draws this pass's samples of the lights whose samples change from
+    /// pass to pass (skies, area lights, emissive meshes), so that the
+    /// progressive mean of their shadows converges (`GpuLights::sampled`):
+    /// new shadow views, redrawn, and the direct and specular passes' sample
+    /// tables rewritten. Nothing is redone while the pass stays the same (a
+    /// moving camera, the viewer without converging).
+    fn resample_lights(&self) {
+        let (pass, n) = (self.settings.pass.max(1), self.settings.area_light_samples);
+        if pass == self.light_pass.get() || !self.light_source.varies_per_pass(n) {
+            return;
+        }
+        let lights = GpuLights::sampled(&self.light_source, n, pass);
+        let queue = &self.ctx.queue;
+        // The same lights: the same number of views, so the maps are rewritten in place.
+        if self.targets.shadow_maps.update(queue, &lights, self.bounds) {
+            self.direct_pass.set_samples(queue, &self.direct_binding, &lights);
+            self.specular_pass.set_light_samples(queue, &lights);
+            self.shadows_drawn.set(false);
+            self.light_pass.set(pass);
+        }
+    }
+
     fn record_stage(&self, stage: Stage, encoder: &mut wgpu::CommandEncoder) {
         let queue = &self.ctx.queue;
         let lod = self.settings.lod.as_ref();
@@ -847,6 +877,7 @@ impl GpuRenderer {
                 self.depth_tiles.record(queue, encoder, self.clip_from_world);
             }
             Stage::Shadows => {
+                self.resample_lights();
                 if !self.shadows_drawn.replace(true) {
                     self.shadow_pass.record(encoder, &self.scene, &self.shadow_scene, &self.targets.shadow_maps)
                 }

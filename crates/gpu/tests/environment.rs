@@ -117,3 +117,73 @@ fn the_gpu_tracer_emits_from_a_sky_image() {
     assert!((count_ratio - 1.0).abs() < 1e-3, "{} against {}", gpu.global.len(), cpu.global.len());
     assert!(((g - c) / c).abs().max_element() < 1e-3, "flux {g} against {c}");
 }
+
+/// The mean of `passes` GPU frames of `scene` (the same photons; each pass
+/// its own light samples, `GpuLights::sampled`), and its mean absolute
+/// difference from `reference` over 8×8-pixel blocks of lit surface.
+fn mean_and_block_error(gpu: &mut GpuRenderer, scene: &Scene, passes: u32, reference: &[Vec3]) -> (Vec<Vec3>, f64) {
+    let size = scene.camera.width as usize;
+    let mut sum = vec![Vec3::ZERO; size * size];
+    for pass in 1..=passes {
+        gpu.settings.pass = pass;
+        gpu.render().unwrap();
+        for (s, v) in sum.iter_mut().zip(gpu.read(gpu.resolved()).unwrap()) {
+            *s += v.truncate();
+        }
+    }
+    let mean: Vec<Vec3> = sum.iter().map(|s| *s / passes as f32).collect();
+    let (mut error, mut blocks) = (0.0, 0);
+    for by in (0..size).step_by(8) {
+        for bx in (0..size).step_by(8) {
+            let block = |image: &[Vec3]| {
+                let pixels = (by..by + 8).flat_map(|y| (bx..bx + 8).map(move |x| y * size + x));
+                pixels.map(|i| image[i].element_sum() as f64).sum::<f64>()
+            };
+            let (g, c) = (block(&mean), block(reference));
+            // Blocks that see the sky are the sky's texels on both sides.
+            if c > 0.0 {
+                error += ((g - c) / c).abs();
+                blocks += 1;
+            }
+        }
+    }
+    (mean, error / blocks as f64)
+}
+
+/// Item 4 of #44: the sky's shadows on the GPU were 16 fixed hard shadows
+/// that no number of passes changed (a 12% block error against Cycles on
+/// a hall). Each pass now draws its own directions (the stratified set
+/// rotated), so the mean of passes converges to photon-cpu's image, whose
+/// every pixel samples the sky afresh: under a uniform sky and a sky image
+/// with a sun, a box's soft shadow on the floor.
+#[test]
+fn sky_shadows_converge_over_passes() {
+    let size = 48;
+    let box_on_floor =
+        "[[object]]\nshape = \"box\"\ncenter = [0.0, 0.3, 0.0]\nsize = [0.6, 0.6, 0.6]\nmaterial = \"grey\"\n";
+    let uniform = open_floor(size, box_on_floor, "[environment]\nradiance = [1.0, 1.0, 1.0]\n");
+    let mut image = uniform.clone();
+    image.set_environment_map(std::sync::Arc::new(sky()), "sky");
+    let ctx = test_context("sky_shadows_converge_over_passes");
+    for (name, scene) in [("uniform sky", uniform), ("sky image", image)] {
+        let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, ..Default::default() }, &Silent);
+        let cpu_settings = PhotonCpuSettings { spp: 4, area_light_samples: 1024, ..Default::default() };
+        let (global, caustic) = cpu_settings.estimate_params(&scene);
+        let cpu = PhotonCpuRenderer::new(&scene, &traced, &cpu_settings).render(&Silent).0;
+        // The default sample count: 16 directions a pass.
+        let settings = GpuSettings { shadow_map_size: 512, ..GpuSettings::new(global, caustic) };
+        let mut gpu = GpuRenderer::new(ctx.clone(), &scene, &traced, settings).unwrap();
+        let (_, one) = mean_and_block_error(&mut gpu, &scene, 1, &cpu.pixels);
+        let (_, many) = mean_and_block_error(&mut gpu, &scene, 32, &cpu.pixels);
+        eprintln!(
+            "{name}: 8×8 block error against photon-cpu: 1 pass {:.2}%, 32 passes {:.2}%",
+            100.0 * one,
+            100.0 * many
+        );
+        // Measured on lavapipe: uniform 3.1% → 0.6%; image 8.7% → 4.0%,
+        // where 128 passes stay at 4.0% (and 2048² maps reach 3.4%): the
+        // sun's shadow edges in the maps' texels, a bias passes leave.
+        let (ratio, floor) = if name == "uniform sky" { (0.3, 0.015) } else { (0.6, 0.05) };
+        assert!(many < ratio * one && many < floor, "{name}: {many} after 32 passes against {one} after 1");
+    }
+}

@@ -167,11 +167,12 @@ impl DirectPass {
             contents: bytemuck::bytes_of(&params),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         });
+        // Rewritten when a progressive pass draws new light samples.
         let storage = |label, bytes: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: bytes,
-                usage: wgpu::BufferUsages::STORAGE,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             })
         };
         // A scene always has a light, so neither array is empty.
@@ -202,7 +203,14 @@ impl DirectPass {
                 wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&emission) },
             ],
         });
-        DirectBinding { bind_group, uniforms, params }
+        DirectBinding { bind_group, uniforms, params, samples: samples_buffer }
+    }
+
+    /// Shades with `lights`' samples from the next frame on: another
+    /// pass's samples of the lights the binding was made with (the same
+    /// count, `GpuLights::sampled`).
+    pub fn set_samples(&self, queue: &wgpu::Queue, binding: &DirectBinding, lights: &GpuLights) {
+        queue.write_buffer(&binding.samples, 0, bytemuck::cast_slice(&lights.samples));
     }
 
     /// Shades every pixel of `target` for progressive pass `pass`.
@@ -228,6 +236,7 @@ pub struct DirectBinding {
     bind_group: wgpu::BindGroup,
     uniforms: wgpu::Buffer,
     params: DirectParams,
+    samples: wgpu::Buffer,
 }
 
 #[cfg(test)]

@@ -119,9 +119,58 @@ const CUBE_FACES: [(Vec3, Vec3); 6] = [
     (Vec3::NEG_Z, Vec3::NEG_Y),
 ];
 
-/// Stratified points in [0,1)², fixed for a given count (golden-ratio lattice).
+/// Stratified points in [0,1)² for a given count (golden-ratio lattice).
 fn lattice(i: u32, n: u32) -> Vec2 {
     Vec2::new((i as f32 + 0.5) / n as f32, (i as f32 * 0.618_034 + 0.5).fract())
+}
+
+/// The toroidal shift (Cranley–Patterson rotation) of the lattice in
+/// progressive pass `pass`: none in pass 1 (and 0), then the R2 sequence's
+/// points, which fill [0,1)² evenly pass after pass. A uniformly shifted
+/// lattice is still stratified, and each of its points is uniform over
+/// the square, so the mean over passes of the shadow-mapped samples
+/// converges to the light's integral instead of a fixed set of hard
+/// shadows.
+pub fn pass_shift(pass: u32) -> Vec2 {
+    // R2: the plastic number's powers (Roberts 2018).
+    const R2: Vec2 = Vec2::new(0.754_877_7, 0.569_840_3);
+    let k = pass.saturating_sub(1) as f64;
+    Vec2::new((k * R2.x as f64).fract() as f32, (k * R2.y as f64).fract() as f32)
+}
+
+/// Point `i` of `n` of the lattice shifted by `shift`.
+fn shifted(i: u32, n: u32, shift: Vec2) -> Vec2 {
+    let p = lattice(i, n) + shift;
+    // fract, kept below 1 in f32 (1 − ε + a shift can round up to 1).
+    Vec2::new(p.x.fract().min(0.999_999_94), p.y.fract().min(0.999_999_94))
+}
+
+/// What the lights' samples are drawn from: the scene's lights and the
+/// distances that size their views, kept by the renderer so that each
+/// progressive pass can draw its own samples (`GpuLights::sampled`).
+#[derive(Clone)]
+pub struct LightSource {
+    lights: Vec<Light>,
+    diagonal: f32,
+    far: f32,
+}
+
+impl LightSource {
+    pub fn of(scene: &Scene) -> Self {
+        let far = 4.0 * scene.diagonal() + (scene.camera.position - scene.accel.bounds().0).length();
+        LightSource { lights: scene.lights.clone(), diagonal: scene.diagonal(), far }
+    }
+
+    /// Do the samples change from pass to pass (a light of several shadow-
+    /// mapped samples: an area light with `area_samples` > 1, a sky, an
+    /// emissive mesh)? Points, spots and suns keep their one sample.
+    pub fn varies_per_pass(&self, area_samples: u32) -> bool {
+        self.lights.iter().any(|l| match l {
+            Light::Sphere { .. } | Light::Quad { .. } => area_samples > 1,
+            Light::Environment { .. } | Light::Mesh(_) => true,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => false,
+        })
+    }
 }
 
 /// The emissive meshes' triangles as shadow-map occluders (positions only),
@@ -158,8 +207,15 @@ pub struct GpuLights {
 }
 
 impl GpuLights {
+    /// The samples of the first progressive pass.
     pub fn new(scene: &Scene, area_samples: u32) -> Self {
-        let far = 4.0 * scene.diagonal() + (scene.camera.position - scene.accel.bounds().0).length();
+        Self::sampled(&LightSource::of(scene), area_samples, 1)
+    }
+
+    /// The samples of progressive pass `pass`: the same count and views
+    /// as every other pass's, at points shifted by `pass_shift(pass)`.
+    pub fn sampled(source: &LightSource, area_samples: u32, pass: u32) -> Self {
+        let (far, diagonal, shift) = (source.far, source.diagonal, pass_shift(pass));
         let mut out = GpuLights {
             lights: Vec::new(),
             samples: Vec::new(),
@@ -168,7 +224,7 @@ impl GpuLights {
             sky_radiance: Vec3::ZERO,
         };
         let n = area_samples.max(1);
-        for (index, light) in scene.lights.iter().enumerate() {
+        for (index, light) in source.lights.iter().enumerate() {
             let index = index as u32;
             let first_sample = out.samples.len() as u32;
             let mut record = GpuLight { first_sample, ..GpuLight::zeroed() };
@@ -204,7 +260,7 @@ impl GpuLights {
                     };
                     for i in 0..n {
                         // Spread over the ball (area-light bodies cast no shadow maps).
-                        let p = center + uniform_sphere(lattice(i, n)) * radius * if n == 1 { 0.0 } else { 0.9 };
+                        let p = center + uniform_sphere(shifted(i, n, shift)) * radius * if n == 1 { 0.0 } else { 0.9 };
                         out.add_sample(index, p, None, far);
                     }
                 }
@@ -217,9 +273,9 @@ impl GpuLights {
                         edge_v: edge_v.to_array(),
                         ..record
                     };
-                    let offset = edge_u.cross(edge_v).normalize() * scene.diagonal() * 1e-4;
+                    let offset = edge_u.cross(edge_v).normalize() * diagonal * 1e-4;
                     for i in 0..n {
-                        let u = lattice(i, n);
+                        let u = shifted(i, n, shift);
                         out.add_sample(index, corner + edge_u * u.x + edge_v * u.y + offset, None, far);
                     }
                 }
@@ -249,13 +305,13 @@ impl GpuLights {
                         // Light arriving from ω travels along −ω. An image's
                         // directions are drawn from it (a sun in the map
                         // gets its share of them), each weighted L/(K·p).
-                        match map.as_ref().and_then(|m| m.sample(lattice(i, k))) {
+                        match map.as_ref().and_then(|m| m.sample(shifted(i, k, shift))) {
                             Some(s) => {
                                 out.add_distant_sample(index, -s.dir, disc);
                                 let weight = s.radiance / (k as f32 * s.pdf);
                                 out.samples.last_mut().expect("just added").weight = weight.to_array();
                             }
-                            None => out.add_distant_sample(index, -uniform_sphere(lattice(i, k)), disc),
+                            None => out.add_distant_sample(index, -uniform_sphere(shifted(i, k, shift)), disc),
                         }
                     }
                 }
@@ -267,9 +323,9 @@ impl GpuLights {
                         two_sided: mesh.two_sided as u32,
                         ..record
                     };
-                    let offset = scene.diagonal() * 1e-4;
+                    let offset = diagonal * 1e-4;
                     for i in 0..n {
-                        let (p, normal) = mesh_point(mesh, lattice(i, n));
+                        let (p, normal) = mesh_point(mesh, shifted(i, n, shift));
                         out.add_sample(index, p + normal * offset, None, far);
                         out.samples.last_mut().expect("just added").direction = normal.to_array();
                     }
@@ -476,6 +532,51 @@ mod tests {
         assert_eq!(mesh.occluders.vertices.len(), 6);
         assert_eq!(mesh.occluders.drawn_by(0).count(), 0);
         assert_eq!(mesh.occluders.drawn_by(1).collect::<Vec<_>>(), [0..6]);
+    }
+
+    /// Each progressive pass draws the sky's and an area light's samples
+    /// anew: as many as pass 1's (the same views, rewritten in place), pass
+    /// 1 the unshifted lattice, and over many passes the directions cover
+    /// the sphere evenly (a fixed set would not move at all).
+    #[test]
+    fn each_pass_draws_its_own_samples() {
+        let sky = sky_floor(1.0, "name = \"floor\"\ntype = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]");
+        let source = LightSource::of(&sky);
+        assert!(source.varies_per_pass(4));
+        let first = GpuLights::sampled(&source, 4, 1);
+        assert_eq!(first.samples.len(), GpuLights::new(&sky, 4).samples.len());
+        assert!(first.samples.iter().zip(&GpuLights::new(&sky, 4).samples).all(|(a, b)| a.direction == b.direction));
+        let passes = 256;
+        let mut directions = Vec::new();
+        for pass in 1..=passes {
+            let lights = GpuLights::sampled(&source, 4, pass);
+            assert_eq!((lights.samples.len(), lights.views.len()), (first.samples.len(), first.views.len()));
+            if pass > 1 {
+                assert!(lights.samples[0].direction != first.samples[0].direction, "pass {pass}");
+            }
+            directions.extend(lights.samples.iter().map(|s| Vec3::from(s.direction)));
+        }
+        let mean = directions.iter().sum::<Vec3>() / directions.len() as f32;
+        assert!(mean.length() < 0.01, "mean direction {mean}");
+        // Every octant of the sphere gets its eighth of the directions.
+        for octant in 0..8 {
+            let sign = |bit: u32| if octant & bit == 0 { 1.0 } else { -1.0 };
+            let inside =
+                directions.iter().filter(|d| d.x * sign(1) > 0.0 && d.y * sign(2) > 0.0 && d.z * sign(4) > 0.0).count();
+            let share = inside as f32 / directions.len() as f32;
+            assert!((share - 0.125).abs() < 0.01, "octant {octant}: {share}");
+        }
+        // Point, spot and sun lights keep their one sample.
+        assert!(!LightSource::of(&sunlit_floor(30.0, 1.0, 0.5, false)).varies_per_pass(4));
+        // An area light's points move over the light, staying on it.
+        let quad = cornell_quad_light(8);
+        let source = LightSource::of(&quad);
+        assert!(source.varies_per_pass(4) && !source.varies_per_pass(1));
+        let (a, b) = (GpuLights::sampled(&source, 4, 1), GpuLights::sampled(&source, 4, 7));
+        for (a, b) in a.samples.iter().zip(&b.samples) {
+            assert!(a.position != b.position);
+            assert!((b.position[1] - a.position[1]).abs() < 1e-6 && b.position[0].abs() <= 0.25, "{:?}", b.position);
+        }
     }
 
     #[test]

@@ -248,6 +248,12 @@ impl SpecularTables {
         SpecularParams { light_table, sample_table, view_table, region_table, environment_table, ..params }
     }
 
+    /// `lights`' samples in place of the ones it was made with (the same
+    /// count: another pass's samples).
+    fn write_samples(&self, queue: &wgpu::Queue, lights: &GpuLights) {
+        queue.write_buffer(&self.buffer, self.offsets[1] as u64 * 4, bytemuck::cast_slice(&lights.samples));
+    }
+
     /// Records the copies of what the renderer may have rewritten.
     fn copy_in(&self, encoder: &mut wgpu::CommandEncoder) {
         let [_, _, views, regions, environment] = self.offsets.map(|words| words as u64 * 4);
@@ -581,6 +587,12 @@ impl SpecularPass {
         queue.write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&self.params));
         self.enabled = has_specular_surfaces(scene);
         self.bind_group = self.bindings.bind_group(device, &self.grid);
+    }
+
+    /// Shades with another pass's samples of the same lights from the next
+    /// frame on (`GpuLights::sampled`).
+    pub fn set_light_samples(&self, queue: &wgpu::Queue, lights: &GpuLights) {
+        self.bindings.tables.write_samples(queue, lights);
     }
 
     /// Casts its primary rays from `camera` (same resolution) from the next frame on.
