@@ -146,5 +146,64 @@ fn photon_cpu_frame(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, ray_casting, photon_tracing, estimates, volume_estimate, photon_cpu_frame);
+/// A 100,352-triangle sheet (225 × 225 vertices, normals) bent by two
+/// joints, the second turning through a keyframed quarter turn, every
+/// vertex weighted on both: what `Scene::posed` redoes per frame for an
+/// animated skinned character before it rebuilds the BVH.
+fn skinning(c: &mut Criterion) {
+    use glam::{Affine3A, Mat4, Quat, Vec3};
+    use hikari_core::scene::keyframes::{Keyframes, NodeTrack, Track};
+    use hikari_core::scene::skinning::{Influences, Joint, SkinnedMesh};
+    let n = 225u32;
+    let positions: Vec<Vec3> =
+        (0..n * n).map(|i| Vec3::new((i % n) as f32 / n as f32, (i / n) as f32 / n as f32, 0.0)).collect();
+    let mut triangles = Vec::new();
+    for y in 0..n - 1 {
+        for x in 0..n - 1 {
+            let i = y * n + x;
+            triangles.push([i, i + 1, i + n + 1]);
+            triangles.push([i, i + n + 1, i + n]);
+        }
+    }
+    let mut influences = Influences { starts: vec![0], entries: Vec::new() };
+    for p in &positions {
+        influences.entries.extend([(0, 1.0 - p.y), (1, p.y)]);
+        influences.starts.push(influences.entries.len() as u32);
+    }
+    let turn = NodeTrack {
+        translation: Vec3::Y * 0.5,
+        rotation: Quat::IDENTITY,
+        scale: Vec3::ONE,
+        translation_track: None,
+        rotation_track: Some(Track {
+            times: vec![0.0, 1.0],
+            values: vec![Quat::IDENTITY, Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)],
+            step: false,
+        }),
+        scale_track: None,
+    };
+    let rest = Affine3A::from_translation(Vec3::Y * 0.5);
+    let keys = Keyframes::new(Affine3A::IDENTITY, vec![turn], rest);
+    let joint = |motion, at: Vec3| Joint {
+        inverse_bind: Mat4::from_translation(-at),
+        rest_world: Mat4::from_translation(at),
+        motion,
+    };
+    let mesh = SkinnedMesh {
+        normals: Some(vec![Vec3::Z; positions.len()]),
+        positions,
+        triangles,
+        influences,
+        joints: vec![joint(None, Vec3::ZERO), joint(keys, Vec3::Y * 0.5)],
+        fallback: Mat4::IDENTITY,
+    };
+    let mut group = c.benchmark_group("skinning");
+    group.throughput(Throughput::Elements(mesh.triangles.len() as u64));
+    group.bench_function("sheet_100k_triangles_2_joints", |b| {
+        b.iter(|| black_box(mesh.triangles_at(black_box(0.5), &Affine3A::IDENTITY)).len())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, ray_casting, photon_tracing, estimates, volume_estimate, photon_cpu_frame, skinning);
 criterion_main!(benches);

@@ -36,6 +36,10 @@ pub enum Motion {
     Move { offset: Vec3, period: f32 },
     /// A glTF file's node animation, looping.
     Keyframed(std::sync::Arc<super::keyframes::Keyframes>),
+    /// A skinned mesh whose joints the file's animations move: its
+    /// triangles are bent anew at each time (`SkinnedMesh::triangles_at`),
+    /// not moved rigidly (its transform here is the identity).
+    Skinned(std::sync::Arc<super::skinning::SkinnedMesh>),
 }
 
 impl Motion {
@@ -54,6 +58,7 @@ impl Motion {
                 Affine3A::from_translation(offset * (0.5 - 0.5 * phase.cos()))
             }
             Motion::Keyframed(ref keys) => keys.at(time),
+            Motion::Skinned(_) => Affine3A::IDENTITY,
         }
     }
 }
@@ -133,7 +138,7 @@ impl Scene {
             })
             .collect();
         let moved = |s: u32| &surface_motion[s as usize];
-        let (triangles, triangle_surfaces): (Vec<Triangle>, Vec<u32>) = self
+        let (mut triangles, triangle_surfaces): (Vec<Triangle>, Vec<u32>) = self
             .accel
             .triangles()
             .map(|(t, s)| {
@@ -144,6 +149,16 @@ impl Scene {
                 (Triangle { v, normals }, s)
             })
             .unzip();
+        // Skinned surfaces are bent at this time, then moved by their edits
+        // (their triangles are one run, in the order the mesh keeps).
+        for animation in &self.animations {
+            let (Target::Object(s), Motion::Skinned(mesh)) = (animation.target, &animation.motion) else { continue };
+            let first = triangle_surfaces.iter().position(|&t| t == s).unwrap_or(triangle_surfaces.len());
+            let bent = mesh.triangles_at(pose.time, moved(s));
+            if first + bent.len() <= triangles.len() {
+                triangles[first..first + bent.len()].copy_from_slice(&bent);
+            }
+        }
         let (spheres, sphere_surfaces): (Vec<Sphere>, Vec<u32>) = self
             .accel
             .spheres()

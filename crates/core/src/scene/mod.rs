@@ -12,6 +12,7 @@ pub mod gltf;
 pub mod keyframes;
 pub mod limits;
 mod load;
+pub mod skinning;
 
 pub use animation::{Animation, Motion, Names, Pose, Target};
 pub use error::SceneError;

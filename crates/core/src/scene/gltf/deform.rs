@@ -8,7 +8,8 @@
 //! transform does not apply, as the specification says.
 
 use super::{LocalPrimitive, accessors};
-use glam::{Mat3, Mat4, Vec3};
+use crate::scene::skinning::{Influences, skin_vertices};
+use glam::{Mat4, Vec3};
 use gltf::accessor::DataType;
 
 /// Each node's world transform in `scene` under `root` (None for nodes
@@ -25,6 +26,22 @@ pub fn node_worlds(doc: &gltf::Document, scene: &gltf::Scene, root: Mat4) -> Vec
         stack.extend(node.children().map(|c| (c, world)));
     }
     worlds
+}
+
+/// Each node's path from the scene's root (node indices, root first;
+/// None for nodes outside it): what animates a joint.
+pub fn node_paths(doc: &gltf::Document, scene: &gltf::Scene) -> Vec<Option<Vec<usize>>> {
+    let mut paths = vec![None; doc.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Vec<usize>)> = scene.nodes().map(|n| (n, Vec::new())).collect();
+    while let Some((node, mut path)) = stack.pop() {
+        if paths[node.index()].is_some() {
+            continue;
+        }
+        path.push(node.index());
+        stack.extend(node.children().map(|c| (c, path.clone())));
+        paths[node.index()] = Some(path);
+    }
+    paths
 }
 
 /// `local` with the morph targets of `primitive` added by `weights`.
@@ -67,8 +84,11 @@ pub fn morph(
     Ok(LocalPrimitive { positions, normals, ..local.clone() })
 }
 
-/// `local` bent by `skin`, in world space; also how many of its vertices
-/// have no joint weight (placed by `node_world`, the mesh's node, instead).
+/// `local` bent by `skin`, in world space, and what it takes to bend it
+/// again at another time: its influences, inverse bind matrices and joint
+/// nodes (the caller adds the joints' motions); also how many of its
+/// vertices have no joint weight (placed by `node_world`, the mesh's node,
+/// instead).
 pub fn skin(
     local: &LocalPrimitive,
     primitive: &gltf::Primitive,
@@ -76,7 +96,7 @@ pub fn skin(
     worlds: &[Option<Mat4>],
     node_world: Mat4,
     buffers: &[gltf::buffer::Data],
-) -> Result<(LocalPrimitive, usize), String> {
+) -> Result<Skinned, String> {
     let at = format!("skins[{}]", skin.index());
     let joints: Vec<usize> = skin.joints().map(|j| j.index()).collect();
     let inverse_binds: Vec<Mat4> = match skin.inverse_bind_matrices() {
@@ -90,18 +110,13 @@ pub fn skin(
     if inverse_binds.len() < joints.len() {
         return Err(format!("{at}: {} inverse bind matrices for {} joints", inverse_binds.len(), joints.len()));
     }
-    let matrices: Vec<Mat4> = joints
+    let rest_worlds: Vec<Mat4> = joints
         .iter()
-        .zip(&inverse_binds)
-        .map(|(&j, ibm)| {
-            let world = worlds[j].ok_or_else(|| format!("{at}: joint nodes[{j}] is not in the scene"))?;
-            Ok(world * *ibm)
-        })
+        .map(|&j| worlds[j].ok_or_else(|| format!("{at}: joint nodes[{j}] is not in the scene")))
         .collect::<Result<_, String>>()?;
+    let matrices: Vec<Mat4> = rest_worlds.iter().zip(&inverse_binds).map(|(w, ibm)| *w * *ibm).collect();
     let count = local.positions.len();
-    // Each vertex's summed joint matrix.
-    let mut sums = vec![Mat4::ZERO; count];
-    let mut weight_sums = vec![0.0f32; count];
+    let mut per_vertex: Vec<Vec<(u32, f32)>> = vec![Vec::new(); count];
     for set in 0..2 {
         let (Some(j), Some(w)) =
             (primitive.get(&gltf::Semantic::Joints(set)), primitive.get(&gltf::Semantic::Weights(set)))
@@ -123,35 +138,48 @@ pub fn skin(
                 if !(weight.is_finite() && weight >= 0.0) {
                     return Err(format!("attributes.WEIGHTS_{set}: vertex {v} has weight {weight}"));
                 }
-                let m = matrices.get(joint as usize).ok_or_else(|| {
-                    format!(
+                if joint as usize >= joints.len() {
+                    return Err(format!(
                         "attributes.JOINTS_{set}: vertex {v} names joint {joint}, beyond the skin's {}",
                         joints.len()
-                    )
-                })?;
-                sums[v] += *m * weight;
-                weight_sums[v] += weight;
+                    ));
+                }
+                per_vertex[v].push((joint as u32, weight));
             }
         }
     }
+    // Weights are meant to sum to 1; exporters round them.
+    let mut influences = Influences { starts: vec![0], entries: Vec::new() };
     let mut unweighted = 0;
-    let mut positions = Vec::with_capacity(count);
-    let mut normals = local.normals.as_ref().map(|_| Vec::with_capacity(count));
-    for v in 0..count {
-        // Weights are meant to sum to 1; exporters round them.
-        let m = if weight_sums[v] > 0.0 {
-            sums[v] * (1.0 / weight_sums[v])
-        } else {
-            unweighted += 1;
-            node_world
-        };
-        positions.push(m.transform_point3(local.positions[v]));
-        if let (Some(out), Some(n)) = (normals.as_mut(), local.normals.as_ref()) {
-            out.push((Mat3::from_mat4(m).inverse().transpose() * n[v]).normalize_or_zero());
-        }
+    for entries in per_vertex {
+        let total: f32 = entries.iter().map(|e| e.1).sum();
+        unweighted += entries.is_empty() as usize;
+        influences.entries.extend(entries.iter().map(|&(j, w)| (j, w / total)));
+        influences.starts.push(influences.entries.len() as u32);
     }
+    let (positions, normals) =
+        skin_vertices(&local.positions, local.normals.as_deref(), &influences, &matrices, node_world);
     if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
         return Err(format!("skinned vertex {i} is not finite: {p}"));
     }
-    Ok((LocalPrimitive { positions, normals, ..local.clone() }, unweighted))
+    Ok(Skinned {
+        placed: LocalPrimitive { positions, normals, ..local.clone() },
+        unweighted,
+        influences,
+        inverse_binds,
+        joints,
+        rest_worlds,
+    })
+}
+
+/// A primitive bent by its skin in the file's node transforms, and what
+/// bending it at other times takes.
+pub struct Skinned {
+    pub placed: LocalPrimitive,
+    pub unweighted: usize,
+    pub influences: Influences,
+    pub inverse_binds: Vec<Mat4>,
+    /// Joint node indices, and their world transforms as loaded.
+    pub joints: Vec<usize>,
+    pub rest_worlds: Vec<Mat4>,
 }

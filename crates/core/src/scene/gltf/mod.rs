@@ -99,6 +99,9 @@ pub struct Primitive {
     pub emission: Option<Emission>,
     /// The node indices from the scene's root down to the primitive's node.
     pub node_path: Vec<usize>,
+    /// A skinned mesh whose joints the file's animations move: how to bend
+    /// it at any time (its triangles are `triangles`, in this order).
+    pub skinned: Option<std::sync::Arc<crate::scene::skinning::SkinnedMesh>>,
 }
 
 impl Primitive {
@@ -204,7 +207,8 @@ pub fn asset_from_bytes(
         quantized: gltf.document.extensions_used().any(|e| e == "KHR_mesh_quantization"),
         without_uvs: 0,
         node_worlds: Vec::new(),
-        skinned: 0,
+        node_paths: Vec::new(),
+        skinned_lights: 0,
         unweighted: 0,
         progress,
     };
@@ -215,6 +219,9 @@ pub fn asset_from_bytes(
         .ok_or_else(|| error(&file, "scenes", "the file has no scene to render"))?;
     let world = Mat4::from(world_from_file);
     walk.node_worlds = deform::node_worlds(&gltf.document, &scene, world);
+    walk.node_paths = deform::node_paths(&gltf.document, &scene);
+    // Read before the meshes: a skin's joints may move with them.
+    walk.asset.channels = animations::read(&gltf.document, &buffers, &file, &mut walk.asset.notes)?;
     progress.begin("reading meshes", placed_primitives(&scene));
     let walked = scene.nodes().try_for_each(|node| walk.node(&node, world, &mut Vec::new()));
     progress.end();
@@ -235,7 +242,6 @@ pub fn asset_from_bytes(
             format!("no perspective camera named \"{name}\" is placed in the scene (cameras: {})", names.join(", ")),
         ));
     }
-    walk.asset.channels = animations::read(&gltf.document, &buffers, &file, &mut walk.asset.notes)?;
     if walk.ignored_range {
         walk.asset.notes.push("light `range` is ignored: lights fall off physically, as 1/d²".into());
     }
@@ -245,10 +251,10 @@ pub fn asset_from_bytes(
             walk.without_uvs
         ));
     }
-    if walk.skinned > 0 && gltf.document.animations().next().is_some() {
+    if walk.skinned_lights > 0 {
         walk.asset.notes.push(format!(
-            "{} skinned mesh(es) are posed as the file's node transforms stand: animations do not bend them yet",
-            walk.skinned
+            "{} emissive skinned mesh(es) keep the pose of the file's node transforms: animations do not bend them",
+            walk.skinned_lights
         ));
     }
     if walk.unweighted > 0 {
@@ -471,6 +477,13 @@ fn check_extensions(doc: &gltf::Document, file: &str, notes: &mut Vec<String>) -
     Ok(())
 }
 
+/// A primitive as `Walk::deformed` leaves it: its (morphed, skinned)
+/// vertices, the transform that places them, the node path that moves it,
+/// and, for a skin whose joints move, the mesh to bend again with the
+/// vertices before skinning.
+type Deformed =
+    (std::rc::Rc<LocalPrimitive>, Mat4, Vec<usize>, Option<(crate::scene::skinning::SkinnedMesh, LocalPrimitive)>);
+
 /// A primitive's triangles in the file's own space, shared by every node
 /// that instances its mesh.
 #[derive(Clone)]
@@ -504,7 +517,10 @@ struct Walk<'a> {
     /// Every node's world transform (what skins read).
     node_worlds: Vec<Option<Mat4>>,
     /// Nodes whose mesh a skin bends.
-    skinned: usize,
+    /// Every node's path from the root (what animates a joint).
+    node_paths: Vec<Option<Vec<usize>>>,
+    /// Emissive skinned meshes whose joints move (they do not bend).
+    skinned_lights: usize,
     /// Skinned vertices without joint weights (placed by their node).
     unweighted: usize,
     progress: &'a dyn Progress,
@@ -544,11 +560,11 @@ impl Walk<'_> {
         let name = node.name().map(str::to_string);
         path.push(node.index());
         if let Some(mesh) = node.mesh() {
-            self.skinned += node.skin().is_some() as usize;
             for primitive in mesh.primitives() {
                 let local = self.local_primitive(&mesh, &primitive)?;
-                let (local, placement, node_path) = self.deformed(node, &mesh, &primitive, local, world, path)?;
-                let (triangles, uvs) = place_triangles(&local, &placement);
+                let (local, placement, node_path, joints) =
+                    self.deformed(node, &mesh, &primitive, local, world, path)?;
+                let (triangles, uvs, kept) = place_triangles(&local, &placement);
                 if let Some(v) = triangles.iter().flat_map(|t| t.v).find(|v| v.abs().max_element() > MAX_COORD) {
                     return Err(error(
                         self.file,
@@ -558,6 +574,15 @@ impl Walk<'_> {
                 }
                 let material = local.material;
                 let emission = self.emissions[material as usize];
+                let skinned = joints.filter(|_| {
+                    self.skinned_lights += emission.is_some() as usize;
+                    emission.is_none()
+                });
+                let skinned = skinned.map(|(mut mesh, unskinned)| {
+                    mesh.triangles = kept;
+                    (mesh.positions, mesh.normals) = (unskinned.positions, unskinned.normals);
+                    std::sync::Arc::new(mesh)
+                });
                 self.asset.primitives.push(Primitive {
                     name: name.clone(),
                     triangles,
@@ -565,6 +590,7 @@ impl Walk<'_> {
                     material,
                     emission,
                     node_path,
+                    skinned,
                 });
                 self.progress.advance(1);
             }
@@ -596,7 +622,7 @@ impl Walk<'_> {
         local: std::rc::Rc<LocalPrimitive>,
         world: Mat4,
         path: &[usize],
-    ) -> Result<(std::rc::Rc<LocalPrimitive>, Mat4, Vec<usize>), SceneError> {
+    ) -> Result<Deformed, SceneError> {
         let at = format!("nodes[{}] (meshes[{}].primitives[{}])", node.index(), mesh.index(), primitive.index());
         let weights = node.weights().or(mesh.weights()).unwrap_or(&[]);
         let mut local = local;
@@ -605,11 +631,34 @@ impl Walk<'_> {
                 deform::morph(&local, primitive, weights, self.buffers).map_err(|m| error(self.file, &at, m))?,
             );
         }
-        let Some(skin) = node.skin() else { return Ok((local, world, path.to_vec())) };
-        let (skinned, unweighted) = deform::skin(&local, primitive, &skin, &self.node_worlds, world, self.buffers)
+        let Some(skin) = node.skin() else { return Ok((local, world, path.to_vec(), None)) };
+        let skinned = deform::skin(&local, primitive, &skin, &self.node_worlds, world, self.buffers)
             .map_err(|m| error(self.file, &at, m))?;
-        self.unweighted += unweighted;
-        Ok((std::rc::Rc::new(skinned), Mat4::IDENTITY, Vec::new()))
+        self.unweighted += skinned.unweighted;
+        // The joints' motions: a skin whose joints the animations move is
+        // bent again at each time (`Motion::Skinned`).
+        let above = self.asset.world_from_file;
+        let joints: Vec<crate::scene::skinning::Joint> = skinned
+            .joints
+            .iter()
+            .zip(&skinned.inverse_binds)
+            .zip(&skinned.rest_worlds)
+            .map(|((&j, &inverse_bind), &rest_world)| crate::scene::skinning::Joint {
+                inverse_bind,
+                rest_world,
+                motion: self.node_paths[j].as_ref().and_then(|p| self.asset.channels.keyframes(above, p)),
+            })
+            .collect();
+        let bendable = crate::scene::skinning::SkinnedMesh {
+            positions: Vec::new(),
+            normals: None,
+            triangles: Vec::new(),
+            influences: skinned.influences,
+            joints,
+            fallback: world,
+        };
+        let again = bendable.moves().then(|| (bendable, (*local).clone()));
+        Ok((std::rc::Rc::new(skinned.placed), Mat4::IDENTITY, Vec::new(), again))
     }
 
     /// Keeps the camera if it is the one asked for by its own or its
@@ -794,7 +843,7 @@ impl Walk<'_> {
 /// determinant), so the front face stays the front face, with their
 /// texture coordinates in the same vertex order. Triangles with no area in
 /// 32-bit floats are dropped.
-fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Option<Vec<[Vec2; 3]>>) {
+fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Option<Vec<[Vec2; 3]>>, Vec<[u32; 3]>) {
     let linear = Mat3::from_mat4(*world);
     let normal_matrix = linear.inverse().transpose();
     let mirrored = linear.determinant() < 0.0;
@@ -802,6 +851,7 @@ fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Opti
     let normals: Option<Vec<Vec3>> =
         local.normals.as_ref().map(|n| n.iter().map(|&n| (normal_matrix * n).normalize_or_zero()).collect());
     let mut uvs = local.uvs.as_ref().map(|_| Vec::with_capacity(local.triangles.len()));
+    let mut kept = Vec::with_capacity(local.triangles.len());
     let triangles = local
         .triangles
         .iter()
@@ -814,10 +864,11 @@ fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Opti
             if let (Some(out), Some(uv)) = (uvs.as_mut(), local.uvs.as_ref()) {
                 out.push(order.map(|i| uv[i as usize]));
             }
+            kept.push(order);
             Some(tri)
         })
         .collect();
-    (triangles, uvs)
+    (triangles, uvs, kept)
 }
 
 #[cfg(test)]
@@ -891,6 +942,9 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
             lights.len() as u32 - 1
         });
         surfaces.push(Surface { material: primitive.material, emitter });
+        if let Some(mesh) = primitive.skinned {
+            animations.push(Animation { target: Target::Object(surface), motion: super::Motion::Skinned(mesh) });
+        }
         if let Some(motion) = motion {
             // An emissive surface moves with its light (`Scene::posed`).
             let target = emitter.map_or(Target::Object(surface), Target::Light);

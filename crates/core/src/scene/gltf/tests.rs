@@ -545,8 +545,11 @@ fn bad_sparse_indices_are_located_errors() {
 /// node (moved by 10 in x) does not place it. The morphed triangle's
 /// vertex 1 rises by its target's delta (0, 0, 1) × the node's weight ½
 /// (which replaces the mesh's 1), and its node moves it by 5 in y.
-#[test]
-fn skins_and_morph_targets_deform_meshes() {
+/// A skinned triangle (joints A at the origin and B at z = 2 turned a
+/// quarter about z, bound with B's inverse bind shifted by −2 in z; one
+/// vertex on each, one half on each) and a morphed one; with `animated`,
+/// an animation moves B from z = 2 to z = 3 over a second.
+fn deformation_file(animated: bool) -> (String, Vec<u8>) {
     let floats = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
     let mut bin = floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]); // 0: positions
     bin.extend([0u8, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0]); // 36: joints
@@ -556,25 +559,36 @@ fn skins_and_morph_targets_deform_meshes() {
     bin.extend(floats(&Mat4::IDENTITY.to_cols_array())); // 96: inverse bind matrices
     bin.extend(floats(&shifted));
     bin.extend(floats(&[0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])); // 224: morph deltas
+    bin.extend(floats(&[0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0, 3.0])); // 260: key times, B's translations
     let s = std::f32::consts::FRAC_1_SQRT_2;
+    let animation = if animated {
+        r#"
+      "animations": [{"samplers": [{"input": 5, "output": 6}], "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]}],"#
+    } else {
+        ""
+    };
     let json = format!(
         r#"{{
       "asset": {{"version": "2.0"}},
-      "buffers": [{{"uri": "d.bin", "byteLength": 260}}],
+      "buffers": [{{"uri": "d.bin", "byteLength": 292}}],
       "bufferViews": [
         {{"buffer": 0, "byteOffset": 0, "byteLength": 36}},
         {{"buffer": 0, "byteOffset": 36, "byteLength": 12}},
         {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
         {{"buffer": 0, "byteOffset": 96, "byteLength": 128}},
-        {{"buffer": 0, "byteOffset": 224, "byteLength": 36}}
+        {{"buffer": 0, "byteOffset": 224, "byteLength": 36}},
+        {{"buffer": 0, "byteOffset": 260, "byteLength": 8}},
+        {{"buffer": 0, "byteOffset": 268, "byteLength": 24}}
       ],
       "accessors": [
         {{"bufferView": 0, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0]}},
         {{"bufferView": 1, "count": 3, "type": "VEC4", "componentType": 5121}},
         {{"bufferView": 2, "count": 3, "type": "VEC4", "componentType": 5126}},
         {{"bufferView": 3, "count": 2, "type": "MAT4", "componentType": 5126}},
-        {{"bufferView": 4, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [0, 0, 1]}}
-      ],
+        {{"bufferView": 4, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [0, 0, 1]}},
+        {{"bufferView": 5, "count": 2, "type": "SCALAR", "componentType": 5126, "min": [0], "max": [1]}},
+        {{"bufferView": 6, "count": 2, "type": "VEC3", "componentType": 5126}}
+      ],{animation}
       "meshes": [
         {{"primitives": [{{"attributes": {{"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}}}]}},
         {{"primitives": [{{"attributes": {{"POSITION": 0}}, "targets": [{{"POSITION": 4}}]}}], "weights": [1.0]}}
@@ -589,6 +603,12 @@ fn skins_and_morph_targets_deform_meshes() {
       "scenes": [{{"nodes": [0, 1, 2, 3]}}]
     }}"#
     );
+    (json, bin)
+}
+
+#[test]
+fn skins_and_morph_targets_deform_meshes() {
+    let (json, bin) = deformation_file(false);
     let dir = folder("deformations");
     write(&dir, "d.bin", &bin);
     let path = write(&dir, "d.gltf", json.as_bytes());
@@ -602,4 +622,33 @@ fn skins_and_morph_targets_deform_meshes() {
     let want = [Vec3::new(0.0, 5.0, 0.0), Vec3::new(1.0, 5.0, 0.5), Vec3::new(0.0, 6.0, 0.0)];
     assert!(close(morphed, want), "morphed {morphed:?}, by hand {want:?}");
     assert!(scene.notes.iter().all(|n| !n.contains("skinned") && !n.contains("morph")), "{:?}", scene.notes);
+}
+
+/// The same skin with an animation moving joint B up by 1 over a second:
+/// loaded, the triangle is as the node transforms place it; at t the vertex
+/// on B has risen by t, the one half on B by t/2, the one on A not at all
+/// (by hand, as above: B's world is then a translation by t in z after its
+/// rest one).
+#[test]
+fn an_animated_skin_bends_over_time() {
+    let (json, bin) = deformation_file(true);
+    let dir = folder("animated-skin");
+    write(&dir, "d.bin", &bin);
+    let path = write(&dir, "d.gltf", json.as_bytes());
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(scene.is_animated());
+    assert!(scene.notes.iter().all(|n| !n.contains("bend")), "{:?}", scene.notes);
+    let triangle = |scene: &crate::scene::Scene| scene.accel.triangles().find(|(_, id)| *id == 0).unwrap().0.v;
+    let close = |got: [Vec3; 3], want: [Vec3; 3]| got.iter().zip(want).all(|(g, w)| (*g - w).length() < 1e-5);
+    let rest = [Vec3::ZERO, Vec3::Y, Vec3::new(-0.5, 0.5, 0.0)];
+    assert!(close(triangle(&scene), rest));
+    // (The animation loops over its one second: t = 1 is t = 0 again.)
+    for (time, rise) in [(0.0, 0.0), (0.5, 0.5), (0.75, 0.75), (1.0, 0.0)] {
+        let want = [rest[0], rest[1] + Vec3::Z * rise, rest[2] + Vec3::Z * rise / 2.0];
+        let got = triangle(&scene.at_time(time));
+        assert!(close(got, want), "t = {time}: {got:?}, by hand {want:?}");
+    }
+    // The morphed mesh, not skinned, does not move.
+    let morphed = |scene: &crate::scene::Scene| scene.accel.triangles().find(|(_, id)| *id == 1).unwrap().0.v;
+    assert_eq!(morphed(&scene.at_time(0.5)), morphed(&scene));
 }
