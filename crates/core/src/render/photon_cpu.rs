@@ -234,7 +234,7 @@ impl<'a> PhotonCpuRenderer<'a> {
         depth: u32,
         rng: &mut Rng,
     ) -> Rgb {
-        let hit = *hit;
+        let hit = self.scene.bent(*hit);
         let can_recurse = depth < self.settings.max_specular_depth;
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let ns = hit.shading_normal * facing;

@@ -162,14 +162,20 @@ impl Scene {
     }
 
     /// The shading normal at `hit`, bent by its material's normal texture
-    /// (`Texturing::shading_normal`); the path tracer shades with it, the
-    /// photon mappers with `hit.shading_normal`.
+    /// (`Texturing::shading_normal`).
     pub fn shading_normal_at(&self, hit: &Hit) -> glam::Vec3 {
         let (Some(t), Some(triangle)) = (&self.texturing, self.accel.triangle(hit.prim)) else {
             return hit.shading_normal;
         };
         let material = self.surfaces[hit.surface as usize].material;
         t.shading_normal(material, hit.prim, hit.barycentrics, triangle.v, hit.shading_normal)
+    }
+
+    /// `hit` with its shading normal bent by its material's normal texture
+    /// (`shading_normal_at`): what every renderer and the photon tracer
+    /// shade with, so a normal-mapped surface looks the same in each.
+    pub fn bent(&self, hit: Hit) -> Hit {
+        Hit { shading_normal: self.shading_normal_at(&hit), ..hit }
     }
 
     pub fn emitter(&self, hit: &Hit) -> Option<&Light> {

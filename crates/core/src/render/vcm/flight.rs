@@ -34,7 +34,8 @@ pub struct Step {
 }
 
 pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
-    let hit = scene.accel.intersect(ray);
+    // Surfaces shade with their normal textures' normals.
+    let hit = scene.accel.intersect(ray).map(|hit| scene.bent(hit));
     let media = &scene.media;
     if media.is_empty() {
         return match hit {

@@ -113,8 +113,8 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     }
     if normal_mapped > 0 {
         notes.push(format!(
-            "{normal_mapped} material(s) have normal textures: the path tracer bends its shading normals by them, \
-             the photon mappers (CPU and GPU) do not"
+            "{normal_mapped} material(s) have normal textures: the CPU renderers (path, photon-cpu, vcm and the \
+             photon tracer) bend their shading normals by them, the GPU renderer does not yet"
         ));
     }
     if other_sets > 0 {

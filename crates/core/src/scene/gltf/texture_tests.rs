@@ -257,9 +257,10 @@ fn an_emissive_texture_varies_the_radiance_seen() {
 /// under a sun 45° from the zenith toward +X: the path tracer shades with
 /// the bent normal, which faces the sun (1/cos 45° more light than flat; a
 /// tangent of the wrong sign would turn it away, no light), `scale` 0
-/// flattens it back, and photon-cpu ignores it.
+/// flattens it back, and photon-cpu and vcm shade with the same bent
+/// normal (photon-cpu's direct light; vcm's mean over its estimates).
 #[test]
-fn a_normal_texture_bends_the_path_tracers_normals() {
+fn a_normal_texture_bends_every_cpu_renderers_normals() {
     use crate::render::path::radiance as path_radiance;
     // (sin 45°, 0, cos 45°) as 8-bit 2n − 1: 218, 128, 218.
     let texel = [218u8, 128, 218, 255];
@@ -301,7 +302,22 @@ fn a_normal_texture_bends_the_path_tracers_normals() {
     let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
     let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
     let photon = renderer.radiance(&look, 0, &mut rng).x;
-    assert!((photon - flat).abs() < 1e-4 * flat, "photon-cpu ignores the map: {photon} vs {flat}");
+    assert!((photon - want).abs() < 1e-4 * want, "photon-cpu: {photon} vs {want}");
+    // vcm, looking straight down at the middle of the floor (16×16 pixels,
+    // all floor): every pixel's value is `want`; its passes' mean is within
+    // noise of it, far from the flat floor's.
+    let mut scene = floor_with(1.0, "normal-vcm");
+    scene.camera = crate::camera::Camera::new(Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, -Vec3::Z, 60.0, 16, 16).unwrap();
+    let settings = crate::render::vcm::VcmSettings::default();
+    let passes = 8;
+    let mean = (1..=passes)
+        .map(|pass| {
+            let image = crate::render::vcm::render_pass(&scene, &settings, pass).unwrap().0;
+            image.pixels.iter().map(|p| p.x).sum::<f32>() / image.pixels.len() as f32
+        })
+        .sum::<f32>()
+        / passes as f32;
+    assert!((mean - want).abs() < 0.03 * want, "vcm: {mean} vs {want} (flat {flat})");
 }
 
 /// `EXT_texture_webp` as gltfpack `-tw` writes it: required, the texture's
