@@ -4,7 +4,7 @@
 //! glass with `KHR_materials_ior`; `KHR_materials_specular`'s factor scales
 //! the dielectric's Fresnel (its colour is ignored). Base-colour,
 //! metallic–roughness, emissive and normal textures are read
-//! (`crate::texture`; normal maps are used by the path tracer only);
+//! (`crate::texture`; normal maps bend the CPU renderers' shading normals);
 //! occlusion textures are not. `alphaMode` MASK makes cut-outs,
 //! BLEND is drawn opaque. Each approximation made is reported in one note.
 
