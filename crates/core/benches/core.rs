@@ -152,8 +152,8 @@ fn photon_cpu_frame(c: &mut Criterion) {
 /// animated skinned character before it rebuilds the BVH.
 fn skinning(c: &mut Criterion) {
     use glam::{Affine3A, Mat4, Quat, Vec3};
+    use hikari_core::scene::deformation::{DeformedMesh, Influences, Joint};
     use hikari_core::scene::keyframes::{Keyframes, NodeTrack, Track};
-    use hikari_core::scene::skinning::{Influences, Joint, SkinnedMesh};
     let n = 225u32;
     let positions: Vec<Vec3> =
         (0..n * n).map(|i| Vec3::new((i % n) as f32 / n as f32, (i / n) as f32 / n as f32, 0.0)).collect();
@@ -189,13 +189,14 @@ fn skinning(c: &mut Criterion) {
         rest_world: Mat4::from_translation(at),
         motion,
     };
-    let mesh = SkinnedMesh {
+    let mesh = DeformedMesh {
         normals: Some(vec![Vec3::Z; positions.len()]),
         positions,
         triangles,
         influences,
         joints: vec![joint(None, Vec3::ZERO), joint(keys, Vec3::Y * 0.5)],
         fallback: Mat4::IDENTITY,
+        morph: None,
     };
     let mut group = c.benchmark_group("skinning");
     group.throughput(Throughput::Elements(mesh.triangles.len() as u64));

@@ -37,9 +37,9 @@ pub enum Motion {
     /// A glTF file's node animation, looping.
     Keyframed(std::sync::Arc<super::keyframes::Keyframes>),
     /// A skinned mesh whose joints the file's animations move: its
-    /// triangles are bent anew at each time (`SkinnedMesh::triangles_at`),
+    /// triangles are bent anew at each time (`DeformedMesh::triangles_at`),
     /// not moved rigidly (its transform here is the identity).
-    Skinned(std::sync::Arc<super::skinning::SkinnedMesh>),
+    Deformed(std::sync::Arc<super::deformation::DeformedMesh>),
 }
 
 impl Motion {
@@ -58,7 +58,7 @@ impl Motion {
                 Affine3A::from_translation(offset * (0.5 - 0.5 * phase.cos()))
             }
             Motion::Keyframed(ref keys) => keys.at(time),
-            Motion::Skinned(_) => Affine3A::IDENTITY,
+            Motion::Deformed(_) => Affine3A::IDENTITY,
         }
     }
 }
@@ -152,7 +152,7 @@ impl Scene {
         // Skinned surfaces are bent at this time, then moved by their edits
         // (their triangles are one run, in the order the mesh keeps).
         for animation in &self.animations {
-            let (Target::Object(s), Motion::Skinned(mesh)) = (animation.target, &animation.motion) else { continue };
+            let (Target::Object(s), Motion::Deformed(mesh)) = (animation.target, &animation.motion) else { continue };
             let first = triangle_surfaces.iter().position(|&t| t == s).unwrap_or(triangle_surfaces.len());
             let bent = mesh.triangles_at(pose.time, moved(s));
             if first + bent.len() <= triangles.len() {

@@ -5,6 +5,7 @@
 
 mod animation;
 pub mod builtin;
+pub mod deformation;
 mod desc;
 mod error;
 pub mod files;
@@ -12,7 +13,6 @@ pub mod gltf;
 pub mod keyframes;
 pub mod limits;
 mod load;
-pub mod skinning;
 
 pub use animation::{Animation, Motion, Names, Pose, Target};
 pub use error::SceneError;

@@ -3,11 +3,12 @@
 //! played together (Blender writes one animation per object's action);
 //! where two animate the same property of a node (clips of one character),
 //! the first wins, with a note. STEP and LINEAR interpolation (CUBICSPLINE
-//! through its key values, linearly, with a note). Morph-target weights
-//! are ignored.
+//! through its key values, linearly, with a note), and morph-target
+//! weights (`scene::deformation::MorphWeights`).
 
 use super::{accessors, error};
 use crate::scene::SceneError;
+use crate::scene::deformation::MorphWeights;
 use crate::scene::keyframes::{Keyframes, NodeTrack, Track};
 use glam::{Affine3A, Quat, Vec3};
 use gltf::accessor::DataType;
@@ -27,6 +28,7 @@ struct Channels {
     translation: Option<Track<Vec3>>,
     rotation: Option<Track<Quat>>,
     scale: Option<Track<Vec3>>,
+    weights: Option<MorphWeights>,
 }
 
 /// Reads every animation; notes what is ignored or approximated.
@@ -44,7 +46,7 @@ pub fn read(
         })
         .collect();
     let mut out = NodeChannels { tracks: HashMap::new(), rest };
-    let (mut cubic, mut weights, mut conflicts) = (false, false, 0);
+    let (mut cubic, mut conflicts) = (false, 0);
     let channels = doc.animations().flat_map(|a| a.channels().enumerate().map(move |(c, ch)| (a.index(), c, ch)));
     for (animation, c, channel) in channels {
         let at = format!("animations[{animation}].channels[{c}]");
@@ -84,7 +86,7 @@ pub fn read(
             Property::Translation => entry.translation.is_some(),
             Property::Rotation => entry.rotation.is_some(),
             Property::Scale => entry.scale.is_some(),
-            Property::MorphTargetWeights => false,
+            Property::MorphTargetWeights => entry.weights.is_some(),
         };
         if taken {
             conflicts += 1;
@@ -110,7 +112,28 @@ pub fn read(
                 finite(values.iter().all(|q| q.is_finite()))?;
                 entry.rotation = Some(Track { times: times.clone(), values, step });
             }
-            Property::MorphTargetWeights => weights = true,
+            Property::MorphTargetWeights => {
+                let allowed = [DataType::F32, DataType::I8, DataType::U8, DataType::I16, DataType::U16];
+                let values = accessors::read::<1>(&output, buffers, &allowed).map_err(read_err)?;
+                // One weight per morph target at each key (three for a cubic spline).
+                let per_key = times.len() * stride;
+                if !values.len().is_multiple_of(per_key) {
+                    return Err(error(
+                        file,
+                        format!("{at}.sampler"),
+                        format!("{} weights are not a whole number per key time ({} keys)", values.len(), times.len()),
+                    ));
+                }
+                let targets = values.len() / per_key;
+                let keyed: Vec<Vec<f32>> = (0..times.len())
+                    .map(|k| {
+                        let first = (k * stride + stride / 2) * targets;
+                        values[first..first + targets].iter().map(|[w]| *w).collect()
+                    })
+                    .collect();
+                finite(keyed.iter().flatten().all(|w| w.is_finite()))?;
+                entry.weights = Some(MorphWeights { times: times.clone(), values: keyed, step });
+            }
         }
     }
     if conflicts > 0 {
@@ -121,13 +144,15 @@ pub fn read(
     if cubic {
         notes.push("cubic-spline animation keys are interpolated linearly".into());
     }
-    if weights {
-        notes.push("morph-target weight animations are ignored".into());
-    }
     Ok(out)
 }
 
 impl NodeChannels {
+    /// The keyed morph-target weights of `node`, if an animation keys them.
+    pub fn weights(&self, node: usize) -> Option<&MorphWeights> {
+        self.tracks.get(&node)?.weights.as_ref()
+    }
+
     /// The motion of whatever sits at the end of `path` (node indices, root
     /// first) placed by `above`: None if nothing on the path moves.
     pub fn keyframes(&self, above: Affine3A, path: &[usize]) -> Option<Keyframes> {

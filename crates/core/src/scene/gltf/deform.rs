@@ -8,7 +8,7 @@
 //! transform does not apply, as the specification says.
 
 use super::{LocalPrimitive, accessors};
-use crate::scene::skinning::{Influences, skin_vertices};
+use crate::scene::deformation::{Influences, MorphTarget, morph_vertices, skin_vertices};
 use glam::{Mat4, Vec3};
 use gltf::accessor::DataType;
 
@@ -44,24 +44,15 @@ pub fn node_paths(doc: &gltf::Document, scene: &gltf::Scene) -> Vec<Option<Vec<u
     paths
 }
 
-/// `local` with the morph targets of `primitive` added by `weights`.
-pub fn morph(
-    local: &LocalPrimitive,
+/// `primitive`'s morph targets: per target, its POSITION deltas (zeros
+/// where it has none) and its NORMAL deltas, checked.
+pub fn morph_targets(
     primitive: &gltf::Primitive,
-    weights: &[f32],
+    count: usize,
     buffers: &[gltf::buffer::Data],
-) -> Result<LocalPrimitive, String> {
-    let mut positions = local.positions.clone();
-    let mut normals = local.normals.clone();
-    let count = positions.len();
+) -> Result<Vec<MorphTarget>, String> {
+    let mut targets = Vec::new();
     for (k, target) in primitive.morph_targets().enumerate() {
-        let w = weights.get(k).copied().unwrap_or(0.0);
-        if !w.is_finite() {
-            return Err(format!("morph target {k}'s weight {w} is not finite"));
-        }
-        if w == 0.0 {
-            continue;
-        }
         let deltas = |a: Option<gltf::Accessor>, what: &str| -> Result<Option<Vec<Vec3>>, String> {
             let Some(a) = a else { return Ok(None) };
             let d = accessors::read::<3>(&a, buffers, &[DataType::F32, DataType::I8, DataType::I16])
@@ -69,15 +60,23 @@ pub fn morph(
             if d.len() != count {
                 return Err(format!("targets[{k}].{what} has {} deltas for {count} vertices", d.len()));
             }
+            if let Some((i, d)) = d.iter().enumerate().find(|(_, d)| !d.iter().all(|x| x.is_finite())) {
+                return Err(format!("targets[{k}].{what}: delta {i} is not finite: {d:?}"));
+            }
             Ok(Some(d.into_iter().map(Vec3::from).collect()))
         };
-        if let Some(d) = deltas(target.positions(), "POSITION")? {
-            positions.iter_mut().zip(d).for_each(|(p, d)| *p += w * d);
-        }
-        if let (Some(normals), Some(d)) = (normals.as_mut(), deltas(target.normals(), "NORMAL")?) {
-            normals.iter_mut().zip(d).for_each(|(n, d)| *n += w * d);
-        }
+        let positions = deltas(target.positions(), "POSITION")?.unwrap_or_else(|| vec![Vec3::ZERO; count]);
+        targets.push((positions, deltas(target.normals(), "NORMAL")?));
     }
+    Ok(targets)
+}
+
+/// `local` with `targets` added by `weights`.
+pub fn morph(local: &LocalPrimitive, targets: &[MorphTarget], weights: &[f32]) -> Result<LocalPrimitive, String> {
+    if let Some((k, w)) = weights.iter().enumerate().find(|(_, w)| !w.is_finite()) {
+        return Err(format!("morph target {k}'s weight {w} is not finite"));
+    }
+    let (positions, normals) = morph_vertices(&local.positions, local.normals.as_deref(), targets, weights);
     if let Some((i, p)) = positions.iter().enumerate().find(|(_, p)| !p.is_finite()) {
         return Err(format!("morphed vertex {i} is not finite: {p}"));
     }

@@ -101,7 +101,7 @@ pub struct Primitive {
     pub node_path: Vec<usize>,
     /// A skinned mesh whose joints the file's animations move: how to bend
     /// it at any time (its triangles are `triangles`, in this order).
-    pub skinned: Option<std::sync::Arc<crate::scene::skinning::SkinnedMesh>>,
+    pub skinned: Option<std::sync::Arc<crate::scene::deformation::DeformedMesh>>,
 }
 
 impl Primitive {
@@ -253,7 +253,7 @@ pub fn asset_from_bytes(
     }
     if walk.skinned_lights > 0 {
         walk.asset.notes.push(format!(
-            "{} emissive skinned mesh(es) keep the pose of the file's node transforms: animations do not bend them",
+            "{} emissive skinned or morphed mesh(es) keep their loaded pose: animations do not reshape them",
             walk.skinned_lights
         ));
     }
@@ -482,7 +482,7 @@ fn check_extensions(doc: &gltf::Document, file: &str, notes: &mut Vec<String>) -
 /// and, for a skin whose joints move, the mesh to bend again with the
 /// vertices before skinning.
 type Deformed =
-    (std::rc::Rc<LocalPrimitive>, Mat4, Vec<usize>, Option<(crate::scene::skinning::SkinnedMesh, LocalPrimitive)>);
+    (std::rc::Rc<LocalPrimitive>, Mat4, Vec<usize>, Option<(crate::scene::deformation::DeformedMesh, LocalPrimitive)>);
 
 /// A primitive's triangles in the file's own space, shared by every node
 /// that instances its mesh.
@@ -623,41 +623,68 @@ impl Walk<'_> {
         world: Mat4,
         path: &[usize],
     ) -> Result<Deformed, SceneError> {
+        use crate::scene::deformation::{DeformedMesh, Influences, Joint, Morph};
         let at = format!("nodes[{}] (meshes[{}].primitives[{}])", node.index(), mesh.index(), primitive.index());
+        let fail = |m: String| error(self.file, &at, m);
         let weights = node.weights().or(mesh.weights()).unwrap_or(&[]);
+        let has_targets = primitive.morph_targets().next().is_some();
+        // Weights an animation keys make the mesh change shape as it plays.
+        let keyed = self.asset.channels.weights(node.index()).filter(|_| has_targets).cloned();
+        let targets = if has_targets && (keyed.is_some() || weights.iter().any(|&w| w != 0.0)) {
+            deform::morph_targets(primitive, local.positions.len(), self.buffers).map_err(fail)?
+        } else {
+            Vec::new()
+        };
+        let unmorphed = local.clone();
         let mut local = local;
-        if primitive.morph_targets().next().is_some() && weights.iter().any(|&w| w != 0.0) {
-            local = std::rc::Rc::new(
-                deform::morph(&local, primitive, weights, self.buffers).map_err(|m| error(self.file, &at, m))?,
-            );
+        if !targets.is_empty() && weights.iter().any(|&w| w != 0.0) {
+            local = std::rc::Rc::new(deform::morph(&local, &targets, weights).map_err(fail)?);
         }
-        let Some(skin) = node.skin() else { return Ok((local, world, path.to_vec(), None)) };
-        let skinned = deform::skin(&local, primitive, &skin, &self.node_worlds, world, self.buffers)
-            .map_err(|m| error(self.file, &at, m))?;
+        let morph = keyed.map(|weights| Morph { targets, weights });
+        // What a posed mesh starts from: unmorphed where the weights are keyed.
+        let base = if morph.is_some() { unmorphed } else { local.clone() };
+        let Some(skin) = node.skin() else {
+            let count = local.positions.len();
+            let again = morph.map(|morph| {
+                let mesh = DeformedMesh {
+                    positions: Vec::new(),
+                    normals: None,
+                    triangles: Vec::new(),
+                    influences: Influences { starts: vec![0; count + 1], entries: Vec::new() },
+                    joints: Vec::new(),
+                    fallback: world,
+                    morph: Some(morph),
+                };
+                (mesh, (*base).clone())
+            });
+            return Ok((local, world, path.to_vec(), again));
+        };
+        let skinned = deform::skin(&local, primitive, &skin, &self.node_worlds, world, self.buffers).map_err(fail)?;
         self.unweighted += skinned.unweighted;
         // The joints' motions: a skin whose joints the animations move is
-        // bent again at each time (`Motion::Skinned`).
+        // bent again at each time (`Motion::Deformed`).
         let above = self.asset.world_from_file;
-        let joints: Vec<crate::scene::skinning::Joint> = skinned
+        let joints: Vec<Joint> = skinned
             .joints
             .iter()
             .zip(&skinned.inverse_binds)
             .zip(&skinned.rest_worlds)
-            .map(|((&j, &inverse_bind), &rest_world)| crate::scene::skinning::Joint {
+            .map(|((&j, &inverse_bind), &rest_world)| Joint {
                 inverse_bind,
                 rest_world,
                 motion: self.node_paths[j].as_ref().and_then(|p| self.asset.channels.keyframes(above, p)),
             })
             .collect();
-        let bendable = crate::scene::skinning::SkinnedMesh {
+        let bendable = DeformedMesh {
             positions: Vec::new(),
             normals: None,
             triangles: Vec::new(),
             influences: skinned.influences,
             joints,
             fallback: world,
+            morph,
         };
-        let again = bendable.moves().then(|| (bendable, (*local).clone()));
+        let again = bendable.moves().then(|| (bendable, (*base).clone()));
         Ok((std::rc::Rc::new(skinned.placed), Mat4::IDENTITY, Vec::new(), again))
     }
 
@@ -943,7 +970,7 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
         });
         surfaces.push(Surface { material: primitive.material, emitter });
         if let Some(mesh) = primitive.skinned {
-            animations.push(Animation { target: Target::Object(surface), motion: super::Motion::Skinned(mesh) });
+            animations.push(Animation { target: Target::Object(surface), motion: super::Motion::Deformed(mesh) });
         }
         if let Some(motion) = motion {
             // An emissive surface moves with its light (`Scene::posed`).

@@ -548,7 +548,8 @@ fn bad_sparse_indices_are_located_errors() {
 /// A skinned triangle (joints A at the origin and B at z = 2 turned a
 /// quarter about z, bound with B's inverse bind shifted by −2 in z; one
 /// vertex on each, one half on each) and a morphed one; with `animated`,
-/// an animation moves B from z = 2 to z = 3 over a second.
+/// an animation moves B from z = 2 to z = 3 over a second and keys the
+/// morph weight from 0 to 1.
 fn deformation_file(animated: bool) -> (String, Vec<u8>) {
     let floats = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
     let mut bin = floats(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]); // 0: positions
@@ -560,17 +561,20 @@ fn deformation_file(animated: bool) -> (String, Vec<u8>) {
     bin.extend(floats(&shifted));
     bin.extend(floats(&[0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])); // 224: morph deltas
     bin.extend(floats(&[0.0, 1.0, 0.0, 0.0, 2.0, 0.0, 0.0, 3.0])); // 260: key times, B's translations
+    bin.extend(floats(&[0.0, 1.0])); // 292: the morph weight at each key
     let s = std::f32::consts::FRAC_1_SQRT_2;
     let animation = if animated {
         r#"
-      "animations": [{"samplers": [{"input": 5, "output": 6}], "channels": [{"sampler": 0, "target": {"node": 2, "path": "translation"}}]}],"#
+      "animations": [{"samplers": [{"input": 5, "output": 6}, {"input": 5, "output": 7}], "channels": [
+        {"sampler": 0, "target": {"node": 2, "path": "translation"}},
+        {"sampler": 1, "target": {"node": 3, "path": "weights"}}]}],"#
     } else {
         ""
     };
     let json = format!(
         r#"{{
       "asset": {{"version": "2.0"}},
-      "buffers": [{{"uri": "d.bin", "byteLength": 292}}],
+      "buffers": [{{"uri": "d.bin", "byteLength": 300}}],
       "bufferViews": [
         {{"buffer": 0, "byteOffset": 0, "byteLength": 36}},
         {{"buffer": 0, "byteOffset": 36, "byteLength": 12}},
@@ -578,7 +582,8 @@ fn deformation_file(animated: bool) -> (String, Vec<u8>) {
         {{"buffer": 0, "byteOffset": 96, "byteLength": 128}},
         {{"buffer": 0, "byteOffset": 224, "byteLength": 36}},
         {{"buffer": 0, "byteOffset": 260, "byteLength": 8}},
-        {{"buffer": 0, "byteOffset": 268, "byteLength": 24}}
+        {{"buffer": 0, "byteOffset": 268, "byteLength": 24}},
+        {{"buffer": 0, "byteOffset": 292, "byteLength": 8}}
       ],
       "accessors": [
         {{"bufferView": 0, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [1, 1, 0]}},
@@ -587,7 +592,8 @@ fn deformation_file(animated: bool) -> (String, Vec<u8>) {
         {{"bufferView": 3, "count": 2, "type": "MAT4", "componentType": 5126}},
         {{"bufferView": 4, "count": 3, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [0, 0, 1]}},
         {{"bufferView": 5, "count": 2, "type": "SCALAR", "componentType": 5126, "min": [0], "max": [1]}},
-        {{"bufferView": 6, "count": 2, "type": "VEC3", "componentType": 5126}}
+        {{"bufferView": 6, "count": 2, "type": "VEC3", "componentType": 5126}},
+        {{"bufferView": 7, "count": 2, "type": "SCALAR", "componentType": 5126}}
       ],{animation}
       "meshes": [
         {{"primitives": [{{"attributes": {{"POSITION": 0, "JOINTS_0": 1, "WEIGHTS_0": 2}}}}]}},
@@ -624,7 +630,8 @@ fn skins_and_morph_targets_deform_meshes() {
     assert!(scene.notes.iter().all(|n| !n.contains("skinned") && !n.contains("morph")), "{:?}", scene.notes);
 }
 
-/// The same skin with an animation moving joint B up by 1 over a second:
+/// The same skin with an animation moving joint B up by 1 over a second
+/// (and keying the morphed mesh's weight from 0 to 1):
 /// loaded, the triangle is as the node transforms place it; at t the vertex
 /// on B has risen by t, the one half on B by t/2, the one on A not at all
 /// (by hand, as above: B's world is then a translation by t in z after its
@@ -648,7 +655,12 @@ fn an_animated_skin_bends_over_time() {
         let got = triangle(&scene.at_time(time));
         assert!(close(got, want), "t = {time}: {got:?}, by hand {want:?}");
     }
-    // The morphed mesh, not skinned, does not move.
+    // The morphed mesh's keyed weight w(t) = t lifts its second vertex
+    // (delta (0, 0, 1)) to z = t; loaded, the node's weight ½ holds.
     let morphed = |scene: &crate::scene::Scene| scene.accel.triangles().find(|(_, id)| *id == 1).unwrap().0.v;
-    assert_eq!(morphed(&scene.at_time(0.5)), morphed(&scene));
+    assert!((morphed(&scene)[1] - Vec3::new(1.0, 5.0, 0.5)).length() < 1e-5);
+    for time in [0.0, 0.25, 0.75] {
+        let got = morphed(&scene.at_time(time))[1];
+        assert!((got - Vec3::new(1.0, 5.0, time)).length() < 1e-5, "t = {time}: {got}");
+    }
 }
