@@ -71,6 +71,11 @@ pub struct GpuSurface {
     pub emissive_texture: u32,
     /// `baseColorFactor`'s alpha, against the cut-off.
     pub alpha_factor: f32,
+    /// The normal texture (`NO_TEXTURE` for none) and its `scale`: the
+    /// G-buffer's normal is bent by it (`bent_normal`).
+    pub normal_texture: u32,
+    pub normal_scale: f32,
+    pub _pad: [u32; 2],
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -240,6 +245,9 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 metallic_roughness_texture: views.reference(textures.metallic_roughness),
                 emissive_texture: views.reference(textures.emissive),
                 alpha_factor: if textures.alpha_cutoff.is_some() { textures.alpha_factor } else { 1.0 },
+                normal_texture: views.reference(textures.normal),
+                normal_scale: textures.normal_scale,
+                _pad: [0; 2],
             }
         })
         .collect()

@@ -100,7 +100,10 @@ fn shared_structs_match_wgsl_layouts() {
             base_color_texture,
             metallic_roughness_texture,
             emissive_texture,
-            alpha_factor
+            alpha_factor,
+            normal_texture,
+            normal_scale,
+            _pad
         ]
     );
     let splat = hikari_gpu::splat::shader_source();

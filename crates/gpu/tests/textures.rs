@@ -279,3 +279,74 @@ fn metallic_roughness_textures_reach_the_gbuffer() {
     }
     assert!(checked > 500, "{checked} pixels see the quad");
 }
+
+/// A normal texture on the GPU: the G-buffer's normal is the CPU's bent
+/// normal (`Scene::shading_normal_at`, turned toward the eye) at every
+/// pixel. The quad is a tilted parallelogram whose coordinates run askew,
+/// so the tangent frame (solved from the fragment's derivatives on the
+/// GPU, from the triangle on the CPU) is neither axis-aligned nor
+/// orthogonal; its one texel tilts the normal 45° (no filtering between
+/// texels to differ by); at scale 0 the normal is the flat one.
+#[test]
+fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
+    use glam::Vec3;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial, png};
+    use hikari_core::test_scenes::gltf_textures::{load, quad};
+    let ctx = test_context("a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu");
+    for scale in [1.0, 0.0] {
+        let mut b = GltfBuilder::new();
+        let image = b.image(&png(1, 1, &[218, 128, 218, 255]), "image/png");
+        let repeat = gltf::json::texture::WrappingMode::Repeat;
+        let t = b.texture(image, repeat, repeat);
+        let m = b.material(&PbrMaterial {
+            base_color: Vec3::splat(0.5),
+            specular: 0.0,
+            normal_texture: Some((t, scale)),
+            ..Default::default()
+        });
+        let (eu, ev) = (Vec3::new(1.0, 0.2, 0.3), Vec3::new(0.4, 1.0, -0.2));
+        let node = quad(&mut b, Vec3::new(-0.7, -0.6, 0.0), eu, ev, 1.0, m);
+        let mut scene = load(&format!("gpu-normal-map-{scale}"), &b.to_glb(vec![node]));
+        let (width, height) = (48, 48);
+        scene.camera = hikari_core::camera::Camera::new(
+            Vec3::new(0.2, 0.3, 3.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::Y,
+            40.0,
+            width,
+            height,
+        )
+        .unwrap();
+        let traced = trace_photons(&scene, &TraceSettings { photons: 2_000, ..Default::default() }, &Silent);
+        let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+        let gpu =
+            hikari_gpu::GpuRenderer::new(ctx.clone(), &scene, &traced, hikari_gpu::GpuSettings::new(global, caustic))
+                .expect("GPU renderer");
+        gpu.render().unwrap();
+        let normals = gpu.read(&gpu.targets.gbuffer.normal).unwrap();
+        let (mut seen, mut worst, mut tilt) = (0, 0.0f32, 0.0f32);
+        for y in 0..height {
+            for x in 0..width {
+                let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let Some(hit) = scene.accel.intersect(&ray) else { continue };
+                let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+                let want = scene.shading_normal_at(&hit) * facing;
+                let got = normals[(y * width + x) as usize].truncate();
+                worst = worst.max((got - want).length());
+                tilt = tilt.max(want.angle_between(hit.geometric_normal * facing));
+                seen += 1;
+            }
+        }
+        eprintln!("scale {scale}: {seen} pixels, worst normal difference {worst:e}, tilt {:.1}°", tilt.to_degrees());
+        assert!(seen > 300, "{seen} pixels see the quad");
+        assert!(worst < 2e-3, "scale {scale}: the G-buffer's normal differs from the CPU's by {worst}");
+        if scale == 1.0 {
+            assert!(tilt > 0.5, "the texture tilts the normal ({tilt} rad)");
+        } else {
+            assert!(tilt < 1e-3, "scale 0 leaves it flat ({tilt} rad)");
+        }
+    }
+}

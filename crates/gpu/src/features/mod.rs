@@ -49,7 +49,7 @@ impl SceneFeatures {
     pub fn of(surfaces: &[GpuSurface], lights: &[Light], media: bool) -> Self {
         SceneFeatures {
             textured: surfaces.iter().any(|s| {
-                [s.base_color_texture, s.metallic_roughness_texture, s.emissive_texture]
+                [s.base_color_texture, s.metallic_roughness_texture, s.emissive_texture, s.normal_texture]
                     .iter()
                     .any(|&t| t != NO_TEXTURE)
             }),

@@ -76,6 +76,18 @@ fn fragment_point(in: VertexOut) -> SurfacePoint {
 // What a pixel stores (fs_main's outputs; gbuffer_storage.wgsl stores the
 // same); a cut-out's fragment is discarded.
 fn shade(in: VertexOut) -> GBufferOut {
+    // Derivatives in uniform control flow (the normal texture's frame),
+    // taken only by pipelines of textured scenes.
+    var px = vec3<f32>(0.0);
+    var py = vec3<f32>(0.0);
+    var dx = vec2<f32>(0.0);
+    var dy = vec2<f32>(0.0);
+    if (TEXTURED) {
+        px = dpdx(in.world);
+        py = dpdy(in.world);
+        dx = dpdx(in.uv);
+        dy = dpdy(in.uv);
+    }
     let point = fragment_point(in);
     if (CUT_OUTS && !point.opaque) {
         discard;
@@ -87,7 +99,9 @@ fn shade(in: VertexOut) -> GBufferOut {
     let side = select(-1.0, 1.0, front);
     var out: GBufferOut;
     out.position = vec4<f32>(in.world, 1.0);
-    out.normal = vec4<f32>(normalize(in.normal) * side, f32(id));
+    let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
+    let n = bent_normal(surface, uv, dx, dy, px, py, normalize(in.normal));
+    out.normal = vec4<f32>(n * side, f32(id));
     out.albedo = vec4<f32>(point.base, f32(surface.kind));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);
     out.emission = vec4<f32>(emitted, pack_metal_rough(point.metallic, point.roughness));

@@ -52,6 +52,61 @@ fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Sur
     return p;
 }
 
+// The shading normal `n` bent by the surface's normal texture:
+// hikari_core::texture::Texturing::shading_normal, its tangent frame here
+// solved from the fragment's derivatives (`px`, `py` of the position, `dx`,
+// `dy` of the coordinates): both are affine over a triangle, so dp/du and
+// dp/dv come out as the triangle's own. The coordinates' change is taken
+// through the texture's transform, as the CPU's is.
+fn bent_normal(
+    s: Surface,
+    uv: vec3<f32>,
+    dx: vec2<f32>,
+    dy: vec2<f32>,
+    px: vec3<f32>,
+    py: vec3<f32>,
+    n: vec3<f32>,
+) -> vec3<f32> {
+    if (!TEXTURED || s.normal_texture == NO_TEXTURE || uv.z == 0.0) {
+        return n;
+    }
+    let texel = texture_lookup(s.normal_texture, uv, dx, dy).value;
+    let local = vec3<f32>(
+        (2.0 * texel.x - 1.0) * s.normal_scale,
+        (2.0 * texel.y - 1.0) * s.normal_scale,
+        2.0 * texel.z - 1.0,
+    );
+    let header = texture_header(s.normal_texture);
+    var linear = mat2x2<f32>(vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0));
+    if ((texture_data[header + 3u] & TEXTURE_TRANSFORMED) != 0u) {
+        linear = texture_linear(header);
+    }
+    let d1 = linear * dx;
+    let d2 = linear * dy;
+    let det = d1.x * d2.y - d2.x * d1.y;
+    if (abs(det) < 1e-30) {
+        return n;
+    }
+    let tangent = (px * d2.y - py * d1.y) / det;
+    let bitangent = (py * d1.x - px * d2.x) / det;
+    // Gram–Schmidt against the shading normal; the bitangent keeps the side
+    // the coordinates give it (mirrored textures).
+    let t_raw = tangent - n * dot(n, tangent);
+    let t_length = length(t_raw);
+    if (!(t_length > 0.0) || t_length > 1e30) {
+        return n;
+    }
+    let t_axis = t_raw / t_length;
+    let handed = select(1.0, -1.0, dot(cross(n, t_axis), bitangent) < 0.0);
+    let b_axis = cross(n, t_axis) * handed;
+    let bent = t_axis * local.x + b_axis * local.y + n * local.z;
+    let b_length = length(bent);
+    if (!(b_length > 0.0) || b_length > 1e30) {
+        return n;
+    }
+    return bent / b_length;
+}
+
 // Metallic and roughness in one f32 of the G-buffer (emission.w), 12 bits
 // each, exact as an integer-valued float. Read back (bsdf.wgsl's
 // `pixel_bsdf`) only for surfaces with a metallic–roughness texture: the

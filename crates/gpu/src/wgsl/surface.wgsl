@@ -27,4 +27,8 @@ struct Surface {
     metallic_roughness_texture: u32,
     emissive_texture: u32,
     alpha_factor: f32,
+    // The normal texture and its scale (surface_point.wgsl's `bent_normal`).
+    normal_texture: u32,
+    normal_scale: f32,
+    _pad: vec2<u32>,
 }

@@ -113,8 +113,9 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     }
     if normal_mapped > 0 {
         notes.push(format!(
-            "{normal_mapped} material(s) have normal textures: the CPU renderers (path, photon-cpu, vcm and the \
-             photon tracer) bend their shading normals by them, the GPU renderer does not yet"
+            "{normal_mapped} material(s) have normal textures: they bend the shading normals of the CPU renderers, \
+             the CPU photon tracer and the GPU's G-buffer; not yet the GPU's specular pass (what mirrors, glass and \
+             glossy reflections show of them) or the GPU photon tracer"
         ));
     }
     if other_sets > 0 {
