@@ -130,6 +130,8 @@ pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneEr
     };
     let mut lights = Vec::new();
     let mut texturing = crate::texture::Texturing::default();
+    // What glTF objects bring besides geometry: their animations and notes.
+    let (mut gltf_animations, mut notes) = (Vec::new(), Vec::new());
     for (i, o) in desc.object.iter().enumerate() {
         let p = place(o.span(), format!("[[object]] #{}", i + 1));
         let obj = o.get_ref();
@@ -139,6 +141,8 @@ pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneEr
                 lights: &mut lights,
                 names: &mut names,
                 texturing: &mut texturing,
+                animations: &mut gltf_animations,
+                notes: &mut notes,
             };
             load_gltf_object(obj, file, &p, files, &mut geometry, &mut parts)?;
             continue;
@@ -219,7 +223,7 @@ pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneEr
         message: e,
     })?;
 
-    let mut animations = Vec::new();
+    let mut animations = gltf_animations;
     for (i, a) in desc.animation.iter().enumerate() {
         let p = place(a.span(), format!("[[animation]] #{}", i + 1));
         let target = a.get_ref().target.get_ref();
@@ -260,7 +264,7 @@ pub fn parse(text: &str, file: &str, files: SceneFiles) -> Result<Scene, SceneEr
         media,
         names,
         animations,
-        notes: Vec::new(),
+        notes,
         texturing,
     })
 }
@@ -273,6 +277,10 @@ struct SceneParts<'a> {
     /// (by triangle) of the glTF objects so far.
     texturing: &'a mut crate::texture::Texturing,
     names: &'a mut Names,
+    /// The files' own animations (node motions, deformed meshes).
+    animations: &'a mut Vec<Animation>,
+    /// The files' notes, each naming its file.
+    notes: &'a mut Vec<String>,
 }
 
 /// Places a glTF file's meshes, materials, lights and emissive surfaces by
@@ -317,6 +325,10 @@ fn load_gltf_object(
     let asset =
         super::gltf::asset_from_bytes(&bytes, &name, own_files, world_from_file, None, &crate::progress::Silent)
             .map_err(|e| p.error(e.to_string()))?;
+    parts.notes.extend(asset.notes.iter().map(|n| format!("{file}: {n}")));
+    // The file's animations play in the scene, as when it is loaded alone.
+    let light_motions: Vec<_> = asset.light_paths.iter().map(|path| asset.motion(path)).collect();
+    let primitive_motions: Vec<_> = asset.primitives.iter().map(|p| asset.motion(&p.node_path)).collect();
     let first_material = parts.materials.len() as u32;
     parts.materials.extend(asset.materials);
     parts.names.materials.resize(first_material as usize, None);
@@ -334,18 +346,32 @@ fn load_gltf_object(
             m
         })
     }));
-    for (_, light) in asset.lights {
+    for ((_, light), motion) in asset.lights.into_iter().zip(light_motions) {
+        if let Some(motion) = motion {
+            parts.animations.push(Animation { target: Target::Light(parts.lights.len() as u32), motion });
+        }
         parts.lights.push(light);
         parts.names.lights.push(None);
     }
     let start = geo.counts();
-    for primitive in asset.primitives {
+    for (primitive, motion) in asset.primitives.into_iter().zip(primitive_motions) {
+        if primitive.triangles.is_empty() {
+            continue;
+        }
         let emitter = primitive.emitted_light().map(|light| {
             parts.lights.push(light);
             parts.names.lights.push(None);
             parts.lights.len() as u32 - 1
         });
         let surface = geo.add_surface(Surface { material: first_material + primitive.material, emitter });
+        if let Some(mesh) = primitive.deformed {
+            parts.animations.push(Animation { target: Target::Object(surface), motion: Motion::Deformed(mesh) });
+        }
+        if let Some(motion) = motion {
+            // An emissive surface moves with its light (`Scene::posed`).
+            let target = emitter.map_or(Target::Object(surface), Target::Light);
+            parts.animations.push(Animation { target, motion });
+        }
         if let Some(uvs) = &primitive.uvs {
             parts.texturing.uvs.push_run(geo.triangles.len() as u32, uvs);
         }

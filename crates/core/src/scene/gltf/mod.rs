@@ -99,9 +99,10 @@ pub struct Primitive {
     pub emission: Option<Emission>,
     /// The node indices from the scene's root down to the primitive's node.
     pub node_path: Vec<usize>,
-    /// A skinned mesh whose joints the file's animations move: how to bend
-    /// it at any time (its triangles are `triangles`, in this order).
-    pub skinned: Option<std::sync::Arc<crate::scene::deformation::DeformedMesh>>,
+    /// A mesh whose skin's joints or morph weights the file's animations
+    /// move: how to reshape it at any time (its triangles are `triangles`,
+    /// in this order).
+    pub deformed: Option<std::sync::Arc<crate::scene::deformation::DeformedMesh>>,
 }
 
 impl Primitive {
@@ -574,13 +575,13 @@ impl Walk<'_> {
                 }
                 let material = local.material;
                 let emission = self.emissions[material as usize];
-                let skinned = joints.filter(|_| {
+                let deformed = joints.filter(|_| {
                     self.skinned_lights += emission.is_some() as usize;
                     emission.is_none()
                 });
-                let skinned = skinned.map(|(mut mesh, unskinned)| {
+                let deformed = deformed.map(|(mut mesh, base)| {
                     mesh.triangles = kept;
-                    (mesh.positions, mesh.normals) = (unskinned.positions, unskinned.normals);
+                    (mesh.positions, mesh.normals) = (base.positions, base.normals);
                     std::sync::Arc::new(mesh)
                 });
                 self.asset.primitives.push(Primitive {
@@ -590,7 +591,7 @@ impl Walk<'_> {
                     material,
                     emission,
                     node_path,
-                    skinned,
+                    deformed,
                 });
                 self.progress.advance(1);
             }
@@ -969,7 +970,7 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
             lights.len() as u32 - 1
         });
         surfaces.push(Surface { material: primitive.material, emitter });
-        if let Some(mesh) = primitive.skinned {
+        if let Some(mesh) = primitive.deformed {
             animations.push(Animation { target: Target::Object(surface), motion: super::Motion::Deformed(mesh) });
         }
         if let Some(motion) = motion {

@@ -664,3 +664,47 @@ fn an_animated_skin_bends_over_time() {
         assert!((got - Vec3::new(1.0, 5.0, time)).length() < 1e-5, "t = {time}: {got}");
     }
 }
+
+/// A glTF file placed by a TOML `[[object]]` plays its animations as when
+/// loaded alone (here its skin's joint rising, moved 10 along x with the
+/// object), and its notes reach the scene, each naming the file.
+#[test]
+fn a_placed_gltf_object_plays_its_animations_and_keeps_its_notes() {
+    let (json, bin) = deformation_file(true);
+    let dir = folder("placed-animated");
+    write(&dir, "d.bin", &bin);
+    write(&dir, "d.gltf", json.as_bytes());
+    let toml = r#"
+[camera]
+position = [0.0, 0.0, 5.0]
+look_at = [0.0, 0.0, 0.0]
+
+[[object]]
+gltf = "d.gltf"
+translate = [10.0, 0.0, 0.0]
+
+[[light]]
+type = "point"
+position = [0.0, 2.0, 0.0]
+intensity = [1.0, 1.0, 1.0]
+"#;
+    let scene = crate::scene::Scene::from_toml(toml, "t.toml", Some(&dir)).unwrap();
+    assert!(scene.is_animated());
+    let triangle = |scene: &crate::scene::Scene| scene.accel.triangles().find(|(_, id)| *id == 0).unwrap().0.v;
+    let shift = Vec3::new(10.0, 0.0, 0.0);
+    let rest = [Vec3::ZERO, Vec3::Y, Vec3::new(-0.5, 0.5, 0.0)].map(|v| v + shift);
+    let close = |got: [Vec3; 3], want: [Vec3; 3]| got.iter().zip(want).all(|(g, w)| (*g - w).length() < 1e-5);
+    assert!(close(triangle(&scene), rest), "{:?}", triangle(&scene));
+    let want = [rest[0], rest[1] + Vec3::Z * 0.5, rest[2] + Vec3::Z * 0.25];
+    assert!(close(triangle(&scene.at_time(0.5)), want), "{:?}", triangle(&scene.at_time(0.5)));
+
+    // A note of the file (an extension it uses and hikari ignores) names it.
+    let json = json.replacen("\"asset\"", "\"extensionsUsed\": [\"KHR_materials_sheen\"],\n      \"asset\"", 1);
+    write(&dir, "d.gltf", json.as_bytes());
+    let scene = crate::scene::Scene::from_toml(toml, "t.toml", Some(&dir)).unwrap();
+    assert!(
+        scene.notes.iter().any(|n| n.starts_with("d.gltf: ") && n.contains("KHR_materials_sheen")),
+        "{:?}",
+        scene.notes
+    );
+}
