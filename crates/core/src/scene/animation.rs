@@ -2,9 +2,11 @@
 //! the viewer's edits, applied to a scene as loaded to give the scene at one
 //! moment (`Scene::posed`).
 //!
-//! Every motion is rigid (a rotation and a translation), so a posed scene is
-//! as valid as the scene it came from: no triangle degenerates, no radius
-//! changes. Posing is a pure function of the loaded scene and the `Pose`, so
+//! Every motion but a glTF file's deformed meshes is rigid (a rotation and
+//! a translation; keyframes may also scale), so a posed scene is as valid
+//! as the scene it came from: no radius changes, and only a skin or morph
+//! target can squeeze a triangle flat (it then has no area and is missed).
+//! Posing is a pure function of the loaded scene and the `Pose`, so
 //! the same time (and edits) gives the same scene, bit for bit, and with the
 //! same seed the same photon maps.
 
@@ -36,9 +38,10 @@ pub enum Motion {
     Move { offset: Vec3, period: f32 },
     /// A glTF file's node animation, looping.
     Keyframed(std::sync::Arc<super::keyframes::Keyframes>),
-    /// A skinned mesh whose joints the file's animations move: its
-    /// triangles are bent anew at each time (`DeformedMesh::triangles_at`),
-    /// not moved rigidly (its transform here is the identity).
+    /// A glTF mesh whose skin's joints or morph weights the file's
+    /// animations move: its triangles are reshaped at each time
+    /// (`DeformedMesh::triangles_at`), not moved rigidly (its transform here
+    /// is the identity).
     Deformed(std::sync::Arc<super::deformation::DeformedMesh>),
 }
 
@@ -149,8 +152,9 @@ impl Scene {
                 (Triangle { v, normals }, s)
             })
             .unzip();
-        // Skinned surfaces are bent at this time, then moved by their edits
-        // (their triangles are one run, in the order the mesh keeps).
+        // Deformed surfaces are reshaped at this time, then moved by their
+        // edits and rigid motions (their triangles are one run, in the order
+        // the mesh keeps).
         for animation in &self.animations {
             let (Target::Object(s), Motion::Deformed(mesh)) = (animation.target, &animation.motion) else { continue };
             let first = triangle_surfaces.iter().position(|&t| t == s).unwrap_or(triangle_surfaces.len());
