@@ -37,6 +37,10 @@ fn dimension_count(d: Dimensions) -> usize {
     }
 }
 
+/// The most elements an accessor without a buffer view may have (its
+/// zeros are allocated; a fuzzed count asked for 64 GiB).
+const MAX_ZERO_ELEMENTS: usize = 1 << 24;
+
 /// An accessor's elements, checked to lie inside their buffer.
 struct Layout<'a> {
     bytes: &'a [u8],
@@ -71,6 +75,12 @@ fn layout<'a>(
     let count = accessor.count();
     let element = data_type.size() * components;
     let Some(view) = accessor.view() else {
+        // Zeros cost memory the file does not: a count no buffer backs is bounded.
+        if count > MAX_ZERO_ELEMENTS {
+            return Err(format!(
+                "has no buffer view and {count} elements, more than the {MAX_ZERO_ELEMENTS} hikari reads as zeros"
+            ));
+        }
         return Ok(Layout { bytes: &[], offset: 0, stride: 0, count, data_type, present: false });
     };
     let stride = view.stride().unwrap_or(element);
