@@ -5,10 +5,12 @@
 //! with an optional perfect-mirror part (ρ_d + ρ_s ≤ 1 per channel),
 //! `Mirror` a perfect mirror (both the `Bsdf` settings `diffuse` and
 //! `mirror` up to the mirror's Fresnel; they stay separate variants until the
-//! GPU renderer evaluates `Bsdf`), `Glass` a smooth dielectric with Fresnel
-//! reflection/refraction.
+//! GPU renderer evaluates `Bsdf`), `Glass` a dielectric boundary
+//! ([`Dielectric`]: Fresnel reflection and tinted refraction, smooth or
+//! GGX-rough).
 
 use crate::bsdf::Bsdf;
+use crate::bsdf::dielectric::Dielectric;
 use glam::Vec3;
 
 pub type Rgb = Vec3;
@@ -22,9 +24,8 @@ pub enum Material {
     Mirror {
         reflectance: Rgb,
     },
-    Glass {
-        ior: f32,
-    },
+    /// Glass: reflects and refracts (`KHR_materials_transmission`).
+    Glass(Dielectric),
     /// The glTF metallic–roughness BRDF.
     Pbr(Bsdf),
     /// Black, non-reflecting surface: the body of an area light.
@@ -40,6 +41,11 @@ pub enum Event {
 }
 
 impl Material {
+    /// Clear smooth glass of index `ior`.
+    pub fn glass(ior: f32) -> Material {
+        Material::Glass(Dielectric::clear(ior))
+    }
+
     /// The glTF BRDF `bsdf` as a material: `Pbr`, or `Diffuse` when it is
     /// exactly Lambertian (a dielectric without specular lobe: f = base/π
     /// whatever the roughness), which every renderer, the GPU's included,

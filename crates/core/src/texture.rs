@@ -347,6 +347,14 @@ impl Texturing {
             // lobe: `Material::from_bsdf`); a metallic texture cannot change
             // a zero metallic factor.
             Material::Diffuse { albedo, specular } => Material::Diffuse { albedo: albedo * base, specular },
+            // Glass: the base colour tints its transmission, G its roughness.
+            Material::Glass(mut glass) => {
+                glass.tint *= base;
+                if let Some(mr) = mr {
+                    glass.roughness = (glass.roughness * mr.y).clamp(0.0, 1.0);
+                }
+                Material::Glass(glass)
+            }
             other => other,
         }
     }

@@ -200,7 +200,8 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
             let (kind, albedo, ior) = match material {
                 Material::Diffuse { albedo, .. } => (kind::DIFFUSE, *albedo, 1.0),
                 Material::Mirror { reflectance } => (kind::MIRROR, *reflectance, 1.0),
-                Material::Glass { ior } => (kind::GLASS, Vec3::ONE, *ior),
+                // Glass's albedo is the tint of what crosses it.
+                Material::Glass(glass) => (kind::GLASS, glass.tint, glass.ior),
                 Material::Emitter => (kind::EMITTER, Vec3::ZERO, 1.0),
                 Material::Pbr(bsdf) => (kind::DIFFUSE, bsdf.base_color, 1.0),
             };

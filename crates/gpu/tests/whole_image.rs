@@ -252,6 +252,29 @@ fn progressive_gpu_image_matches_photon_cpu_on_cornell_caustic() {
     assert!(specular_mean < 0.05, "glass pixels: mean relative difference {specular_mean}");
 }
 
+/// Tinted glass around a white ball: the specular pass tints what crosses
+/// the glass and carries radiance out of it scaled by 1/η² per crossing in
+/// (photons carry power, unscaled), as photon-cpu does. Carried as power,
+/// the white ball seen through the glass is about 2.2× too bright.
+#[test]
+fn gpu_image_matches_photon_cpu_through_tinted_glass_around_a_ball() {
+    let text = hikari_core::scene::builtin::source("cornell-caustic").unwrap().replacen(
+        "type = \"glass\"\nior = 1.5",
+        "type = \"glass\"\nior = 1.5\nbase_color = [0.95, 0.8, 0.6]",
+        1,
+    ) + "\n[[material]]\nname = \"inner\"\ntype = \"diffuse\"\nalbedo = [0.8, 0.8, 0.8]\n\n[[object]]\nshape = \"sphere\"\ncenter = [0.15, -0.6, 0.1]\nradius = 0.25\nmaterial = \"inner\"\n";
+    let scene = Scene::from_toml(&text, "tinted-caustic.toml", None).unwrap();
+    assert!(matches!(scene.materials.iter().find(|m| matches!(m, hikari_core::material::Material::Glass(_))),
+        Some(hikari_core::material::Material::Glass(g)) if g.tint.z == 0.6));
+    let Some((mean, count, specular)) = compare_scene("tinted glass around a ball", scene) else { return };
+    assert!(count > 2000, "only {count} pixels compared");
+    assert!(mean < 0.02, "mean relative difference {mean}");
+    let (specular_mean, specular_count) = specular.expect("the glass ball is in view");
+    eprintln!("tinted glass: {specular_count} pixels, mean relative difference {:.3}%", specular_mean * 100.0);
+    assert!(specular_count > 100);
+    assert!(specular_mean < 0.05, "glass pixels: mean relative difference {specular_mean}");
+}
+
 /// A floor that is part diffuse, part mirror: the raster passes shade the
 /// diffuse part, the specular pass follows the mirror part (photon-cpu does
 /// both by recursion).

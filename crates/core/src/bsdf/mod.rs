@@ -53,6 +53,7 @@
 //! Hence plain f32 arithmetic only: no lookup tables, powers written as
 //! products, and the sampler's angles through `sampling::unit_circle`.
 
+pub mod dielectric;
 pub mod ggx;
 
 use crate::material::{Rgb, mean};
@@ -382,7 +383,7 @@ impl ShadingFrame {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::ggx::tests::{direction_at, integrate_half_vectors};
     use super::*;
     use crate::sampling::chi2::assert_direction_distribution;
@@ -403,7 +404,7 @@ mod tests {
     /// lobe of width 0.003 rad still gets about 100 of them in ψ) and still
     /// cover the rest of the sphere at 0.003 rad or finer. Independent of
     /// the sampling code and of the half-vector parametrisation.
-    fn integrate_about(axis: Vec3, g: impl Fn(Vec3) -> f64) -> f64 {
+    pub(crate) fn integrate_about(axis: Vec3, g: impl Fn(Vec3) -> f64) -> f64 {
         const N_S: usize = 1000;
         const N_PHI: usize = 512;
         let frame = ShadingFrame::new(axis);

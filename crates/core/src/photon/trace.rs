@@ -5,8 +5,9 @@
 
 use super::{PathClass, Photon};
 use crate::bsdf::ShadingFrame;
+use crate::bsdf::dielectric::Transport;
 use crate::geometry::Ray;
-use crate::material::{Event, Material, Rgb, dielectric_split, mean, reflect};
+use crate::material::{Event, Material, Rgb, mean, reflect};
 use crate::medium::Flight;
 use crate::progress::Progress;
 use crate::sampling::{Rng, cosine_hemisphere, local_to_world};
@@ -191,13 +192,23 @@ impl PathTracer<'_> {
 
             let next_dir = match material {
                 Material::Emitter => return,
-                Material::Glass { ior } => {
-                    let split = dielectric_split(ray.dir, hit.geometric_normal, *ior);
-                    specular_bounces += 1;
-                    match split.refracted {
-                        Some(t) if rng.next_f32() >= split.reflectance => t,
-                        _ => split.reflected,
+                Material::Glass(glass) => {
+                    // Power crosses unchanged (importance); a rough or
+                    // tinted boundary's weight is below 1, and Russian
+                    // roulette on it keeps photons near constant power.
+                    let u_lobe = rng.next_f32();
+                    let u = if glass.is_smooth() { glam::Vec2::ZERO } else { rng.next_2d() };
+                    let Some(s) = glass.sample_world(ray.dir, hit.geometric_normal, u_lobe, u, Transport::Importance)
+                    else {
+                        return;
+                    };
+                    let survive = mean(s.weight).min(1.0);
+                    if survive < 1.0 && !(rng.next_f32() < survive) {
+                        return;
                     }
+                    power *= s.weight / survive;
+                    specular_bounces += 1;
+                    s.wi
                 }
                 Material::Pbr(bsdf) => {
                     if bsdf.stores_photons() {

@@ -79,8 +79,8 @@ fn see(scene: &Scene, mut ray: Ray) -> Option<Seen> {
             Material::Pbr(bsdf) => return Some(Seen { albedo: bsdf.base_color, normal }),
             Material::Emitter => return Some(Seen { albedo: Vec3::ZERO, normal }),
             Material::Mirror { .. } => reflect(ray.dir, normal),
-            Material::Glass { ior } => {
-                let split = dielectric_split(ray.dir, hit.geometric_normal, ior);
+            Material::Glass(glass) => {
+                let split = dielectric_split(ray.dir, hit.geometric_normal, glass.ior);
                 split.refracted.unwrap_or(split.reflected)
             }
         };

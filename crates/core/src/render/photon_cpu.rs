@@ -8,9 +8,10 @@
 
 use super::{Image, direct_diffuse, direct_reflected, render_pixels};
 use crate::bsdf::ShadingFrame;
+use crate::bsdf::dielectric::Transport;
 use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf};
 use crate::geometry::Ray;
-use crate::material::{Material, Rgb, dielectric_split, reflect};
+use crate::material::{Material, Rgb, reflect};
 use crate::medium::MediaAlong;
 use crate::photon::{PhotonMap, TracedPhotons, VolumePhotonMap};
 use crate::progress::Progress;
@@ -239,14 +240,38 @@ impl<'a> PhotonCpuRenderer<'a> {
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let ns = hit.shading_normal * facing;
         match material {
-            Material::Glass { ior } => {
-                if !can_recurse {
-                    return Rgb::ZERO;
+            Material::Glass(glass) => {
+                if glass.is_smooth() {
+                    if !can_recurse {
+                        return Rgb::ZERO;
+                    }
+                    let (reflected, refracted) =
+                        glass.smooth_branches(ray.dir, hit.geometric_normal, Transport::Radiance);
+                    let mut l = Rgb::ZERO;
+                    for (wi, weight) in std::iter::once(reflected).chain(refracted) {
+                        if weight.max_element() > 0.0 {
+                            l += weight * self.radiance(&Ray::new(hit.point, wi), depth + 1, rng);
+                        }
+                    }
+                    return l;
                 }
-                let split = dielectric_split(ray.dir, hit.geometric_normal, *ior);
-                let mut l = split.reflectance * self.radiance(&Ray::new(hit.point, split.reflected), depth + 1, rng);
-                if let Some(t) = split.refracted {
-                    l += (1.0 - split.reflectance) * self.radiance(&Ray::new(hit.point, t), depth + 1, rng);
+                // Rough glass: lights on this side by shadow rays through the
+                // reflection, then one sampled direction per eye ray; a
+                // reflected one leaves out what its shadow rays counted.
+                let frame = ShadingFrame::new(hit.geometric_normal);
+                let wo = frame.to_local(-ray.dir);
+                let mut l = Rgb::ZERO;
+                if self.settings.components.direct {
+                    let ng = hit.geometric_normal * facing;
+                    let f = |wi: glam::Vec3| glass.f(wo, frame.to_local(wi), Transport::Radiance);
+                    l += direct_reflected(self.scene, hit.point, ng, f, self.settings.area_light_samples, rng);
+                }
+                if can_recurse {
+                    let u_lobe = rng.next_f32();
+                    if let Some(s) = glass.sample(wo, u_lobe, rng.next_2d(), Transport::Radiance) {
+                        let next = Ray::new(hit.point, frame.to_world(s.wi));
+                        l += s.weight * self.radiance_seen(&next, depth + 1, s.transmitted, rng);
+                    }
                 }
                 l
             }

@@ -482,8 +482,12 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
             Ok(Material::Mirror { reflectance: p.color("reflectance", m.reflectance.unwrap_or([1.0; 3]), 1.0)? })
         }
         "glass" => {
-            p.only("a glass material", &given, &["ior"])?;
-            Ok(Material::Glass { ior: p.in_range("ior", m.ior.unwrap_or(1.5), limits::IOR)? })
+            p.only("a glass material", &given, &["ior", "base_color", "roughness"])?;
+            Ok(Material::Glass(crate::bsdf::dielectric::Dielectric {
+                ior: p.in_range("ior", m.ior.unwrap_or(1.5), limits::IOR)?,
+                roughness: p.in_range("roughness", m.roughness.unwrap_or(0.0), (0.0, 1.0))?,
+                tint: p.color("base_color", m.base_color.unwrap_or([1.0; 3]), 1.0)?,
+            }))
         }
         "pbr" => {
             p.only("a pbr material", &given, &["base_color", "metallic", "roughness", "specular"])?;

@@ -430,7 +430,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     let reflectance = fresnel.x;
                     if (reflectance < 1.0 && top < STACK) {
                         let refracted = refract_direction(b.dir, n, eta, cos_i, fresnel.y);
-                        stack[top] = Branch(x, b.depth + 1u, refracted, 1u, weight * (1.0 - reflectance));
+                        // Dielectric::smooth_branches (radiance): tinted, and
+                        // over η'² = 1/eta² for radiance crossing.
+                        let crossing = (1.0 - reflectance) * eta * eta * point.base;
+                        stack[top] = Branch(x, b.depth + 1u, refracted, 1u, weight * crossing);
                         top += 1u;
                     }
                     if (reflectance > 0.0 && top < STACK) {

@@ -530,6 +530,14 @@ fn trace_one(rng: ptr<function, Rng>) {
             if (fresnel.x < 1.0) {
                 if (rng_next_f32(rng) >= fresnel.x) {
                     next_dir = refract_direction(ray.dir, n, eta, cos_i, fresnel.y);
+                    // Dielectric::sample (importance): the tint, by roulette.
+                    let survive = min(rgb_mean(point.base), 1.0);
+                    if (survive < 1.0) {
+                        if (!(rng_next_f32(rng) < survive)) {
+                            return;
+                        }
+                    }
+                    power *= point.base / survive;
                 }
             }
         } else if (GLOSSY && s.glossy != 0u) {

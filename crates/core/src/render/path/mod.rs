@@ -17,14 +17,15 @@ mod lanes;
 
 use super::{Image, finite_mean, render_row_batches};
 use crate::bsdf::ShadingFrame;
+use crate::bsdf::dielectric::Transport;
 use crate::geometry::Ray;
 use crate::geometry::packet::LANES;
-use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
+use crate::material::{Material, Rgb, mean, reflect};
 use crate::medium::{Flight, Phase};
 use crate::progress::Progress;
 use crate::sampling::{Equiangular, Sampler, SobolSampler, cosine_hemisphere, local_to_world, power_heuristic};
 use crate::scene::Scene;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 #[derive(Clone, Debug)]
@@ -65,11 +66,13 @@ struct PathState {
     beta: Rgb,
     previous: Previous,
     bounce: u32,
+    /// Product of η'² over the boundaries crossed (1 outside glass).
+    eta_scale: f32,
 }
 
 impl PathState {
     fn new(ray: Ray) -> Self {
-        PathState { ray, l: Rgb::ZERO, beta: Rgb::ONE, previous: Previous::Specular, bounce: 0 }
+        PathState { ray, l: Rgb::ZERO, beta: Rgb::ONE, previous: Previous::Specular, bounce: 0, eta_scale: 1.0 }
     }
 
     /// Moves on to the next vertex: false where the path is cut.
@@ -158,13 +161,36 @@ fn advance(
     let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(hit) * facing);
     let next_dir = match material {
         Material::Emitter => return false,
-        Material::Glass { ior } => {
-            let split = dielectric_split(path.ray.dir, hit.geometric_normal, *ior);
-            path.previous = Previous::Specular;
-            match split.refracted {
-                Some(t) if sampler.next_f32() >= split.reflectance => t,
-                _ => split.reflected,
+        Material::Glass(glass) => {
+            if !glass.is_smooth() {
+                // The boundary's own frame: +z its outward (geometric) normal.
+                let frame = ShadingFrame::new(hit.geometric_normal);
+                let wo = frame.to_local(-path.ray.dir);
+                // Lights on this side, through the rough reflection (shadow
+                // rays stop at glass, so lights beyond it are left to the
+                // transmitted samples, which count what they hit in full).
+                let f = |wi: Vec3| glass.f(wo, frame.to_local(wi), Transport::Radiance);
+                let pdf = |wi: Vec3| glass.pdf(wo, frame.to_local(wi));
+                path.l += path.beta * next_event(scene, hit.point, ng, f, pdf, sampler);
             }
+            let u_lobe = sampler.next_f32();
+            let u = if glass.is_smooth() { Vec2::ZERO } else { sampler.next_2d() };
+            let Some(s) = glass.sample_world(path.ray.dir, hit.geometric_normal, u_lobe, u, Transport::Radiance) else {
+                return false;
+            };
+            path.beta *= s.weight;
+            if s.transmitted {
+                // Radiance crossing scales by 1/η'²; roulette looks past it.
+                let entering = path.ray.dir.dot(hit.geometric_normal) < 0.0;
+                let eta = if entering { glass.ior } else { 1.0 / glass.ior };
+                path.eta_scale *= eta * eta;
+            }
+            path.previous = if s.is_delta || s.transmitted {
+                Previous::Specular
+            } else {
+                Previous::Diffuse { point: hit.point, pdf: s.pdf }
+            };
+            s.wi
         }
         Material::Pbr(bsdf) => {
             let frame = ShadingFrame::new(ns);
@@ -214,7 +240,9 @@ fn advance(
     // the third (pbrt's rule) made paths 1.25× cheaper but 1.32× as
     // noisy in variance on the Cornell box: 7% less efficient.
     if path.bounce >= 4 {
-        let survive = path.beta.max_element().min(0.95);
+        // Inside glass β is 1/η² of what it carries out again (pbrt's
+        // `etaScale`): judged without that, paths inside are not cut more.
+        let survive = (path.beta.max_element() * path.eta_scale).min(0.95);
         if sampler.next_f32() >= survive {
             return false;
         }

@@ -39,6 +39,7 @@ use self::grid::HashGrid;
 use self::mis::{Factors, SubpathMis};
 use self::scatter::Scatter;
 use super::Image;
+use crate::bsdf::dielectric::Transport;
 use crate::geometry::Ray;
 use crate::light::Light;
 use crate::material::Rgb;
@@ -360,7 +361,9 @@ impl Pass<'_> {
             let step = flight::step(self.scene, &ray, rng);
             let (point, scatter) = match step.event {
                 Event::Escaped => break,
-                Event::Surface(hit) => (hit.point, Scatter::at(*self.scene.material_at(&hit), &hit, ray.dir)),
+                Event::Surface(hit) => {
+                    (hit.point, Scatter::at(*self.scene.material_at(&hit), &hit, ray.dir, Transport::Importance))
+                }
                 Event::Medium { point, mask } => (point, Scatter::medium(&self.scene.media, mask, ray.dir)),
             };
             if length == 1 && sphere {
@@ -502,7 +505,7 @@ impl Pass<'_> {
                             self.emitter_weight(&state, length, specular_path, found.direct_pdf, found.emission_pdf_w);
                         color += throughput * found.radiance * weight;
                     }
-                    (hit.point, Scatter::at(*self.scene.material_at(&hit), &hit, ray.dir))
+                    (hit.point, Scatter::at(*self.scene.material_at(&hit), &hit, ray.dir, Transport::Radiance))
                 }
                 Event::Medium { point, mask } => {
                     let scatter = Scatter::medium(&self.scene.media, mask, ray.dir);

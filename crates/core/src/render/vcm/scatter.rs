@@ -9,9 +9,10 @@
 //! textures are the path tracer's alone); f is symmetric, so light and
 //! camera subpaths evaluate it alike.
 
+use crate::bsdf::dielectric::{Dielectric, Transport};
 use crate::bsdf::{Bsdf, ShadingFrame};
 use crate::geometry::Hit;
-use crate::material::{Material, Rgb, dielectric_split, mean, reflect};
+use crate::material::{Material, Rgb, mean, reflect};
 use crate::medium::{MAX_PHASES, Media, Phase};
 use crate::sampling::{Rng, cosine_hemisphere};
 use glam::Vec3;
@@ -24,8 +25,11 @@ enum Lobes {
     /// Lambertian `albedo` chosen with probability `p_diffuse`, else a
     /// perfect mirror of reflectance `mirror` (hikari's `diffuse` and `mirror`).
     Lambert { albedo: Rgb, mirror: Rgb, p_diffuse: f32 },
-    /// Smooth glass: Fresnel reflection or refraction, both deltas.
-    Glass { ior: f32 },
+    /// Glass, in the frame of its outward geometric normal: smooth (Fresnel
+    /// reflection or refraction, both deltas) or rough (both lobes
+    /// densities); eye subpaths carry radiance through it, light subpaths
+    /// power.
+    Glass(Dielectric, Transport),
     /// A point in a medium.
     Medium(PhaseMix),
 }
@@ -138,12 +142,14 @@ pub struct Sampled {
 impl Scatter {
     /// The vertex at `hit`, reached along `dir`; None where nothing
     /// scatters (the black bodies of area lights, black materials).
-    pub fn at(material: Material, hit: &Hit, dir: Vec3) -> Option<Scatter> {
+    /// `mode` says what the subpath carries: radiance (from the eye) or
+    /// power (from a light), which differ across glass.
+    pub fn at(material: Material, hit: &Hit, dir: Vec3, mode: Transport) -> Option<Scatter> {
         let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let (lobes, continuation) = match material {
             Material::Emitter => return None,
             Material::Pbr(bsdf) => (Lobes::Pbr(bsdf), bsdf.albedo_estimate().max_element()),
-            Material::Glass { ior } => (Lobes::Glass { ior }, 1.0),
+            Material::Glass(glass) => (Lobes::Glass(glass, mode), 1.0),
             Material::Diffuse { .. } | Material::Mirror { .. } => {
                 let (albedo, mirror) = (material.diffuse_albedo(), material.mirror_reflectance());
                 let (p_d, p_s) = (mean(albedo), mean(mirror));
@@ -210,7 +216,7 @@ impl Scatter {
         match self.lobes {
             Lobes::Pbr(bsdf) => bsdf.is_delta() && !bsdf.has_diffuse(),
             Lobes::Lambert { p_diffuse, .. } => p_diffuse == 0.0,
-            Lobes::Glass { .. } => true,
+            Lobes::Glass(glass, _) => glass.is_smooth(),
             Lobes::Medium(_) => false,
         }
     }
@@ -243,6 +249,18 @@ impl Scatter {
                 pdf_rev: pdf,
             });
         }
+        if let Lobes::Glass(glass, mode) = self.lobes {
+            let outward = ShadingFrame::new(self.outward);
+            let (wo, wi) = (outward.to_local(self.wo), outward.to_local(wi));
+            let f = glass.f(wo, wi, mode);
+            let (pdf_dir, pdf_rev) = (glass.pdf(wo, wi), glass.pdf(wi, wo));
+            return (f.max_element() > 0.0 && pdf_dir > 0.0).then_some(Evaluation {
+                f,
+                cos: wi.z.abs(),
+                pdf_dir,
+                pdf_rev,
+            });
+        }
         // Reflection only, on the side the subpath arrived from.
         if wi.dot(self.geometric) <= 0.0 {
             return None;
@@ -258,7 +276,7 @@ impl Scatter {
             Lobes::Lambert { albedo, p_diffuse, .. } => {
                 (albedo / PI, p_diffuse * wi_local.z / PI, p_diffuse * self.wo_local.z / PI)
             }
-            Lobes::Glass { .. } | Lobes::Medium(_) => return None,
+            Lobes::Glass(..) | Lobes::Medium(_) => return None,
         };
         (f.max_element() > 0.0 && pdf_dir > 0.0).then_some(Evaluation { f, cos: wi_local.z, pdf_dir, pdf_rev })
     }
@@ -296,13 +314,23 @@ impl Scatter {
                     Sampled { wi, weight: mirror / p, pdf_dir: p, pdf_rev: p, cos: wi.dot(self.normal), delta: true }
                 }
             }
-            Lobes::Glass { ior } => {
-                let split = dielectric_split(-self.wo, self.outward, ior);
-                let (wi, p) = match split.refracted {
-                    Some(t) if u_lobe >= split.reflectance => (t, 1.0 - split.reflectance),
-                    _ => (split.reflected, split.reflectance.max(f32::MIN_POSITIVE)),
+            Lobes::Glass(glass, mode) => {
+                let s = glass.sample_world(-self.wo, self.outward, u_lobe, u, mode)?;
+                // A delta choice's probability is the same either way.
+                let pdf_rev = if s.is_delta {
+                    s.pdf.max(f32::MIN_POSITIVE)
+                } else {
+                    let outward = ShadingFrame::new(self.outward);
+                    glass.pdf(outward.to_local(s.wi), outward.to_local(self.wo))
                 };
-                Sampled { wi, weight: Rgb::ONE, pdf_dir: p, pdf_rev: p, cos: wi.dot(self.normal).abs(), delta: true }
+                Sampled {
+                    wi: s.wi,
+                    weight: s.weight,
+                    pdf_dir: s.pdf.max(f32::MIN_POSITIVE),
+                    pdf_rev,
+                    cos: s.wi.dot(self.normal).abs(),
+                    delta: s.is_delta,
+                }
             }
             Lobes::Medium(mix) => {
                 let wi = mix.choose(u_lobe).sample(-self.wo, u);

@@ -509,7 +509,12 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
             (Material::Mirror { reflectance }, _) => {
                 PbrMaterial { base_color: *reflectance, metallic: 1.0, roughness: 0.0, ..Default::default() }
             }
-            (Material::Glass { ior }, _) => PbrMaterial { roughness: 0.0, glass_ior: Some(*ior), ..Default::default() },
+            (Material::Glass(glass), _) => PbrMaterial {
+                base_color: glass.tint,
+                roughness: glass.roughness,
+                glass_ior: Some(glass.ior),
+                ..Default::default()
+            },
             (other, _) => return Err(format!("material {other:?} has no glTF form")),
         };
         let material = b.material(&PbrMaterial { name: format!("surface{s}"), ..material });

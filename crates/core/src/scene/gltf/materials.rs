@@ -1,7 +1,8 @@
 //! glTF materials as hikari materials: `pbrMetallicRoughness` is
 //! [`Material::Pbr`] (the specification's BRDF, `crate::bsdf`); a
-//! transmissive material (`KHR_materials_transmission` ≥ 0.5) is smooth
-//! glass with `KHR_materials_ior`; `KHR_materials_specular`'s factor scales
+//! transmissive material (`KHR_materials_transmission` ≥ 0.5) is glass
+//! ([`Dielectric`]) of the base colour's tint, the roughness and
+//! `KHR_materials_ior`; `KHR_materials_specular`'s factor scales
 //! the dielectric's Fresnel (its colour is ignored). Base-colour,
 //! metallic–roughness, emissive and normal textures are read
 //! (`crate::texture`; normal maps bend the CPU renderers' shading normals);
@@ -10,6 +11,7 @@
 
 use super::textures::Images;
 use crate::bsdf::Bsdf;
+use crate::bsdf::dielectric::Dielectric;
 use crate::material::{Material, Rgb};
 use crate::texture::{ColorSpace, MaterialTextures};
 use glam::{Vec3, Vec4Swizzles};
@@ -71,8 +73,9 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let roughness = sane(Vec3::splat(pbr.roughness_factor()), 1.0).x;
             let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
             let material = if transmission >= 0.5 {
-                approximated += (roughness > 0.0 || transmission < 1.0) as usize;
-                Material::Glass { ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0) }
+                approximated += (transmission < 1.0) as usize;
+                // The base colour tints what crosses (glTF's BTDF, and Cycles').
+                Material::Glass(Dielectric { ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0), roughness, tint: base })
             } else {
                 approximated += (transmission > 0.0) as usize;
                 // KHR_materials_specular's factor scales the dielectric's
@@ -125,7 +128,7 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     }
     if approximated > 0 {
         notes.push(format!(
-            "{approximated} material(s) approximated: transmission from 0.5 as smooth glass, below 0.5 as none"
+            "{approximated} material(s) approximated: transmission from 0.5 as glass (factor 1), below 0.5 as none"
         ));
     }
     if coloured_specular > 0 {

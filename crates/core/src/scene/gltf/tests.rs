@@ -376,6 +376,24 @@ fn the_specular_extension_is_read() {
     assert_eq!(scene.materials[0], Material::Diffuse { albedo: Vec3::splat(0.5), specular: Vec3::ZERO });
 }
 
+/// `KHR_materials_transmission` is glass of the material's roughness,
+/// tinted by its base colour, with `KHR_materials_ior`: no longer noted
+/// as approximated (Blender writes rough and coloured glass this way).
+#[test]
+fn transmission_is_rough_tinted_glass() {
+    let mut b = GltfBuilder::new();
+    let tint = Vec3::new(0.9, 0.6, 0.3);
+    let m = b.material(&PbrMaterial { base_color: tint, roughness: 0.4, glass_ior: Some(1.33), ..Default::default() });
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let dir = folder("transmission");
+    let path = write(&dir, "t.glb", &b.to_glb(vec![node]));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(!scene.notes.iter().any(|n| n.contains("approximated")), "{:?}", scene.notes);
+    let want = crate::bsdf::dielectric::Dielectric { ior: 1.33, roughness: 0.4, tint };
+    assert_eq!(scene.materials[0], Material::Glass(want));
+}
+
 /// A glTF animation moves what it animates: a parent's rotation carries a
 /// child mesh and a light, `--at` poses them (`Scene::at_time`), and the
 /// loop restarts after the last key.
