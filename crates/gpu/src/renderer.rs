@@ -228,10 +228,17 @@ fn depth_range((lo, hi): (Vec3, Vec3), eye: Vec3) -> (f32, f32) {
     (far * 1e-4, far)
 }
 
-/// Why the GPU's shaders (specular pass and photon tracer) cannot draw the
-/// materials of `scene`, if so: rough glass (and glass whose roughness a
-/// texture varies), which they would draw smooth.
+/// Why the GPU's shaders cannot draw the materials of `scene`, if so:
+/// rough glass (or glass whose roughness a texture varies) lit by point,
+/// spot or sun lights. The specular pass follows one sampled direction of
+/// rough glass per pass and sees what it meets, with no light sampling
+/// there: area lights, emissive meshes and skies converge, but the
+/// highlights of delta lights (which no sampled direction meets) would be
+/// missing. Such scenes render on the CPU, with this reason.
 pub(crate) fn undrawn_materials(scene: &Scene) -> Option<String> {
+    if !scene.lights.iter().any(|l| l.is_delta()) {
+        return None;
+    }
     let textured = |m: usize| {
         let textures = scene.texturing.as_ref().and_then(|t| t.materials.get(m).copied().flatten());
         textures.is_some_and(|t| t.metallic_roughness.is_some())
@@ -240,7 +247,9 @@ pub(crate) fn undrawn_materials(scene: &Scene) -> Option<String> {
         hikari_core::material::Material::Glass(glass) => !glass.is_smooth() || textured(m),
         _ => false,
     });
-    rough.then(|| "rough glass (roughness from 0.05) is not drawn on the GPU yet".to_string())
+    rough.then(|| {
+        "rough glass (roughness from 0.05) under point, spot or sun lights is not drawn on the GPU yet".to_string()
+    })
 }
 
 impl GpuRenderer {

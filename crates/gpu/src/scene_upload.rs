@@ -237,7 +237,10 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 },
                 two_sided: two_sided as u32,
                 metallic: glossy.map_or(0.0, |b| b.metallic),
-                roughness: glossy.map_or(1.0, |b| b.roughness),
+                roughness: match material {
+                    Material::Glass(glass) => glass.roughness,
+                    _ => glossy.map_or(1.0, |b| b.roughness),
+                },
                 specular_factor: glossy.map_or(0.0, |b| b.specular),
                 glossy: glossy.is_some() as u32,
                 emission_per_texel: per_texel.to_array(),

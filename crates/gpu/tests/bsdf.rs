@@ -151,3 +151,84 @@ fn wgsl_bsdf_matches_the_cpu() {
     let gathered = items.iter().filter(|(b, ..)| b.has_specular() && b.gathers_specular()).count();
     assert!(smooth > 500 && followed > 500 && gathered > 500, "{smooth} {followed} {gathered}");
 }
+
+/// dielectric.wgsl against hikari_core::bsdf::dielectric: rough glass's f
+/// (radiance and importance), density and samples from either side.
+#[test]
+fn wgsl_glass_matches_the_cpu() {
+    use hikari_core::bsdf::dielectric::{Dielectric, Transport};
+    const GLASS_ITEM: usize = 32;
+    let ctx = test_context("wgsl_glass_matches_the_cpu");
+    let mut rng = Rng::for_item(19, 0);
+    let n = 8192;
+    let mut items = Vec::new();
+    let mut input = vec![0u32; n * GLASS_ITEM];
+    for item in input.chunks_mut(GLASS_ITEM) {
+        let g = Dielectric {
+            ior: [1.5, 1.33, 2.4][(rng.next_f32() * 3.0) as usize % 3],
+            roughness: 0.05 + 0.95 * rng.next_f32(),
+            tint: Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()),
+        };
+        let (wo, wi) = (uniform_sphere(rng.next_2d()), uniform_sphere(rng.next_2d()));
+        let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
+        let radiance = rng.next_f32() < 0.5;
+        let words =
+            [g.ior, g.roughness, g.tint.x, g.tint.y, g.tint.z, wo.x, wo.y, wo.z, wi.x, wi.y, wi.z, u_lobe, u.x, u.y];
+        for (k, w) in words.iter().enumerate() {
+            item[k] = w.to_bits();
+        }
+        item[14] = radiance as u32;
+        items.push((g, wo, wi, u_lobe, u, radiance));
+    }
+    let main = format!(
+        "let o = {GLASS_ITEM}u * id.x; if (o >= arrayLength(&io)) {{ return; }}\n\
+         var w: array<f32, 14>;\n\
+         for (var k = 0u; k < 14u; k++) {{ w[k] = bitcast<f32>(io[o + k]); }}\n\
+         let g = Dielectric(w[0], w[1], vec3<f32>(w[2], w[3], w[4]));\n\
+         let wo = vec3<f32>(w[5], w[6], w[7]);\n\
+         let wi = vec3<f32>(w[8], w[9], w[10]);\n\
+         let radiance = io[o + 14u] != 0u;\n\
+         let fr = glass_f(g, wo, wi, true);\n\
+         let fi = glass_f(g, wo, wi, false);\n\
+         let s = glass_sample_rough(g, wo, w[11], vec2<f32>(w[12], w[13]), radiance);\n\
+         var out = array<f32, 14>(fr.x, fr.y, fr.z, fi.x, fi.y, fi.z, glass_pdf(g, wo, wi),\n\
+             s.wi.x, s.wi.y, s.wi.z, s.weight.x, s.weight.y, s.weight.z, s.pdf);\n\
+         for (var k = 0u; k < 14u; k++) {{ io[o + 16u + k] = bitcast<u32>(out[k]); }}\n\
+         io[o + 31u] = select(0u, 1u | select(0u, 2u, s.transmitted), s.valid);"
+    );
+    let gpu = run_kernel(&ctx, &[&hikari_gpu::wgsl::DIELECTRIC], &main, &input);
+    const TOLERANCE: f32 = 2e-3;
+    let (mut worst, mut mismatches, mut transmitted) = (0.0f32, 0, 0);
+    for (i, (out, (g, wo, wi, u_lobe, u, radiance))) in gpu.chunks(GLASS_ITEM).zip(&items).enumerate() {
+        let at = |k: usize| f32::from_bits(out[16 + k]);
+        let mut check = |name: &str, got: f32, want: f32| {
+            let err = (got - want).abs() / want.abs().max(1.0);
+            worst = worst.max(err);
+            assert!(close(got, want, TOLERANCE), "item {i} {g:?} wo {wo} wi {wi}: {name} {got} vs {want}");
+        };
+        let (fr, fi) = (g.f(*wo, *wi, Transport::Radiance), g.f(*wo, *wi, Transport::Importance));
+        for k in 0..3 {
+            check("f radiance", at(k), fr[k]);
+            check("f importance", at(3 + k), fi[k]);
+        }
+        check("pdf", at(6), g.pdf(*wo, *wi));
+        let mode = if *radiance { Transport::Radiance } else { Transport::Importance };
+        let sample = g.sample(*wo, *u_lobe, *u, mode);
+        let flags = sample.map_or(0, |s| 1 | (s.transmitted as u32) << 1);
+        if out[31] != flags {
+            mismatches += 1; // a lobe choice or a horizon decided by rounding
+            continue;
+        }
+        if let Some(s) = sample {
+            transmitted += s.transmitted as usize;
+            for k in 0..3 {
+                check("sampled wi", at(7 + k), s.wi[k]);
+                check("sample weight", at(10 + k), s.weight[k]);
+            }
+            check("sample pdf", at(13), s.pdf);
+        }
+    }
+    eprintln!("dielectric.wgsl: worst relative difference {worst:e}, {mismatches} of {n} samples decided otherwise");
+    assert!(mismatches <= 8, "{mismatches} samples decided otherwise");
+    assert!(transmitted > n / 4, "only {transmitted} transmitted samples");
+}

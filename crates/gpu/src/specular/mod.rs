@@ -54,6 +54,7 @@ pub fn shader_source() -> String {
         &LOOP_BUDGET,
         &BVH,
         &OPTICS,
+        &crate::wgsl::DIELECTRIC,
         &crate::wgsl::SURFACE,
         &crate::wgsl::CUT_OUTS,
         &crate::textures::ENVIRONMENT,

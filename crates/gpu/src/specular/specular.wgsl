@@ -422,7 +422,20 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
             }
             case 2u: {
-                if (can_bounce) {
+                let g = Dielectric(s.ior, point.roughness, point.base);
+                if (!glass_is_smooth(g)) {
+                    // Rough glass: one sampled direction per pass, which sees
+                    // what it meets emitted (no light sampling here, so
+                    // nothing is counted twice; delta lights are left to the
+                    // CPU: `undrawn_materials`).
+                    let u_lobe = stream_next_f32(&path_rng);
+                    let u = stream_next_2d(&path_rng);
+                    let sample = glass_sample_rough(g, to_shading(-b.dir, ng), u_lobe, u, true);
+                    if (sample.valid && can_bounce && top < STACK) {
+                        stack[top] = Branch(x, b.depth + 1u, local_to_world(sample.wi, ng), 1u, weight * sample.weight);
+                        top += 1u;
+                    }
+                } else if (can_bounce) {
                     // hikari_core::material::dielectric_split
                     let eta = select(s.ior, 1.0 / s.ior, front);
                     let cos_i = -dot(b.dir, n);

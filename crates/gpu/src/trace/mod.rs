@@ -45,6 +45,7 @@ pub fn trace_shader_source() -> String {
             &BVH,
             &SURFACE,
             &crate::wgsl::BSDF,
+            &crate::wgsl::DIELECTRIC,
             &crate::wgsl::CUT_OUTS,
             &SPOT,
             &PHOTON_ENCODING,

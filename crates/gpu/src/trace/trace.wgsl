@@ -518,6 +518,25 @@ fn trace_one(rng: ptr<function, Rng>) {
         var next_dir: vec3<f32>;
         if (s.kind == 3u) {
             return;
+        } else if (s.kind == 2u && !glass_is_smooth(Dielectric(s.ior, point.roughness, point.base))) {
+            // Rough glass (Dielectric::sample_world, importance): one
+            // microfacet lobe, roulette on the sample's weight.
+            let g = Dielectric(s.ior, point.roughness, point.base);
+            let u_lobe = rng_next_f32(rng);
+            let u = rng_next_2d(rng);
+            let sample = glass_sample_rough(g, to_shading(-ray.dir, normals.geometric), u_lobe, u, false);
+            if (!sample.valid) {
+                return;
+            }
+            let survive = min(rgb_mean(sample.weight), 1.0);
+            if (survive < 1.0) {
+                if (!(rng_next_f32(rng) < survive)) {
+                    return;
+                }
+            }
+            power *= sample.weight / survive;
+            specular_bounces += 1u;
+            next_dir = local_to_world(sample.wi, normals.geometric);
         } else if (s.kind == 2u) {
             // dielectric_split about the outward geometric normal.
             let entering = dot(ray.dir, normals.geometric) < 0.0;

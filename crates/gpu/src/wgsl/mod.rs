@@ -65,6 +65,10 @@ pub static BSDF: Module = Module {
     requires: &[&CONSTANTS, &SAMPLING, &OPTICS, &SURFACE],
 };
 
+/// Glass, smooth or rough (hikari_core::bsdf::dielectric).
+pub static DIELECTRIC: Module =
+    Module { name: "dielectric.wgsl", source: include_str!("dielectric.wgsl"), requires: &[&BSDF, &OPTICS] };
+
 /// Mitsuba's spot falloff (hikari_core::light::spot_falloff).
 pub static SPOT: Module = Module { name: "spot.wgsl", source: include_str!("spot.wgsl"), requires: &[] };
 
