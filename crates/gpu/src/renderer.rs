@@ -260,10 +260,8 @@ impl GpuRenderer {
     /// optical depths off by 8e-4 where they are 0, fog frames off by more
     /// than 2%).
     ///
-    /// Rough glass (and glass whose roughness a texture varies) is not
-    /// drawn by the GPU's specular pass and photon tracer yet, which follow
-    /// only smooth boundaries: such scenes render on the CPU, with this
-    /// reason, rather than as smooth glass.
+    /// Rough glass under point, spot or sun lights is refused too
+    /// ([`undrawn_materials`]).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
         if !ctx.float32_blend && !scene.media.is_empty() {
             return Some("participating media need 32-bit float blending, which this adapter lacks".to_string());

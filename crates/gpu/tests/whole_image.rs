@@ -545,7 +545,7 @@ fn gpu_image_matches_photon_cpu_on_a_glossy_box_under_every_light() {
 /// so its few-pass sums are noisy (the light made larger than
 /// cornell-caustic's, same power, so that they settle: measured on lavapipe
 /// with clear rough glass 9% apart after 8 passes, 2.6% after 16, 0.5%
-/// after 64; with this tint 4.8% after 32 and 2.0% after 64).
+/// after 64; with this tint 1.4% after 64).
 #[test]
 fn gpu_image_matches_photon_cpu_through_rough_glass() {
     let text = hikari_core::scene::builtin::source("cornell-caustic").unwrap().replacen(

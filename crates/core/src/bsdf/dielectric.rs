@@ -4,8 +4,11 @@
 //! # The model
 //!
 //! glTF's `KHR_materials_transmission` (and Cycles' Principled BSDF at
-//! transmission 1): Fresnel reflection, white, and transmission tinted by
-//! the base colour at each crossing. Below [`SMOOTH_ROUGHNESS`] both are
+//! transmission 1): Fresnel reflection, white, and transmission tinted at
+//! each crossing by the square root of the base colour, so that a solid
+//! piece seen through shows the base colour (Cycles' Principled BSDF
+//! tints so; glTF's thin-walled reading, one crossing by the base colour,
+//! gives the same colour through a closed object). Below [`SMOOTH_ROUGHNESS`] both are
 //! deltas (the mirror direction and Snell's refraction). Rougher glass is
 //! Walter et al. 2007 ("Microfacet Models for Refraction through Rough
 //! Surfaces") with the GGX distribution of α = roughness² and the
@@ -54,7 +57,8 @@ pub enum Transport {
 }
 
 /// A glass surface: index of refraction, perceptual roughness (GGX α =
-/// roughness²) and the colour its transmission is tinted by per crossing.
+/// roughness²) and the colour seen through a solid piece of it (each
+/// crossing tints by its square root).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dielectric {
     pub ior: f32,
@@ -99,11 +103,12 @@ impl Dielectric {
     }
 
     /// What transmission multiplies a path's throughput by, besides 1 − F
-    /// and the microfacet terms: the tint, and 1/η'² for radiance.
+    /// and the microfacet terms: √tint, and 1/η'² for radiance.
     fn transmission_factor(&self, eta: f32, mode: Transport) -> Rgb {
+        let tint = Rgb::new(self.tint.x.sqrt(), self.tint.y.sqrt(), self.tint.z.sqrt());
         match mode {
-            Transport::Radiance => self.tint / (eta * eta),
-            Transport::Importance => self.tint,
+            Transport::Radiance => tint / (eta * eta),
+            Transport::Importance => tint,
         }
     }
 

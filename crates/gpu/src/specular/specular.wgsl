@@ -443,9 +443,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     let reflectance = fresnel.x;
                     if (reflectance < 1.0 && top < STACK) {
                         let refracted = refract_direction(b.dir, n, eta, cos_i, fresnel.y);
-                        // Dielectric::smooth_branches (radiance): tinted, and
+                        // Dielectric::smooth_branches (radiance): √tint, and
                         // over η'² = 1/eta² for radiance crossing.
-                        let crossing = (1.0 - reflectance) * eta * eta * point.base;
+                        let crossing = (1.0 - reflectance) * glass_transmission_factor(g, 1.0 / eta, true);
                         stack[top] = Branch(x, b.depth + 1u, refracted, 1u, weight * crossing);
                         top += 1u;
                     }

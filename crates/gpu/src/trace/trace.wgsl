@@ -550,13 +550,14 @@ fn trace_one(rng: ptr<function, Rng>) {
                 if (rng_next_f32(rng) >= fresnel.x) {
                     next_dir = refract_direction(ray.dir, n, eta, cos_i, fresnel.y);
                     // Dielectric::sample (importance): the tint, by roulette.
-                    let survive = min(rgb_mean(point.base), 1.0);
+                    let tint = glass_transmission_factor(Dielectric(s.ior, point.roughness, point.base), 1.0, false);
+                    let survive = min(rgb_mean(tint), 1.0);
                     if (survive < 1.0) {
                         if (!(rng_next_f32(rng) < survive)) {
                             return;
                         }
                     }
-                    power *= point.base / survive;
+                    power *= tint / survive;
                 }
             }
         } else if (GLOSSY && s.glossy != 0u) {

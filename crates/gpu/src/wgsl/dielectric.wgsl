@@ -1,8 +1,8 @@
 // Rough glass (hikari_core::bsdf::dielectric), operation for operation in
 // the boundary's frame: +z its outward normal, wo.z > 0 outside (index 1),
 // wo toward where the path came from. GGX reflection and transmission
-// (Walter et al. 2007) sampled through the normals visible from wo; the
-// tint colours what crosses; radiance crossing scales by 1/η'² (eye paths),
+// (Walter et al. 2007) sampled through the normals visible from wo; √tint
+// colours each crossing; radiance crossing scales by 1/η'² (eye paths),
 // power does not (photons). Smooth glass (roughness below SMOOTH_ROUGHNESS)
 // is split by optics.wgsl's fresnel_dielectric instead. A test
 // (tests/bsdf.rs) pins these functions to their Rust twins.
@@ -34,8 +34,10 @@ fn glass_eta_across(g: Dielectric, wo_z: f32) -> f32 {
     return select(1.0 / g.ior, g.ior, wo_z > 0.0);
 }
 
+// √tint per crossing: a solid piece shows the tint.
 fn glass_transmission_factor(g: Dielectric, eta: f32, radiance: bool) -> vec3<f32> {
-    return select(g.tint, g.tint / (eta * eta), radiance);
+    let tint = sqrt(g.tint);
+    return select(tint, tint / (eta * eta), radiance);
 }
 
 // Smith's Λ, as ggx::lambda (infinite in the tangent plane).
