@@ -347,6 +347,20 @@ def test_materials_edited_by_name():
         material.metallic = 0.5
 
 
+def test_glass_tint_and_roughness_edited():
+    scene = hk.load("cornell-caustic")
+    name, glass = next((n, m) for n, m in scene.materials.items() if m.kind == "glass")
+    assert glass.base_color == pytest.approx((1.0, 1.0, 1.0)) and glass.roughness == 0.0
+    first = scene.render("path", **small(spp=2))
+    glass.base_color = (0.9, 0.5, 0.2)
+    glass.roughness = 0.3
+    assert scene.materials[name].base_color == pytest.approx((0.9, 0.5, 0.2))
+    assert scene.materials[name].roughness == pytest.approx(0.3)
+    tinted = scene.render("path", **small(spp=2))
+    assert tinted[..., 2].mean() < first[..., 2].mean(), "blue is taken out of what crosses the glass"
+    assert glass.metallic is None
+
+
 def test_every_light_and_emission_doubled_doubles_the_image():
     scene = hk.load(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "showcase.glb")
     emissive = [m for m in scene.materials.values() if max(m.emission) > 0]

@@ -310,14 +310,16 @@ impl MaterialView {
 
     /// The base colour: a diffuse material's albedo, a mirror's
     /// reflectance, a glTF material's base colour factor (times its
-    /// texture where it has one); None for glass and emitters.
+    /// texture where it has one), the colour seen through a solid piece of
+    /// glass; None for emitters.
     #[getter]
     fn base_color(&self) -> Option<(f32, f32, f32)> {
         match self.get() {
             Material::Diffuse { albedo, .. } => Some(tuple(albedo)),
             Material::Mirror { reflectance } => Some(tuple(reflectance)),
             Material::Pbr(b) => Some(tuple(b.base_color)),
-            Material::Glass { .. } | Material::Emitter => None,
+            Material::Glass(g) => Some(tuple(g.tint)),
+            Material::Emitter => None,
         }
     }
     #[setter]
@@ -330,7 +332,8 @@ impl MaterialView {
             Material::Diffuse { specular, .. } => Material::Diffuse { albedo: c, specular },
             Material::Mirror { .. } => Material::Mirror { reflectance: c },
             Material::Pbr(b) => Material::Pbr(hikari_core::bsdf::Bsdf { base_color: c, ..b }),
-            Material::Glass { .. } | Material::Emitter => {
+            Material::Glass(g) => Material::Glass(hikari_core::bsdf::dielectric::Dielectric { tint: c, ..g }),
+            Material::Emitter => {
                 return Err(PyValueError::new_err(format!("material.base_color: a {} has none", self.kind())));
             }
         };
@@ -353,18 +356,24 @@ impl MaterialView {
         Ok(())
     }
 
-    /// A glTF material's perceptual roughness; None for the others.
+    /// A glTF material's or glass's perceptual roughness; None for the others.
     #[getter]
     fn roughness(&self) -> Option<f32> {
-        if let Material::Pbr(b) = self.get() { Some(b.roughness) } else { None }
+        match self.get() {
+            Material::Pbr(b) => Some(b.roughness),
+            Material::Glass(g) => Some(g.roughness),
+            _ => None,
+        }
     }
     #[setter]
     fn set_roughness(&self, v: f32) -> PyResult<()> {
         let v = unit_interval(v, "material.roughness")?;
-        let Material::Pbr(b) = self.get() else {
-            return Err(PyValueError::new_err(format!("material.roughness: a {} has none", self.kind())));
+        let material = match self.get() {
+            Material::Pbr(b) => Material::Pbr(hikari_core::bsdf::Bsdf { roughness: v, ..b }),
+            Material::Glass(g) => Material::Glass(hikari_core::bsdf::dielectric::Dielectric { roughness: v, ..g }),
+            _ => return Err(PyValueError::new_err(format!("material.roughness: a {} has none", self.kind()))),
         };
-        self.set(Material::Pbr(hikari_core::bsdf::Bsdf { roughness: v, ..b }));
+        self.set(material);
         Ok(())
     }
 
