@@ -531,6 +531,25 @@ fn validator_edge_cases_load() {
     assert!((up[1] - Vec3::new(1.0, 0.0, 1.0)).length() < 1e-5, "{up:?}");
 }
 
+/// An accessor without a buffer view is read as zeros, which are
+/// allocated: a count past 2^24 is a located error, not an allocation of
+/// gigabytes (the CI fuzzer's seed 256 asked for 64 GiB through an
+/// animation's key times and aborted).
+#[test]
+fn a_huge_accessor_without_a_buffer_view_is_a_located_error() {
+    let json = r#"{
+      "asset": {"version": "2.0"},
+      "accessors": [{"count": 1073741824, "type": "VEC3", "componentType": 5126, "min": [0, 0, 0], "max": [0, 0, 0]}],
+      "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+      "nodes": [{"mesh": 0}],
+      "scenes": [{"nodes": [0]}]
+    }"#;
+    let dir = folder("huge-zeros");
+    let path = write(&dir, "z.gltf", json.as_bytes());
+    let e = crate::scene::Scene::load(path.to_str().unwrap()).err().expect("refused");
+    assert_says(&e.to_string(), &["z.gltf", "POSITION", "no buffer view", "1073741824"]);
+}
+
 /// A sparse accessor's index beyond its elements, and indices that do not
 /// increase, are located errors.
 #[test]
