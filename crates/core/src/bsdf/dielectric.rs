@@ -80,6 +80,9 @@ pub struct GlassSample {
     pub is_delta: bool,
     /// `wi` crossed the boundary.
     pub transmitted: bool,
+    /// η' of the crossing, η(wi's side)/η(wo's side); 1 for a reflection.
+    /// Radiance carried across is 1/η'² of what it was (pbrt's `etaScale`).
+    pub eta: f32,
 }
 
 impl Dielectric {
@@ -146,12 +149,12 @@ impl Dielectric {
             return None;
         }
         let wi = up(wi_up);
-        let pdf = self.pdf(wo, wi);
+        let (f, pdf) = self.f_and_pdf(wo, wi, mode);
         if !(pdf > 0.0) {
             return None;
         }
-        let f = self.f(wo, wi, mode);
-        Some(GlassSample { wi, weight: f * (wi.z.abs() / pdf), pdf, is_delta: false, transmitted })
+        let eta = if transmitted { eta } else { 1.0 };
+        Some(GlassSample { wi, weight: f * (wi.z.abs() / pdf), pdf, is_delta: false, transmitted, eta })
     }
 
     /// [`Self::sample`] in world space, for a path travelling along `dir`
@@ -172,19 +175,24 @@ impl Dielectric {
     fn split(&self, dir: Vec3, n_out: Vec3, u_lobe: f32, mode: Transport) -> GlassSample {
         let split = dielectric_split(dir, n_out, self.ior);
         match split.refracted {
-            Some(wi) if u_lobe >= split.reflectance => GlassSample {
-                wi,
-                weight: self.transmission_factor(self.eta_across(-dir.dot(n_out)), mode),
-                pdf: 1.0 - split.reflectance,
-                is_delta: true,
-                transmitted: true,
-            },
+            Some(wi) if u_lobe >= split.reflectance => {
+                let eta = self.eta_across(-dir.dot(n_out));
+                GlassSample {
+                    wi,
+                    weight: self.transmission_factor(eta, mode),
+                    pdf: 1.0 - split.reflectance,
+                    is_delta: true,
+                    transmitted: true,
+                    eta,
+                }
+            }
             _ => GlassSample {
                 wi: split.reflected,
                 weight: Rgb::ONE,
                 pdf: split.reflectance,
                 is_delta: true,
                 transmitted: false,
+                eta: 1.0,
             },
         }
     }
@@ -228,7 +236,20 @@ impl Dielectric {
     /// f(wo, wi) per steradian of the rough boundary (zero on a smooth one,
     /// whose lobes are deltas).
     pub fn f(&self, wo: Vec3, wi: Vec3, mode: Transport) -> Rgb {
-        let Some(p) = self.half_vector(wo, wi) else { return Rgb::ZERO };
+        self.half_vector(wo, wi).map_or(Rgb::ZERO, |p| self.f_at(&p, mode))
+    }
+
+    /// Density per steradian with which `sample` returns the non-delta `wi`.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.half_vector(wo, wi).map_or(0.0, |p| self.pdf_at(&p))
+    }
+
+    /// Both, from one microfacet normal (what `sample` needs).
+    fn f_and_pdf(&self, wo: Vec3, wi: Vec3, mode: Transport) -> (Rgb, f32) {
+        self.half_vector(wo, wi).map_or((Rgb::ZERO, 0.0), |p| (self.f_at(&p, mode), self.pdf_at(&p)))
+    }
+
+    fn f_at(&self, p: &Half, mode: Transport) -> Rgb {
         let alpha = self.alpha();
         let dg = ggx::d(p.h, alpha) * ggx::g2(p.wo, p.wi, alpha);
         let cosines = (p.wo.z * p.wi.z).abs();
@@ -240,9 +261,7 @@ impl Dielectric {
         self.transmission_factor(p.eta, mode) * scalar
     }
 
-    /// Density per steradian with which `sample` returns the non-delta `wi`.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        let Some(p) = self.half_vector(wo, wi) else { return 0.0 };
+    fn pdf_at(&self, p: &Half) -> f32 {
         let visible = ggx::visible_normal_pdf(p.wo, p.h, self.alpha());
         if !p.transmitted {
             return p.reflectance * visible / (4.0 * p.cos_oh);

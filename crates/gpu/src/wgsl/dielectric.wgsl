@@ -111,6 +111,19 @@ fn glass_f(g: Dielectric, wo: vec3<f32>, wi: vec3<f32>, radiance: bool) -> vec3<
     if (!p.valid) {
         return vec3<f32>(0.0);
     }
+    return glass_f_at(g, p, radiance);
+}
+
+fn glass_pdf(g: Dielectric, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    let p = glass_half(g, wo, wi);
+    if (!p.valid) {
+        return 0.0;
+    }
+    return glass_pdf_at(g, p);
+}
+
+// Dielectric::f_at: f of a valid pair.
+fn glass_f_at(g: Dielectric, p: GlassHalf, radiance: bool) -> vec3<f32> {
     let alpha = glass_alpha(g);
     let dg = ggx_d(p.h, alpha) * ggx_g2(p.wo, p.wi, alpha);
     let cosines = abs(p.wo.z * p.wi.z);
@@ -122,11 +135,8 @@ fn glass_f(g: Dielectric, wo: vec3<f32>, wi: vec3<f32>, radiance: bool) -> vec3<
     return glass_transmission_factor(g, p.eta, radiance) * scalar;
 }
 
-fn glass_pdf(g: Dielectric, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    let p = glass_half(g, wo, wi);
-    if (!p.valid) {
-        return 0.0;
-    }
+// Dielectric::pdf_at: the density of a valid pair.
+fn glass_pdf_at(g: Dielectric, p: GlassHalf) -> f32 {
     let visible = ggx_visible_normal_pdf(p.wo, p.h, glass_alpha(g));
     if (!p.transmitted) {
         return p.reflectance * visible / (4.0 * p.cos_oh);
@@ -162,12 +172,17 @@ fn glass_sample_rough(g: Dielectric, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>, r
         return s;
     }
     let wi = vec3<f32>(wi_up.x, wi_up.y, wi_up.z * flip);
-    let pdf = glass_pdf(g, wo, wi);
+    // Dielectric::f_and_pdf: one microfacet normal for both.
+    let p = glass_half(g, wo, wi);
+    if (!p.valid) {
+        return s;
+    }
+    let pdf = glass_pdf_at(g, p);
     if (!(pdf > 0.0)) {
         return s;
     }
     s.wi = wi;
-    s.weight = glass_f(g, wo, wi, radiance) * (abs(wi.z) / pdf);
+    s.weight = glass_f_at(g, p, radiance) * (abs(wi.z) / pdf);
     s.pdf = pdf;
     s.transmitted = transmitted;
     s.valid = true;

@@ -179,12 +179,8 @@ fn advance(
                 return false;
             };
             path.beta *= s.weight;
-            if s.transmitted {
-                // Radiance crossing scales by 1/η'²; roulette looks past it.
-                let entering = path.ray.dir.dot(hit.geometric_normal) < 0.0;
-                let eta = if entering { glass.ior } else { 1.0 / glass.ior };
-                path.eta_scale *= eta * eta;
-            }
+            // Radiance crossing scales by 1/η'²; roulette looks past it.
+            path.eta_scale *= s.eta * s.eta;
             path.previous = if s.is_delta || s.transmitted {
                 Previous::Specular
             } else {

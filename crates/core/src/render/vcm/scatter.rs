@@ -5,9 +5,11 @@
 //! continuation, and the Russian-roulette probability of going on, which
 //! every density includes (in a medium, the albedo Λ).
 //!
-//! Shading uses the interpolated normal, as the photon mappers do (normal
-//! textures are the path tracer's alone); f is symmetric, so light and
-//! camera subpaths evaluate it alike.
+//! Shading uses the interpolated normal bent by its normal texture
+//! (`Scene::bent`), as every renderer does. f is symmetric, so light and
+//! camera subpaths evaluate it alike, except across glass: eye subpaths
+//! carry radiance (1/η'² per crossing), light subpaths power, and each
+//! evaluates glass in its own mode (`Transport`), the adjoint of the other.
 
 use crate::bsdf::dielectric::{Dielectric, Transport};
 use crate::bsdf::{Bsdf, ShadingFrame};

@@ -295,6 +295,15 @@ fn unused_optional_extensions_are_one_note() {
     assert_says(ext_notes[0], &["KHR_materials_sheen", "KHR_materials_clearcoat"]);
 }
 
+/// A TOML scene whose one `[[object]]` is `object` (its fields), with a
+/// camera on +z and a point light.
+fn placing(object: &str) -> String {
+    format!(
+        "[camera]\nposition = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n\n[[object]]\n{object}\n\n\
+         [[light]]\ntype = \"point\"\nposition = [0.0, 2.0, 0.0]\nintensity = [1.0, 1.0, 1.0]\n"
+    )
+}
+
 #[test]
 fn a_toml_scene_places_a_gltf_object() {
     let mut b = GltfBuilder::new();
@@ -302,23 +311,8 @@ fn a_toml_scene_places_a_gltf_object() {
     let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
     let dir = folder("toml");
     write(&dir, "tri.glb", &b.to_glb(vec![node]));
-    let toml = r#"
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-
-[[object]]
-gltf = "tri.glb"
-scale = 2.0
-rotate_y = 90.0
-translate = [1.0, 0.0, 0.0]
-
-[[light]]
-type = "point"
-position = [0.0, 2.0, 0.0]
-intensity = [1.0, 1.0, 1.0]
-"#;
-    let scene = crate::scene::Scene::from_toml(toml, "t.toml", Some(&dir)).unwrap();
+    let toml = placing("gltf = \"tri.glb\"\nscale = 2.0\nrotate_y = 90.0\ntranslate = [1.0, 0.0, 0.0]");
+    let scene = crate::scene::Scene::from_toml(&toml, "t.toml", Some(&dir)).unwrap();
     let (t, _) = scene.accel.triangles().next().unwrap();
     // (1, 0, 0) scaled by 2 and turned 90° about +y is (0, 0, −2), then moved by (1, 0, 0).
     assert!(t.v.iter().any(|v| (*v - Vec3::new(1.0, 0.0, -2.0)).length() < 1e-5), "{:?}", t.v);
@@ -711,21 +705,8 @@ fn a_placed_gltf_object_plays_its_animations_and_keeps_its_notes() {
     let dir = folder("placed-animated");
     write(&dir, "d.bin", &bin);
     write(&dir, "d.gltf", json.as_bytes());
-    let toml = r#"
-[camera]
-position = [0.0, 0.0, 5.0]
-look_at = [0.0, 0.0, 0.0]
-
-[[object]]
-gltf = "d.gltf"
-translate = [10.0, 0.0, 0.0]
-
-[[light]]
-type = "point"
-position = [0.0, 2.0, 0.0]
-intensity = [1.0, 1.0, 1.0]
-"#;
-    let scene = crate::scene::Scene::from_toml(toml, "t.toml", Some(&dir)).unwrap();
+    let toml = placing("gltf = \"d.gltf\"\ntranslate = [10.0, 0.0, 0.0]");
+    let scene = crate::scene::Scene::from_toml(&toml, "t.toml", Some(&dir)).unwrap();
     assert!(scene.is_animated());
     let triangle = |scene: &crate::scene::Scene| scene.accel.triangles().find(|(_, id)| *id == 0).unwrap().0.v;
     let shift = Vec3::new(10.0, 0.0, 0.0);
@@ -738,7 +719,7 @@ intensity = [1.0, 1.0, 1.0]
     // A note of the file (an extension it uses and hikari ignores) names it.
     let json = json.replacen("\"asset\"", "\"extensionsUsed\": [\"KHR_materials_sheen\"],\n      \"asset\"", 1);
     write(&dir, "d.gltf", json.as_bytes());
-    let scene = crate::scene::Scene::from_toml(toml, "t.toml", Some(&dir)).unwrap();
+    let scene = crate::scene::Scene::from_toml(&toml, "t.toml", Some(&dir)).unwrap();
     assert!(
         scene.notes.iter().any(|n| n.starts_with("d.gltf: ") && n.contains("KHR_materials_sheen")),
         "{:?}",
