@@ -400,3 +400,22 @@ def test_gltf_materials_metallic_and_roughness():
     assert (pbr[0].roughness, pbr[0].metallic) == (0.25, 1.0)
     with pytest.raises(ValueError, match="roughness"):
         pbr[0].roughness = 1.5
+
+
+def test_clear_coat_edited_and_rendered():
+    scene = hk.load(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "showcase.glb")
+    pbr = next(m for m in scene.materials.values() if m.kind == "pbr" and max(m.emission) == 0)
+    assert pbr.clearcoat == 0.0
+    before = scene.render("path", **small(spp=2))
+    pbr.clearcoat = 1.0
+    pbr.clearcoat_roughness = 0.1
+    assert (pbr.clearcoat, pbr.clearcoat_roughness) == (1.0, pytest.approx(0.1))
+    after = scene.render("path", **small(spp=2))
+    assert not np.array_equal(after, before), "the coat changed nothing"
+    with pytest.raises(ValueError, match="clearcoat"):
+        pbr.clearcoat = 2.0
+    glass = hk.load("cornell-caustic")
+    clear = next(m for m in glass.materials.values() if m.kind == "glass")
+    assert clear.clearcoat is None
+    with pytest.raises(ValueError, match="has none"):
+        clear.clearcoat = 0.5

@@ -51,7 +51,7 @@ impl Material {
     /// whatever the roughness), which every renderer, the GPU's included,
     /// draws exactly.
     pub fn from_bsdf(bsdf: Bsdf) -> Material {
-        if bsdf.metallic == 0.0 && bsdf.specular == 0.0 {
+        if bsdf.metallic == 0.0 && bsdf.specular == 0.0 && !bsdf.has_coat() {
             Material::Diffuse { albedo: bsdf.base_color, specular: Rgb::ZERO }
         } else {
             Material::Pbr(bsdf)

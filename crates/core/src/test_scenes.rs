@@ -147,7 +147,36 @@ pub fn quad_lights_as_split_meshes(scene: &Scene, cuts: u32) -> Scene {
 
 /// The Cornell box with glossy walls and blocks, open at the front, lit by `light`.
 pub fn glossy_box(light: &str, size: u32) -> Scene {
-    let text = format!(
+    Scene::from_toml(
+        &glossy_box_toml(light, size),
+        &format!("glossy-box ({})", light.lines().nth(1).unwrap_or(light)),
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// `glossy_box` with clear coats (KHR_materials_clearcoat): a smooth coat
+/// over the red wall's rough dielectric (car paint), a followed coat
+/// (roughness 0.2) over the rough steel block, a gathered one (0.5) over
+/// every satin white surface (floor, ceiling, back wall, tall block).
+pub fn coated_box(light: &str, size: u32) -> Scene {
+    let text = glossy_box_toml(light, size)
+        .replace(
+            "name = \"lacquered red\"\ntype = \"pbr\"\nbase_color = [0.63, 0.07, 0.05]\nroughness = 0.1",
+            "name = \"lacquered red\"\ntype = \"pbr\"\nbase_color = [0.63, 0.07, 0.05]\nroughness = 0.6\nclearcoat = 1.0",
+        )
+        .replace("roughness = 0.7\n", "roughness = 0.7\nclearcoat = 0.8\nclearcoat_roughness = 0.2\n")
+        .replace(
+            "roughness = 0.5\n",
+            "roughness = 0.5\nclearcoat = 1.0\nclearcoat_roughness = 0.5\n",
+        );
+    assert_eq!(text.matches("clearcoat =").count(), 3, "glossy_box's materials changed: update coated_box");
+    Scene::from_toml(&text, &format!("coated-box ({})", light.lines().nth(1).unwrap_or(light)), None)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn glossy_box_toml(light: &str, size: u32) -> String {
+    format!(
         r#"
 [camera]
 position = [0.0, 0.0, 3.9]
@@ -238,9 +267,7 @@ material = "satin white"
 
 {light}
 "#
-    );
-    Scene::from_toml(&text, &format!("glossy-box ({})", light.lines().nth(1).unwrap_or(light)), None)
-        .unwrap_or_else(|e| panic!("{e}"))
+    )
 }
 
 /// The lights `glossy_box` is tested under, one of each kind, as TOML.

@@ -9,7 +9,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, pho
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{glossy_box, glossy_lights::*, quad_lights_as_meshes};
+use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights::*, quad_lights_as_meshes};
 
 /// The mean of passes 1..=n of `photons` paths each, at the default first radii.
 fn progressive(scene: &Scene, photons: u64, passes: u32) -> Image {
@@ -87,4 +87,18 @@ fn glossy_box_under_a_sphere_light() {
 #[test]
 fn glossy_box_under_an_emissive_mesh() {
     converges("mesh", quad_lights_as_meshes(&glossy_box(QUAD, 32)));
+}
+
+/// Clear coats (smooth, followed and gathered) over dielectric, metal and
+/// satin bases: photon-cpu splits each coated BRDF into what the photon
+/// maps stand for and what the eye follows, and still converges to the
+/// path tracer, which samples the whole.
+#[test]
+fn coated_box_under_a_quad_light() {
+    converges("coated, quad", coated_box(QUAD, 32));
+}
+
+#[test]
+fn coated_box_under_a_point_light() {
+    converges("coated, point", coated_box(POINT, 32));
 }

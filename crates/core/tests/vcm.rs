@@ -184,3 +184,15 @@ fn bidirectional_converges_to_path_on_the_other_built_in_scenes() {
         converges_with(name, &small(name, 24), with(Strategies::Connections), 1.2, 1024, 0.02);
     }
 }
+
+/// Clear coats (smooth, followed and gathered) over every kind of base:
+/// VCM's connections and merges evaluate the coated BRDF both ways, and
+/// without merging it stays unbiased.
+#[test]
+fn vcm_converges_to_path_under_clear_coats() {
+    use hikari_core::test_scenes::{coated_box, glossy_lights};
+    let scene = coated_box(glossy_lights::QUAD, 24);
+    let reference = reference(&scene, 1024);
+    converges_to("coated-box", &scene, with(Strategies::Connections), 1.2, &reference, 0.02);
+    converges_to("coated-box", &scene, with(Strategies::All), 1.2, &reference, 0.03);
+}

@@ -75,7 +75,10 @@ pub struct GpuSurface {
     /// G-buffer's normal is bent by it (`bent_normal`).
     pub normal_texture: u32,
     pub normal_scale: f32,
-    pub _pad: [u32; 2],
+    /// The glTF BRDF's clear coat (`Bsdf::clearcoat`, 0: none) and its
+    /// roughness, where `glossy` is 1.
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -220,10 +223,10 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
             let mean = textures.emissive_mean;
             let per_texel =
                 Vec3::select(mean.cmpgt(Vec3::ZERO), emission / mean.max(Vec3::splat(f32::MIN_POSITIVE)), Vec3::ZERO);
-            // The glTF BRDF where it has a specular lobe; exactly
+            // The glTF BRDF where it has a specular lobe or a coat; exactly
             // Lambertian ones (and the old materials) take the cheaper path.
             let glossy = match material {
-                Material::Pbr(bsdf) if bsdf.has_specular() => Some(bsdf),
+                Material::Pbr(bsdf) if bsdf.is_glossy() => Some(bsdf),
                 _ => None,
             };
             GpuSurface {
@@ -251,7 +254,8 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 alpha_factor: if textures.alpha_cutoff.is_some() { textures.alpha_factor } else { 1.0 },
                 normal_texture: views.reference(textures.normal),
                 normal_scale: textures.normal_scale,
-                _pad: [0; 2],
+                clearcoat: glossy.map_or(0.0, |b| b.clearcoat),
+                clearcoat_roughness: glossy.map_or(0.0, |b| b.clearcoat_roughness),
             }
         })
         .collect()

@@ -7,8 +7,10 @@ use hikari_core::sampling::{Rng, uniform_sphere};
 use hikari_gpu::test_support::{run_kernel, test_context};
 use hikari_gpu::wgsl::BSDF;
 
-/// Words per item: 15 inputs, then the outputs the kernel writes.
-const ITEM: usize = 40;
+/// Words per item: 17 inputs, then the outputs the kernel writes.
+const ITEM: usize = 42;
+/// Input words per item.
+const INPUTS: usize = 17;
 
 /// A random material, roughness spread over the smooth, followed and
 /// gathered ranges, with the extremes (black, pure metal or dielectric,
@@ -23,7 +25,9 @@ fn random_bsdf(rng: &mut Rng) -> Bsdf {
     let metallic = pick(rng, &[0.0, 1.0]);
     let roughness = pick(rng, &[0.0, 0.03, 0.2, 0.35, 1.0]);
     let specular = pick(rng, &[0.0, 1.0]);
-    Bsdf::new(base, metallic, roughness, specular)
+    let bsdf = Bsdf::new(base, metallic, roughness, specular);
+    // A third under a clear coat, smooth, followed or gathered.
+    if rng.next_f32() < 0.33 { bsdf.with_clearcoat(pick(rng, &[1.0]), pick(rng, &[0.0, 0.2, 0.5])) } else { bsdf }
 }
 
 /// A direction toward the viewer or light: mostly above the surface,
@@ -34,7 +38,7 @@ fn random_direction(rng: &mut Rng) -> Vec3 {
 }
 
 fn flags(s: &Option<BsdfSample>) -> u32 {
-    s.map_or(0, |s| 1 | (s.is_delta as u32) << 1 | (s.specular as u32) << 2)
+    s.map_or(0, |s| 1 | (s.is_delta as u32) << 1 | (s.followed as u32) << 2)
 }
 
 fn close(got: f32, want: f32, tolerance: f32) -> bool {
@@ -67,6 +71,8 @@ fn wgsl_bsdf_matches_the_cpu() {
             u_lobe,
             u.x,
             u.y,
+            b.clearcoat,
+            b.clearcoat_roughness,
         ];
         for (k, w) in words.iter().enumerate() {
             item[k] = w.to_bits();
@@ -75,12 +81,9 @@ fn wgsl_bsdf_matches_the_cpu() {
     }
     let main = format!(
         "let o = {ITEM}u * id.x; if (o >= arrayLength(&io)) {{ return; }}\n\
-         let w = array<f32, 15>(bitcast<f32>(io[o]), bitcast<f32>(io[o + 1u]), bitcast<f32>(io[o + 2u]),\n\
-             bitcast<f32>(io[o + 3u]), bitcast<f32>(io[o + 4u]), bitcast<f32>(io[o + 5u]),\n\
-             bitcast<f32>(io[o + 6u]), bitcast<f32>(io[o + 7u]), bitcast<f32>(io[o + 8u]),\n\
-             bitcast<f32>(io[o + 9u]), bitcast<f32>(io[o + 10u]), bitcast<f32>(io[o + 11u]),\n\
-             bitcast<f32>(io[o + 12u]), bitcast<f32>(io[o + 13u]), bitcast<f32>(io[o + 14u]));\n\
-         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5]);\n\
+         var w: array<f32, {INPUTS}>;\n\
+         for (var k = 0u; k < {INPUTS}u; k++) {{ w[k] = bitcast<f32>(io[o + k]); }}\n\
+         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16]);\n\
          let wo = vec3<f32>(w[6], w[7], w[8]);\n\
          let wi = vec3<f32>(w[9], w[10], w[11]);\n\
          let u = vec2<f32>(w[13], w[14]);\n\
@@ -88,7 +91,7 @@ fn wgsl_bsdf_matches_the_cpu() {
          let f = bsdf_f(b, wo, wi);\n\
          let fg = bsdf_f_gathered(b, wo, wi);\n\
          let s = bsdf_sample(b, wo, w[12], u);\n\
-         let ss = bsdf_sample_specular(b, wo, u);\n\
+         let ss = bsdf_sample_followed(b, wo, u);\n\
          let local = to_shading(wi, normalize(wo));\n\
          out[0] = f.x; out[1] = f.y; out[2] = f.z; out[3] = bsdf_pdf(b, wo, wi);\n\
          out[4] = fg.x; out[5] = fg.y; out[6] = fg.z;\n\
@@ -97,9 +100,9 @@ fn wgsl_bsdf_matches_the_cpu() {
          out[14] = ss.wi.x; out[15] = ss.wi.y; out[16] = ss.wi.z; out[17] = ss.pdf;\n\
          out[18] = ss.weight.x; out[19] = ss.weight.y; out[20] = ss.weight.z;\n\
          out[21] = local.x; out[22] = local.y; out[23] = local.z;\n\
-         for (var k = 0u; k < 24u; k++) {{ io[o + 15u + k] = bitcast<u32>(out[k]); }}\n\
-         io[o + 39u] = select(0u, 1u | select(0u, 2u, s.is_delta) | select(0u, 4u, s.specular), s.valid)\n\
-             | (select(0u, 1u | select(0u, 2u, ss.is_delta) | select(0u, 4u, ss.specular), ss.valid) << 8u);"
+         for (var k = 0u; k < 24u; k++) {{ io[o + {INPUTS}u + k] = bitcast<u32>(out[k]); }}\n\
+         io[o + {INPUTS}u + 24u] = select(0u, 1u | select(0u, 2u, s.is_delta) | select(0u, 4u, s.followed), s.valid)\n\
+             | (select(0u, 1u | select(0u, 2u, ss.is_delta) | select(0u, 4u, ss.followed), ss.valid) << 8u);"
     );
     let gpu = run_kernel(&ctx, &[&BSDF], &main, &input);
     // Rounding differs (WGSL's sqrt and normalize against Rust's), and a
@@ -108,9 +111,9 @@ fn wgsl_bsdf_matches_the_cpu() {
     const TOLERANCE: f32 = 2e-4;
     let (mut worst, mut flag_mismatches) = (0.0f32, 0);
     for (i, (out, (b, wo, wi, u_lobe, u))) in gpu.chunks(ITEM).zip(&items).enumerate() {
-        let g = |k: usize| f32::from_bits(out[15 + k]);
+        let g = |k: usize| f32::from_bits(out[INPUTS + k]);
         let f = b.f(*wo, *wi);
-        let gathered = if b.gathers_specular() { f } else { b.f_diffuse(*wo, *wi) };
+        let gathered = b.f_gathered(*wo, *wi);
         let local = ShadingFrame::new(wo.normalize()).to_local(*wi);
         let mut check = |name: &str, got: f32, want: f32| {
             let err = (got - want).abs() / want.abs().max(1.0);
@@ -123,9 +126,9 @@ fn wgsl_bsdf_matches_the_cpu() {
             check("to_shading", g(21 + k), local[k]);
         }
         check("pdf", g(3), b.pdf(*wo, *wi));
-        let samples = [(b.sample(*wo, *u_lobe, *u), 7, 0), (b.sample_specular(*wo, *u), 14, 8)];
+        let samples = [(b.sample(*wo, *u_lobe, *u), 7, 0), (b.sample_followed(*wo, *u), 14, 8)];
         for (sample, at, shift) in samples {
-            let gpu_flags = (out[39] >> shift) & 0xff;
+            let gpu_flags = (out[INPUTS + 24] >> shift) & 0xff;
             if gpu_flags != flags(&sample) {
                 // A lobe choice or a direction at the horizon decided by rounding.
                 flag_mismatches += 1;
@@ -150,6 +153,8 @@ fn wgsl_bsdf_matches_the_cpu() {
     let followed = items.iter().filter(|(b, ..)| b.has_specular() && !b.is_delta() && !b.gathers_specular()).count();
     let gathered = items.iter().filter(|(b, ..)| b.has_specular() && b.gathers_specular()).count();
     assert!(smooth > 500 && followed > 500 && gathered > 500, "{smooth} {followed} {gathered}");
+    let coats = |r: f32| items.iter().filter(|(b, ..)| b.has_coat() && b.clearcoat_roughness == r).count();
+    assert!(coats(0.0) > 200 && coats(0.2) > 200 && coats(0.5) > 200, "{} {} {}", coats(0.0), coats(0.2), coats(0.5));
 }
 
 /// dielectric.wgsl against hikari_core::bsdf::dielectric: rough glass's f

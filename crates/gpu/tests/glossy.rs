@@ -10,7 +10,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, pas
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{glossy_box, glossy_lights, quad_lights_as_meshes};
+use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights, quad_lights_as_meshes};
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
@@ -119,4 +119,17 @@ fn glossy_box_on_the_gpu_under_a_sphere_light() {
 #[test]
 fn glossy_box_on_the_gpu_under_an_emissive_mesh() {
     converges("mesh", quad_lights_as_meshes(&glossy_box(glossy_lights::QUAD, 32)), 4);
+}
+
+/// Clear coats (smooth, followed and gathered; bsdf.wgsl's coat): the
+/// splat weights photons by the gathered part, the specular pass follows
+/// the rest, the direct pass and the photon tracer use the whole.
+#[test]
+fn coated_box_on_the_gpu_under_a_quad_light() {
+    converges("coated, quad", coated_box(glossy_lights::QUAD, 32), 4);
+}
+
+#[test]
+fn coated_box_on_the_gpu_under_a_point_light() {
+    converges("coated, point", coated_box(glossy_lights::POINT, 32), 4);
 }

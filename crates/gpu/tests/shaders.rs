@@ -103,7 +103,8 @@ fn shared_structs_match_wgsl_layouts() {
             alpha_factor,
             normal_texture,
             normal_scale,
-            _pad
+            clearcoat,
+            clearcoat_roughness
         ]
     );
     let splat = hikari_gpu::splat::shader_source();

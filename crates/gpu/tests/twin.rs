@@ -90,12 +90,12 @@ fn twin_pass(
             // (the lobes the maps stand for); Lambertian surfaces by ρ/π.
             let material = scene.materials[scene.surfaces[normal[i].w as usize].material as usize];
             let want = match material {
-                Material::Pbr(bsdf) if bsdf.has_specular() => {
+                Material::Pbr(bsdf) if bsdf.is_glossy() => {
                     let frame = ShadingFrame::new(n);
                     let wo = frame.to_local((scene.camera.position - x).normalize());
                     fixed_radius_radiance_brdf(map, x, n, params, |wi| {
                         let wi = frame.to_local(wi);
-                        if bsdf.gathers_specular() { bsdf.f(wo, wi) } else { bsdf.f_diffuse(wo, wi) }
+                        bsdf.f_gathered(wo, wi)
                     })
                 }
                 _ => fixed_radius_radiance(map, None, x, n, albedo[i].truncate(), params),

@@ -377,6 +377,37 @@ impl MaterialView {
         Ok(())
     }
 
+    /// A glTF material's clear coat (KHR_materials_clearcoat's factor, 0:
+    /// none); None for the others.
+    #[getter]
+    fn clearcoat(&self) -> Option<f32> {
+        if let Material::Pbr(b) = self.get() { Some(b.clearcoat) } else { None }
+    }
+    #[setter]
+    fn set_clearcoat(&self, v: f32) -> PyResult<()> {
+        let v = unit_interval(v, "material.clearcoat")?;
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.clearcoat: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(b.with_clearcoat(v, b.clearcoat_roughness)));
+        Ok(())
+    }
+
+    /// A glTF material's clear coat's perceptual roughness; None for the others.
+    #[getter]
+    fn clearcoat_roughness(&self) -> Option<f32> {
+        if let Material::Pbr(b) = self.get() { Some(b.clearcoat_roughness) } else { None }
+    }
+    #[setter]
+    fn set_clearcoat_roughness(&self, v: f32) -> PyResult<()> {
+        let v = unit_interval(v, "material.clearcoat_roughness")?;
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.clearcoat_roughness: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(b.with_clearcoat(b.clearcoat, v)));
+        Ok(())
+    }
+
     /// The RGB radiance (W/(m² sr)) the material's surfaces emit: a glTF
     /// emissive factor times its strength (an emissive texture's mean where
     /// it has one, the texture's pattern kept), an area light's body's

@@ -53,6 +53,7 @@
 //! Hence plain f32 arithmetic only: no lookup tables, powers written as
 //! products, and the sampler's angles through `sampling::unit_circle`.
 
+pub mod clearcoat;
 pub mod dielectric;
 pub mod ggx;
 
@@ -99,6 +100,11 @@ pub struct Bsdf {
     /// KHR_materials_specular's specularFactor: 1 is glTF's default
     /// (F0 = 0.04), 0 removes the dielectric's specular lobe.
     pub specular: f32,
+    /// KHR_materials_clearcoat's clearcoatFactor c: a clear layer of F0 =
+    /// 0.04 over the lobes above ([`clearcoat`]); 0 is no coat.
+    pub clearcoat: f32,
+    /// The coat's perceptual roughness (α = roughness²).
+    pub clearcoat_roughness: f32,
 }
 
 /// A direction drawn by [`Bsdf::sample`].
@@ -116,14 +122,14 @@ pub struct BsdfSample {
     /// The mirror lobe produced `wi`: `f` and `pdf` are not densities, so no
     /// MIS against light sampling.
     pub is_delta: bool,
-    /// The specular (microfacet or mirror) lobe produced `wi`, not the
-    /// diffuse one: photon paths count such bounces as specular on surfaces
-    /// smoother than `GATHER_ROUGHNESS`.
-    pub specular: bool,
+    /// A lobe the eye follows produced `wi` (a specular or coat lobe
+    /// smoother than `GATHER_ROUGHNESS`, which the photon maps do not stand
+    /// for): photon paths count such a bounce as specular.
+    pub followed: bool,
 }
 
 /// Schlick's (1 − cos)^5, as products.
-fn schlick_weight(cos: f32) -> f32 {
+pub(crate) fn schlick_weight(cos: f32) -> f32 {
     let m = (1.0 - cos).clamp(0.0, 1.0);
     let m2 = m * m;
     m2 * m2 * m
@@ -142,18 +148,26 @@ impl Bsdf {
             metallic: metallic.clamp(0.0, 1.0),
             roughness: roughness.clamp(0.0, 1.0),
             specular: specular.clamp(0.0, 1.0),
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
         }
+    }
+
+    /// This material under a clear coat of factor `clearcoat` and
+    /// perceptual roughness `roughness` (both clamped to [0, 1]).
+    pub fn with_clearcoat(self, clearcoat: f32, roughness: f32) -> Self {
+        Bsdf { clearcoat: clearcoat.clamp(0.0, 1.0), clearcoat_roughness: roughness.clamp(0.0, 1.0), ..self }
     }
 
     /// Lambertian reflectance `albedo`: f = albedo/π exactly.
     pub fn diffuse(albedo: Rgb) -> Self {
-        Bsdf { base_color: albedo, metallic: 0.0, roughness: 1.0, specular: 0.0 }
+        Bsdf::new(albedo, 0.0, 1.0, 0.0)
     }
 
     /// Perfect mirror with Schlick's conductor Fresnel of reflectance `f0` at
     /// normal incidence.
     pub fn mirror(f0: Rgb) -> Self {
-        Bsdf { base_color: f0, metallic: 1.0, roughness: 0.0, specular: 1.0 }
+        Bsdf::new(f0, 1.0, 0.0, 1.0)
     }
 
     /// GGX width α = roughness², at least `ALPHA_MIN`.
@@ -165,14 +179,27 @@ impl Bsdf {
         self.roughness < SMOOTH_ROUGHNESS
     }
 
-    /// The specular lobe carries anything (metals always do: F_m → 1 at grazing).
+    /// The base's specular lobe carries anything (metals always do: F_m → 1
+    /// at grazing).
     pub fn has_specular(&self) -> bool {
         self.metallic > 0.0 || self.specular > 0.0
     }
 
-    /// The specular lobe is a perfect mirror (and is present).
+    /// The base's specular lobe is a perfect mirror (and is present).
     pub fn is_delta(&self) -> bool {
         self.is_smooth() && self.has_specular()
+    }
+
+    /// Some lobe is not a delta: light sampling and photon merges can use
+    /// this surface.
+    pub fn has_non_delta_lobe(&self) -> bool {
+        self.has_diffuse() || (self.has_specular() && !self.is_smooth()) || (self.has_coat() && !self.coat_is_smooth())
+    }
+
+    /// Some lobe reflects anything: the base's or the coat's. (Surfaces
+    /// without are Lambertian: `Material::from_bsdf`.)
+    pub fn is_glossy(&self) -> bool {
+        self.has_specular() || self.has_coat()
     }
 
     /// The diffuse lobe carries anything: photon maps store photons here.
@@ -221,15 +248,34 @@ impl Bsdf {
         (diffuse, self.specular_fresnel(cos) * (ggx::d(h, alpha) * ggx::visibility(wo, wi, alpha)))
     }
 
-    /// f(wo, wi) per steradian, without the mirror of smooth surfaces.
+    /// f(wo, wi) per steradian, without the mirrors of smooth lobes.
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let (diffuse, specular) = self.f_lobes(wo, wi);
-        diffuse + specular
+        if self.has_coat() { self.coated_f(wo, wi) } else { self.base_f(wo, wi) }
     }
 
     /// Density per steradian with which `sample` returns the non-delta
     /// direction `wi`.
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.has_coat() { self.coated_pdf(wo, wi) } else { self.base_pdf(wo, wi) }
+    }
+
+    /// A direction toward the light for viewer direction `wo`: `u_lobe`
+    /// chooses the lobe, `u` the direction within it. None when `wo` is
+    /// below the surface, the material is black, or the microfacet
+    /// reflection points below the surface (energy the single-scattering
+    /// model loses).
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        if self.has_coat() { self.coated_sample(wo, u_lobe, u) } else { self.base_sample(wo, u_lobe, u) }
+    }
+
+    /// The base lobes' f (diffuse and specular, no coat).
+    pub(crate) fn base_f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let (diffuse, specular) = self.f_lobes(wo, wi);
+        diffuse + specular
+    }
+
+    /// The base lobes' sampling density.
+    pub(crate) fn base_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
@@ -241,12 +287,8 @@ impl Bsdf {
         pdf
     }
 
-    /// A direction toward the light for viewer direction `wo`: `u_lobe`
-    /// chooses the lobe, `u` the direction within it. None when `wo` is
-    /// below the surface, the material is black, or the microfacet
-    /// reflection points below the surface (energy the single-scattering
-    /// model loses).
-    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+    /// A direction from the base lobes (`sample` without the coat).
+    pub(crate) fn base_sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -262,7 +304,7 @@ impl Bsdf {
                     pdf: p_specular,
                     weight: fresnel / p_specular,
                     is_delta: true,
-                    specular: true,
+                    followed: true,
                 });
             }
             ggx::reflect(wo, ggx::sample_visible_normal(wo, self.alpha(), u))
@@ -272,12 +314,13 @@ impl Bsdf {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
+        let pdf = self.base_pdf(wo, wi);
         if pdf <= 0.0 {
             return None;
         }
-        let f = self.f(wo, wi);
-        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, specular })
+        let f = self.base_f(wo, wi);
+        let followed = specular && !self.gathers_specular();
+        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed })
     }
 
     /// π times the diffuse lobe at normal incidence: its Lambert albedo.
@@ -290,32 +333,56 @@ impl Bsdf {
         self.specular_fresnel(1.0)
     }
 
-    /// The diffuse lobe alone, f_d(wo, wi) (its Fresnel dimming included).
-    pub fn f_diffuse(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.f_lobes(wo, wi).0
+    /// The part of f the photon maps stand for (photon-cpu's estimate, the
+    /// GPU's splat): every lobe at least `GATHER_ROUGHNESS` rough and the
+    /// diffuse one. The rest is followed by the eye ([`Bsdf::sample_followed`]).
+    pub fn f_gathered(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let (diffuse, specular) = self.f_lobes(wo, wi);
+        let specular = if self.gathers_specular() { specular } else { Rgb::ZERO };
+        if self.has_coat() { self.coated_gathered(wo, wi, diffuse, specular) } else { diffuse + specular }
     }
 
-    /// The microfacet lobe alone (zero on smooth surfaces, whose mirror is a delta).
-    pub fn f_specular(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.f_lobes(wo, wi).1
-    }
-
-    /// The photon maps stand for this surface's whole BRDF: its specular
-    /// lobe, if any, is at least `GATHER_ROUGHNESS` rough.
+    /// The base's specular lobe, if any, is at least `GATHER_ROUGHNESS`
+    /// rough: the photon maps stand for it.
     pub fn gathers_specular(&self) -> bool {
         self.roughness >= GATHER_ROUGHNESS
     }
 
     /// Photons are stored here: some lobe is estimated from the photon maps.
     pub fn stores_photons(&self) -> bool {
-        self.has_diffuse() || (self.has_specular() && self.gathers_specular())
+        self.has_diffuse()
+            || (self.has_specular() && self.gathers_specular())
+            || (self.has_coat() && self.coat_is_gathered())
     }
 
-    /// A direction from the specular lobe alone, for an eye path that
-    /// follows it (surfaces smoother than `GATHER_ROUGHNESS`): `weight` is
+    /// Some lobe is followed by the eye rather than estimated from the
+    /// photon maps: the base's specular or the coat, smoother than
+    /// `GATHER_ROUGHNESS`.
+    pub fn follows_any(&self) -> bool {
+        (self.has_specular() && !self.gathers_specular()) || (self.has_coat() && !self.coat_is_gathered())
+    }
+
+    /// A direction from the lobes the eye follows (`follows_any`), one of
+    /// them chosen by its weight at `wo` (`u.x` chooses, then is reused):
+    /// `weight` is f_k·cos/(P_k·pdf_k) of the chosen lobe k, a mirror's
+    /// Fresnel over P_k. None when no lobe is followed or the sampled
+    /// reflection points below the surface.
+    pub fn sample_followed(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+        if self.has_coat() { self.coated_sample_followed(wo, u) } else { self.base_sample_followed(wo, u) }
+    }
+
+    /// `sample_followed` of the base's specular lobe, if it is followed.
+    pub(crate) fn base_sample_followed(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+        if self.gathers_specular() {
+            return None;
+        }
+        self.sample_specular_lobe(wo, u)
+    }
+
+    /// A direction from the base's specular lobe alone: `weight` is
     /// f_s·cos/pdf_s, the mirror's Fresnel on smooth surfaces. None when the
     /// lobe is absent or the sampled reflection points below the surface.
-    pub fn sample_specular(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
+    pub(crate) fn sample_specular_lobe(&self, wo: Vec3, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 || !self.has_specular() {
             return None;
         }
@@ -328,7 +395,7 @@ impl Bsdf {
                 pdf: 1.0,
                 weight: fresnel,
                 is_delta: true,
-                specular: true,
+                followed: true,
             });
         }
         let alpha = self.alpha();
@@ -338,8 +405,9 @@ impl Bsdf {
         if wi.z <= 0.0 || pdf <= 0.0 {
             return None;
         }
-        let f = self.f_specular(wo, wi);
-        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, specular: true })
+        let f = self.f_lobes(wo, wi).1;
+        let followed = !self.gathers_specular();
+        Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed })
     }
 
     /// A rough directional albedo for Russian roulette: the lobe weights
@@ -349,6 +417,11 @@ impl Bsdf {
     /// roughness 1, see the furnace tests), so it overestimates rough
     /// materials; it is ≤ 1 per channel whenever base_color is.
     pub fn albedo_estimate(&self) -> Rgb {
+        if self.has_coat() { self.coated_albedo_estimate() } else { self.base_albedo_estimate() }
+    }
+
+    /// `albedo_estimate` of the base lobes.
+    pub(crate) fn base_albedo_estimate(&self) -> Rgb {
         let average = |f0: Rgb| f0 + (Rgb::ONE - f0) / 21.0;
         let f_dielectric = self.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
         let diffuse = self.base_color * ((1.0 - self.metallic) * (1.0 - f_dielectric));
@@ -392,7 +465,7 @@ pub(crate) mod tests {
     use std::f64::consts::PI as PI64;
 
     fn white(metallic: f32, roughness: f32) -> Bsdf {
-        Bsdf { base_color: Rgb::ONE, metallic, roughness, specular: 1.0 }
+        Bsdf::new(Rgb::ONE, metallic, roughness, 1.0)
     }
 
     fn mirror_direction(wo: Vec3) -> Vec3 {
@@ -430,14 +503,15 @@ pub(crate) mod tests {
         lobes + mirror
     }
 
-    /// Directional albedo as the mean sample weight (zero for no sample):
-    /// (mean, standard error).
-    fn albedo_by_sampling(bsdf: &Bsdf, wo: Vec3, n: usize, seed: u64) -> (f64, f64) {
+    /// The mean of `weight(u_lobe, u)` over `n` draws of a generator seeded
+    /// by `seed`, with its standard error: a sampler's directional albedo
+    /// when `weight` is a sample's mean weight (zero for no sample).
+    pub(crate) fn mean_weight(n: usize, seed: u64, weight: impl Fn(f32, Vec2) -> f64) -> (f64, f64) {
         let mut rng = Rng::for_item(seed, 0);
         let (mut sum, mut sum2) = (0.0f64, 0.0f64);
         for _ in 0..n {
             let u_lobe = rng.next_f32();
-            let w = bsdf.sample(wo, u_lobe, rng.next_2d()).map_or(0.0, |s| mean(s.weight) as f64);
+            let w = weight(u_lobe, rng.next_2d());
             sum += w;
             sum2 += w * w;
         }
@@ -445,9 +519,14 @@ pub(crate) mod tests {
         (m, ((sum2 / n as f64 - m * m).max(0.0) / n as f64).sqrt())
     }
 
+    /// Directional albedo as the mean sample weight: (mean, standard error).
+    fn albedo_by_sampling(bsdf: &Bsdf, wo: Vec3, n: usize, seed: u64) -> (f64, f64) {
+        mean_weight(n, seed, |u_lobe, u| bsdf.sample(wo, u_lobe, u).map_or(0.0, |s| mean(s.weight) as f64))
+    }
+
     #[test]
     fn mixed_material_samples_match_its_pdf() {
-        let bsdf = Bsdf { base_color: Rgb::new(0.8, 0.5, 0.2), metallic: 0.5, roughness: 0.4, specular: 1.0 };
+        let bsdf = Bsdf::new(Rgb::new(0.8, 0.5, 0.2), 0.5, 0.4, 1.0);
         for deg in [30.0, 70.0] {
             let wo = direction_at(deg);
             // `sample` gives up on microfacet reflections below the surface;
@@ -585,7 +664,7 @@ pub(crate) mod tests {
     fn lambertian_setting_is_exactly_lambert() {
         let rho = Rgb::new(0.7, 0.4, 0.1);
         let bsdf = Bsdf::diffuse(rho);
-        assert_eq!(bsdf, Bsdf { base_color: rho, metallic: 0.0, roughness: 1.0, specular: 0.0 });
+        assert_eq!(bsdf, Bsdf::new(rho, 0.0, 1.0, 0.0));
         assert!(bsdf.has_diffuse() && !bsdf.has_specular() && !bsdf.is_delta());
         let mut rng = Rng::for_item(3, 0);
         for _ in 0..10_000 {
@@ -636,7 +715,7 @@ pub(crate) mod tests {
         for metallic in [0.0, 1.0] {
             for deg in [0.0, 45.0, 80.0] {
                 let wo = direction_at(deg);
-                let below = Bsdf { base_color: base, metallic, roughness: SMOOTH_ROUGHNESS * 0.999, specular: 1.0 };
+                let below = Bsdf::new(base, metallic, SMOOTH_ROUGHNESS * 0.999, 1.0);
                 let at = Bsdf { roughness: SMOOTH_ROUGHNESS, ..below };
                 assert!(below.is_delta() && !at.is_delta());
                 let (a_below, a_at) = (albedo_by_quadrature(&below, wo), albedo_by_quadrature(&at, wo));
@@ -648,7 +727,7 @@ pub(crate) mod tests {
 
     #[test]
     fn nothing_below_the_surface() {
-        let bsdf = Bsdf { base_color: Rgb::splat(0.5), metallic: 0.3, roughness: 0.5, specular: 1.0 };
+        let bsdf = Bsdf::new(Rgb::splat(0.5), 0.3, 0.5, 1.0);
         let (up, down) = (direction_at(30.0), -direction_at(50.0));
         assert_eq!(bsdf.sample(down, 0.5, Vec2::splat(0.5)), None);
         for (wo, wi) in [(up, down), (down, up), (down, down)] {

@@ -225,7 +225,7 @@ impl PathTracer<'_> {
                     power *= s.weight / survive;
                     // A bounce off a lobe the eye follows (smoother than the
                     // gather threshold) makes caustics, as a mirror does.
-                    if s.specular && !bsdf.gathers_specular() {
+                    if s.followed {
                         specular_bounces += 1;
                     } else {
                         diffuse_bounces += 1;

@@ -279,10 +279,9 @@ impl<'a> PhotonCpuRenderer<'a> {
             Material::Pbr(bsdf) => {
                 let frame = ShadingFrame::new(ns);
                 let wo = frame.to_local(-ray.dir);
-                let whole = bsdf.gathers_specular();
-                // The lobes the photon maps and shadow rays stand for: all of
-                // f on rough surfaces, the diffuse one on smoother ones.
-                let part = |wi: glam::Vec3| if whole { bsdf.f(wo, wi) } else { bsdf.f_diffuse(wo, wi) };
+                // The lobes the photon maps stand for: the diffuse one and
+                // every lobe at least GATHER_ROUGHNESS rough.
+                let part = |wi: glam::Vec3| bsdf.f_gathered(wo, wi);
                 let mut l = Rgb::ZERO;
                 if self.settings.components.direct {
                     // Direct light through every non-delta lobe, by shadow rays.
@@ -293,9 +292,9 @@ impl<'a> PhotonCpuRenderer<'a> {
                 // A lobe smoother than the gather threshold is followed, one
                 // sampled direction per eye ray. A glossy (non-delta) one
                 // leaves out what it sees emitted: its shadow rays counted that.
-                if !whole
+                if bsdf.follows_any()
                     && can_recurse
-                    && let Some(s) = bsdf.sample_specular(wo, rng.next_2d())
+                    && let Some(s) = bsdf.sample_followed(wo, rng.next_2d())
                 {
                     let next = Ray::new(hit.point, frame.to_world(s.wi));
                     l += s.weight * self.radiance_seen(&next, depth + 1, s.is_delta, rng);

@@ -64,6 +64,9 @@ pub struct MaterialDesc {
     pub metallic: Option<f32>,
     pub roughness: Option<f32>,
     pub specular: Option<f32>,
+    /// A clear coat over a pbr material (KHR_materials_clearcoat).
+    pub clearcoat: Option<f32>,
+    pub clearcoat_roughness: Option<f32>,
 }
 
 #[derive(Deserialize, Debug)]

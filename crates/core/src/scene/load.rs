@@ -464,6 +464,8 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
         ("metallic", m.metallic.is_some()),
         ("roughness", m.roughness.is_some()),
         ("specular", m.specular.is_some()),
+        ("clearcoat", m.clearcoat.is_some()),
+        ("clearcoat_roughness", m.clearcoat_roughness.is_some()),
     ];
     match m.kind.as_str() {
         "diffuse" => {
@@ -490,14 +492,24 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
             }))
         }
         "pbr" => {
-            p.only("a pbr material", &given, &["base_color", "metallic", "roughness", "specular"])?;
+            p.only(
+                "a pbr material",
+                &given,
+                &["base_color", "metallic", "roughness", "specular", "clearcoat", "clearcoat_roughness"],
+            )?;
             let unit = |field: &str, v: Option<f32>, default: f32| p.in_range(field, v.unwrap_or(default), (0.0, 1.0));
-            Ok(Material::from_bsdf(crate::bsdf::Bsdf::new(
-                p.color("base_color", p.required("base_color", m.base_color)?, 1.0)?,
-                unit("metallic", m.metallic, 0.0)?,
-                unit("roughness", m.roughness, 0.5)?,
-                unit("specular", m.specular, 1.0)?,
-            )))
+            Ok(Material::from_bsdf(
+                crate::bsdf::Bsdf::new(
+                    p.color("base_color", p.required("base_color", m.base_color)?, 1.0)?,
+                    unit("metallic", m.metallic, 0.0)?,
+                    unit("roughness", m.roughness, 0.5)?,
+                    unit("specular", m.specular, 1.0)?,
+                )
+                .with_clearcoat(
+                    unit("clearcoat", m.clearcoat, 0.0)?,
+                    unit("clearcoat_roughness", m.clearcoat_roughness, 0.0)?,
+                ),
+            ))
         }
         other => Err(p.error(format!("unknown material type \"{other}\" (expected diffuse, mirror, glass or pbr)"))),
     }
@@ -912,6 +924,23 @@ intensity = [1.0, 1.0, 1.0]
             Ok(_) => panic!("scene was accepted:\n{text}"),
             Err(e) => e,
         }
+    }
+
+    /// A pbr material takes a clear coat; out of range is a located
+    /// error, and glass refuses one.
+    #[test]
+    fn pbr_materials_take_a_clear_coat() {
+        let coated = BASE.replace(
+            "type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]",
+            "type = \"pbr\"\nbase_color = [0.5, 0.1, 0.1]\nclearcoat = 1.0\nclearcoat_roughness = 0.1",
+        );
+        let s = parse(&coated, "test.toml", SceneFiles::beside(None)).unwrap();
+        let Material::Pbr(b) = s.materials[0] else { panic!("{:?}", s.materials[0]) };
+        assert_eq!((b.clearcoat, b.clearcoat_roughness), (1.0, 0.1));
+        let e = err(&coated.replace("clearcoat = 1.0", "clearcoat = 1.5"));
+        assert!(e.to_string().contains("clearcoat") && e.to_string().contains("test.toml"), "{e}");
+        let glass = BASE.replace("type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", "type = \"glass\"\nclearcoat = 1.0");
+        assert!(err(&glass).to_string().contains("clearcoat"));
     }
 
     #[test]

@@ -11,6 +11,8 @@ override TEXTURED: bool = true;
 override CUT_OUTS: bool = true;
 // Some surface reflects by the glTF BRDF's specular lobe (`Surface::glossy`).
 override GLOSSY: bool = true;
+// Some glossy surface has a clear coat (`Surface::clearcoat`; bsdf.wgsl's coat).
+override COATED: bool = true;
 // Some light is a sky or an emissive mesh (light_eval.wgsl's `sampled_radiance`).
 override SAMPLED_LIGHTS: bool = true;
 // The sky is an image (environment.wgsl).

@@ -20,6 +20,7 @@ pub struct SceneFeatures {
     pub textured: bool,
     pub cut_outs: bool,
     pub glossy: bool,
+    pub coated: bool,
     pub sampled_lights: bool,
     pub sky_image: bool,
     pub media: bool,
@@ -31,6 +32,7 @@ impl SceneFeatures {
         textured: false,
         cut_outs: false,
         glossy: false,
+        coated: false,
         sampled_lights: false,
         sky_image: false,
         media: false,
@@ -39,6 +41,7 @@ impl SceneFeatures {
         textured: true,
         cut_outs: true,
         glossy: true,
+        coated: true,
         sampled_lights: true,
         sky_image: true,
         media: true,
@@ -55,6 +58,7 @@ impl SceneFeatures {
             }),
             cut_outs: surfaces.iter().any(|s| s.alpha_cutoff >= 0.0),
             glossy: surfaces.iter().any(|s| s.glossy != 0),
+            coated: surfaces.iter().any(|s| s.glossy != 0 && s.clearcoat > 0.0),
             sampled_lights: lights.iter().any(|l| matches!(l, Light::Environment { .. } | Light::Mesh(_))),
             sky_image: lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. })),
             media,
@@ -67,6 +71,7 @@ impl SceneFeatures {
             textured: self.textured || other.textured,
             cut_outs: self.cut_outs || other.cut_outs,
             glossy: self.glossy || other.glossy,
+            coated: self.coated || other.coated,
             sampled_lights: self.sampled_lights || other.sampled_lights,
             sky_image: self.sky_image || other.sky_image,
             media: self.media || other.media,
@@ -86,6 +91,7 @@ impl SceneFeatures {
             ("TEXTURED", self.textured),
             ("CUT_OUTS", self.cut_outs),
             ("GLOSSY", self.glossy),
+            ("COATED", self.coated),
             ("SAMPLED_LIGHTS", self.sampled_lights),
             ("SKY_IMAGE", self.sky_image),
             ("MEDIA", self.media),
@@ -109,6 +115,7 @@ mod tests {
             ("TEXTURED", 0.0),
             ("CUT_OUTS", 1.0),
             ("GLOSSY", 1.0),
+            ("COATED", 1.0),
             ("SAMPLED_LIGHTS", 0.0),
             ("SKY_IMAGE", 1.0),
             ("MEDIA", 1.0),
@@ -126,5 +133,8 @@ mod tests {
         let showcase = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb");
         let showcase = SceneFeatures::of_scene(&Scene::load(showcase).unwrap());
         assert!(showcase.glossy && showcase.sampled_lights && !showcase.sky_image, "{showcase:?}");
+        assert!(!showcase.coated);
+        let coated = hikari_core::test_scenes::coated_box(hikari_core::test_scenes::glossy_lights::QUAD, 8);
+        assert!(SceneFeatures::of_scene(&coated).coated);
     }
 }

@@ -36,7 +36,7 @@ pub fn has_specular_surfaces(scene: &Scene) -> bool {
                 .as_ref()
                 .and_then(|t| t.materials.get(s.material as usize).copied().flatten())
                 .is_some_and(|t| t.metallic_roughness.is_some());
-            bsdf.has_specular() && (!bsdf.gathers_specular() || textured)
+            bsdf.follows_any() || (bsdf.has_specular() && textured)
         }
         Material::Emitter => false,
     })

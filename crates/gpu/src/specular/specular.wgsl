@@ -300,13 +300,15 @@ struct Branch {
 // eye follows (smoother than GATHER_ROUGHNESS; the photon maps stand for
 // rougher ones).
 fn follows_lobe(s: Surface, b: Bsdf) -> bool {
-    return GLOSSY && s.kind == 0u && s.glossy != 0u && b.roughness < GATHER_ROUGHNESS;
+    return GLOSSY && s.kind == 0u && s.glossy != 0u && bsdf_follows_any(b);
 }
 
 // Whether surface `s` may follow its lobe somewhere: smooth enough, or
 // made so by a metallic–roughness texture.
 fn may_follow_lobe(s: Surface) -> bool {
-    return GLOSSY && s.kind == 0u && s.glossy != 0u && (s.roughness < GATHER_ROUGHNESS || s.metallic_roughness_texture != NO_TEXTURE);
+    return GLOSSY && s.kind == 0u && s.glossy != 0u
+        && (s.roughness < GATHER_ROUGHNESS || s.metallic_roughness_texture != NO_TEXTURE
+            || (COATED && s.clearcoat > 0.0 && s.clearcoat_roughness < GATHER_ROUGHNESS));
 }
 
 const STACK: u32 = 16u;
@@ -389,7 +391,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 // A diffuse primary hit is shaded by the raster passes; here
                 // only its mirror part or followed lobe is.
                 let eye = -b.dir;
-                let bsdf = Bsdf(point.base, point.metallic, point.roughness, s.specular_factor);
+                let bsdf = point_bsdf(s, point.base, point.metallic, point.roughness);
                 let glossy = GLOSSY && s.glossy != 0u;
                 if (b.depth > 0u) {
                     if (slice.index == 0u) {
@@ -404,7 +406,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
                 if (follows_lobe(s, bsdf)) {
                     // One direction of the specular lobe per pass.
-                    let sample = bsdf_sample_specular(bsdf, to_shading(eye, n), stream_next_2d(&path_rng));
+                    let sample = bsdf_sample_followed(bsdf, to_shading(eye, n), stream_next_2d(&path_rng));
                     if (sample.valid && can_bounce && top < STACK) {
                         let dir = local_to_world(sample.wi, n);
                         stack[top] = Branch(x, b.depth + 1u, dir, select(0u, 1u, sample.is_delta), weight * sample.weight);

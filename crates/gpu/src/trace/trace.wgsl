@@ -564,8 +564,8 @@ fn trace_one(rng: ptr<function, Rng>) {
             // The glTF BRDF (photon::trace's Pbr arm): stored where the
             // photon maps stand for some lobe, then a bounce sampling the
             // whole BRDF with roulette on the sample's weight.
-            let b = Bsdf(point.base, point.metallic, point.roughness, s.specular_factor);
-            if (bsdf_has_diffuse(b) || bsdf_gathers_specular(b)) {
+            let b = point_bsdf(s, point.base, point.metallic, point.roughness);
+            if (bsdf_stores_photons(b)) {
                 store_surface(x, power, ray.dir, diffuse_bounces, specular_bounces);
             }
             let u_lobe = rng_next_f32(rng);
@@ -579,7 +579,7 @@ fn trace_one(rng: ptr<function, Rng>) {
                 return;
             }
             power *= sample.weight / survive;
-            if (sample.specular && !bsdf_gathers_specular(b)) {
+            if (sample.followed) {
                 specular_bounces += 1u;
             } else {
                 diffuse_bounces += 1u;

@@ -15,7 +15,12 @@ struct Bsdf {
     metallic: f32,
     roughness: f32,
     specular: f32,
+    clearcoat: f32,
+    clearcoat_roughness: f32,
 }
+
+// The largest f32 below 1 (clearcoat.rs's ONE_BELOW).
+const ONE_BELOW: f32 = 0.99999994;
 
 // ---- ggx ----
 
@@ -104,7 +109,7 @@ fn bsdf_has_diffuse(b: Bsdf) -> bool {
     return b.metallic < 1.0 && max(b.base_color.x, max(b.base_color.y, b.base_color.z)) > 0.0;
 }
 
-// The photon maps stand for the whole BRDF (Bsdf::gathers_specular).
+// The photon maps stand for the base's specular lobe (Bsdf::gathers_specular).
 fn bsdf_gathers_specular(b: Bsdf) -> bool {
     return b.roughness >= GATHER_ROUGHNESS;
 }
@@ -163,22 +168,12 @@ fn bsdf_f_lobes(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> Lobes {
     return Lobes(diffuse, bsdf_specular_fresnel(b, cos) * (ggx_d(h, alpha) * ggx_visibility(wo, wi, alpha)));
 }
 
-fn bsdf_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+fn bsdf_base_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let lobes = bsdf_f_lobes(b, wo, wi);
     return lobes.diffuse + lobes.specular;
 }
 
-// What the photon maps stand for at this surface (photon-cpu's `part`): all
-// of f where they gather the specular lobe, else the diffuse lobe.
-fn bsdf_f_gathered(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    let lobes = bsdf_f_lobes(b, wo, wi);
-    if (bsdf_gathers_specular(b)) {
-        return lobes.diffuse + lobes.specular;
-    }
-    return lobes.diffuse;
-}
-
-fn bsdf_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+fn bsdf_base_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
@@ -200,7 +195,7 @@ struct BsdfSample {
     f: vec3<f32>,
     is_delta: bool,
     weight: vec3<f32>,
-    specular: bool,
+    followed: bool,
     valid: bool,
 }
 
@@ -208,7 +203,7 @@ fn no_bsdf_sample() -> BsdfSample {
     return BsdfSample(vec3<f32>(0.0), 0.0, vec3<f32>(0.0), false, vec3<f32>(0.0), false, false);
 }
 
-fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
+fn bsdf_base_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
     if (wo.z <= 0.0) {
         return no_bsdf_sample();
     }
@@ -230,16 +225,16 @@ fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample 
     if (wi.z <= 0.0) {
         return no_bsdf_sample();
     }
-    let pdf = bsdf_pdf(b, wo, wi);
+    let pdf = bsdf_base_pdf(b, wo, wi);
     if (pdf <= 0.0) {
         return no_bsdf_sample();
     }
-    let f = bsdf_f(b, wo, wi);
-    return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), specular, true);
+    let f = bsdf_base_f(b, wo, wi);
+    return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), specular && !bsdf_gathers_specular(b), true);
 }
 
-// A direction from the specular lobe alone (Bsdf::sample_specular).
-fn bsdf_sample_specular(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
+// A direction from the base's specular lobe alone (Bsdf::sample_specular_lobe).
+fn bsdf_sample_specular_lobe(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     if (wo.z <= 0.0 || !bsdf_has_specular(b)) {
         return no_bsdf_sample();
     }
@@ -255,7 +250,239 @@ fn bsdf_sample_specular(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
         return no_bsdf_sample();
     }
     let f = bsdf_f_lobes(b, wo, wi).specular;
-    return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), true, true);
+    return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), !bsdf_gathers_specular(b), true);
+}
+
+// Bsdf::base_albedo_estimate.
+fn bsdf_base_albedo_estimate(b: Bsdf) -> vec3<f32> {
+    let f_dielectric = b.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+    let diffuse = b.base_color * ((1.0 - b.metallic) * (1.0 - f_dielectric));
+    let average = b.base_color + (vec3<f32>(1.0) - b.base_color) / 21.0;
+    return diffuse + vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * average;
+}
+
+// ---- the clear coat (bsdf::clearcoat) ----
+
+// COATED (features.wgsl) folds the coat's code away in scenes without one.
+fn bsdf_has_coat(b: Bsdf) -> bool {
+    return COATED && b.clearcoat > 0.0;
+}
+
+fn coat_is_smooth(b: Bsdf) -> bool {
+    return b.clearcoat_roughness < SMOOTH_ROUGHNESS;
+}
+
+fn coat_is_gathered(b: Bsdf) -> bool {
+    return b.clearcoat_roughness >= GATHER_ROUGHNESS;
+}
+
+fn coat_alpha(b: Bsdf) -> f32 {
+    return max(b.clearcoat_roughness * b.clearcoat_roughness, ALPHA_MIN);
+}
+
+fn coat_fresnel(b: Bsdf, cos: f32) -> f32 {
+    return b.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * schlick_weight(cos));
+}
+
+fn coat_transmission(b: Bsdf, cos: f32) -> f32 {
+    return 1.0 - coat_fresnel(b, cos);
+}
+
+fn coat_diffuse_through(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
+    let mean_reflectance = b.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+    return coat_transmission(b, cos_o) * coat_transmission(b, cos_i) / (1.0 - mean_reflectance);
+}
+
+fn coat_specular_through(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
+    return sqrt(coat_transmission(b, cos_o) * coat_transmission(b, cos_i));
+}
+
+fn under_coat(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, diffuse: vec3<f32>, specular: vec3<f32>) -> vec3<f32> {
+    return diffuse * coat_diffuse_through(b, wo.z, wi.z) + specular * coat_specular_through(b, wo.z, wi.z);
+}
+
+fn coat_lobe(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (coat_is_smooth(b)) {
+        return 0.0;
+    }
+    let h = unit(wo + wi);
+    let cos = 0.5 * (dot(wo, h) + dot(wi, h));
+    let alpha = coat_alpha(b);
+    return coat_fresnel(b, cos) * ggx_d(h, alpha) * ggx_visibility(wo, wi, alpha);
+}
+
+fn coat_probability(b: Bsdf, cos_o: f32) -> f32 {
+    let coat = coat_fresnel(b, cos_o);
+    let e = bsdf_base_albedo_estimate(b);
+    let base = (1.0 - coat) * max(e.x, max(e.y, e.z));
+    if (coat + base <= 0.0) {
+        return 0.0;
+    }
+    return coat / (coat + base);
+}
+
+fn coated_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (wo.z <= 0.0 || wi.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let lobes = bsdf_f_lobes(b, wo, wi);
+    return under_coat(b, wo, wi, lobes.diffuse, lobes.specular) + vec3<f32>(coat_lobe(b, wo, wi));
+}
+
+fn coated_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (wo.z <= 0.0 || wi.z <= 0.0) {
+        return 0.0;
+    }
+    let p = coat_probability(b, wo.z);
+    var pdf = (1.0 - p) * bsdf_base_pdf(b, wo, wi);
+    if (!coat_is_smooth(b)) {
+        pdf += p * ggx_reflection_pdf(wo, unit(wo + wi), coat_alpha(b));
+    }
+    return pdf;
+}
+
+fn coated_finish(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, followed: bool) -> BsdfSample {
+    if (wi.z <= 0.0) {
+        return no_bsdf_sample();
+    }
+    let pdf = coated_pdf(b, wo, wi);
+    if (pdf <= 0.0) {
+        return no_bsdf_sample();
+    }
+    let f = coated_f(b, wo, wi);
+    return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), followed, true);
+}
+
+fn coated_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
+    if (wo.z <= 0.0) {
+        return no_bsdf_sample();
+    }
+    let p = coat_probability(b, wo.z);
+    if (u_lobe < p) {
+        if (coat_is_smooth(b)) {
+            let fc = coat_fresnel(b, wo.z);
+            return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p, vec3<f32>(fc / wo.z), true, vec3<f32>(fc / p), true, true);
+        }
+        let wi = ggx_reflect(wo, ggx_sample_visible_normal(wo, coat_alpha(b), u));
+        return coated_finish(b, wo, wi, !coat_is_gathered(b));
+    }
+    let s = bsdf_base_sample(b, wo, min((u_lobe - p) / (1.0 - p), ONE_BELOW), u);
+    if (!s.valid) {
+        return s;
+    }
+    if (s.is_delta) {
+        let through = coat_transmission(b, wo.z);
+        let pdf = (1.0 - p) * s.pdf;
+        return BsdfSample(s.wi, pdf, s.f * through, true, s.f * (through * wo.z / pdf), s.followed, true);
+    }
+    return coated_finish(b, wo, s.wi, s.followed);
+}
+
+fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
+    if (wo.z <= 0.0) {
+        return no_bsdf_sample();
+    }
+    var coat = 0.0;
+    if (!coat_is_gathered(b)) {
+        coat = coat_fresnel(b, wo.z);
+    }
+    var base = 0.0;
+    if (bsdf_has_specular(b) && !bsdf_gathers_specular(b)) {
+        base = coat_transmission(b, wo.z) * max(rgb_mean(bsdf_specular_fresnel(b, wo.z)), MIN_LOBE_WEIGHT);
+    }
+    if (coat + base <= 0.0) {
+        return no_bsdf_sample();
+    }
+    let p = coat / (coat + base);
+    if (u.x < p) {
+        let uc = vec2<f32>(min(u.x / p, ONE_BELOW), u.y);
+        if (coat_is_smooth(b)) {
+            let fc = coat_fresnel(b, wo.z);
+            return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p, vec3<f32>(fc / wo.z), true, vec3<f32>(fc / p), true, true);
+        }
+        let alpha = coat_alpha(b);
+        let h = ggx_sample_visible_normal(wo, alpha, uc);
+        let wi = ggx_reflect(wo, h);
+        let pdf = p * ggx_reflection_pdf(wo, h, alpha);
+        if (wi.z <= 0.0 || pdf <= 0.0) {
+            return no_bsdf_sample();
+        }
+        let f = vec3<f32>(coat_lobe(b, wo, wi));
+        return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), true, true);
+    }
+    let ub = vec2<f32>(min((u.x - p) / (1.0 - p), ONE_BELOW), u.y);
+    let s = bsdf_sample_specular_lobe(b, wo, ub);
+    if (!s.valid) {
+        return s;
+    }
+    let through = coat_specular_through(b, wo.z, s.wi.z);
+    return BsdfSample(s.wi, (1.0 - p) * s.pdf, s.f * through, s.is_delta, s.weight * (through / (1.0 - p)), s.followed, true);
+}
+
+// ---- the whole BSDF: the base, under the coat where there is one ----
+
+fn bsdf_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (bsdf_has_coat(b)) {
+        return coated_f(b, wo, wi);
+    }
+    return bsdf_base_f(b, wo, wi);
+}
+
+fn bsdf_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (bsdf_has_coat(b)) {
+        return coated_pdf(b, wo, wi);
+    }
+    return bsdf_base_pdf(b, wo, wi);
+}
+
+fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample {
+    if (bsdf_has_coat(b)) {
+        return coated_sample(b, wo, u_lobe, u);
+    }
+    return bsdf_base_sample(b, wo, u_lobe, u);
+}
+
+// What the photon maps stand for at this surface (Bsdf::f_gathered): the
+// diffuse lobe and every lobe at least GATHER_ROUGHNESS rough.
+fn bsdf_f_gathered(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let lobes = bsdf_f_lobes(b, wo, wi);
+    var specular = vec3<f32>(0.0);
+    if (bsdf_gathers_specular(b)) {
+        specular = lobes.specular;
+    }
+    if (!bsdf_has_coat(b)) {
+        return lobes.diffuse + specular;
+    }
+    if (wo.z <= 0.0 || wi.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    var coat = 0.0;
+    if (coat_is_gathered(b)) {
+        coat = coat_lobe(b, wo, wi);
+    }
+    return under_coat(b, wo, wi, lobes.diffuse, specular) + vec3<f32>(coat);
+}
+
+// Photons are stored here (Bsdf::stores_photons).
+fn bsdf_stores_photons(b: Bsdf) -> bool {
+    return bsdf_has_diffuse(b) || (bsdf_has_specular(b) && bsdf_gathers_specular(b))
+        || (bsdf_has_coat(b) && coat_is_gathered(b));
+}
+
+// Some lobe is followed by the eye (Bsdf::follows_any).
+fn bsdf_follows_any(b: Bsdf) -> bool {
+    return (bsdf_has_specular(b) && !bsdf_gathers_specular(b)) || (bsdf_has_coat(b) && !coat_is_gathered(b));
+}
+
+// A direction from the lobes the eye follows (Bsdf::sample_followed).
+fn bsdf_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
+    if (bsdf_has_coat(b)) {
+        return coated_sample_followed(b, wo, u);
+    }
+    if (bsdf_gathers_specular(b)) {
+        return no_bsdf_sample();
+    }
+    return bsdf_sample_specular_lobe(b, wo, u);
 }
 
 // World direction `w` in the shading frame around unit `n`
@@ -268,7 +495,13 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // The BRDF of a glossy kind-0 surface whose base colour is `base` (the
 // G-buffer's, textures applied; `s.albedo` where no texture is).
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
-    return Bsdf(base, s.metallic, s.roughness, s.specular_factor);
+    return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness);
+}
+
+// The BRDF of glossy surface `s` at a point whose textures gave `base`,
+// `metallic` and `roughness` (textures.wgsl's `surface_point`).
+fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsdf {
+    return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness);
 }
 
 // The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the

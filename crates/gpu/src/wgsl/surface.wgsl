@@ -5,7 +5,8 @@
 // `two_sided` is 1; emissive meshes emit from surfaces of any kind. A
 // kind-0 surface with `glossy` 1 reflects by the glTF BRDF (bsdf.wgsl) of
 // base colour `albedo` (the G-buffer's, with textures), `metallic`,
-// `roughness` and `specular_factor`; otherwise it is Lambertian.
+// `roughness`, `specular_factor` and `clearcoat` (with its roughness);
+// otherwise it is Lambertian.
 
 struct Surface {
     albedo: vec3<f32>,
@@ -30,5 +31,7 @@ struct Surface {
     // The normal texture and its scale (surface_point.wgsl's `bent_normal`).
     normal_texture: u32,
     normal_scale: f32,
-    _pad: vec2<u32>,
+    // The clear coat over the glTF BRDF (bsdf.wgsl; 0: none).
+    clearcoat: f32,
+    clearcoat_roughness: f32,
 }

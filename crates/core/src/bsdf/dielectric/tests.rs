@@ -36,16 +36,9 @@ fn albedo_by_quadrature(g: &Dielectric, wo: Vec3, mode: Transport) -> f64 {
 }
 
 fn albedo_by_sampling(g: &Dielectric, wo: Vec3, mode: Transport, n: usize) -> (f64, f64) {
-    let mut rng = Rng::for_item(0xD1E1, 0);
-    let (mut sum, mut sum2) = (0.0f64, 0.0f64);
-    for _ in 0..n {
-        let u_lobe = rng.next_f32();
-        let w = g.sample(wo, u_lobe, rng.next_2d(), mode).map_or(0.0, |s| mean(s.weight) as f64);
-        sum += w;
-        sum2 += w * w;
-    }
-    let m = sum / n as f64;
-    (m, ((sum2 / n as f64 - m * m).max(0.0) / n as f64).sqrt())
+    crate::bsdf::tests::mean_weight(n, 0xD1E1, |u_lobe, u| {
+        g.sample(wo, u_lobe, u, mode).map_or(0.0, |s| mean(s.weight) as f64)
+    })
 }
 
 #[test]

@@ -192,7 +192,7 @@ fn advance(
             let frame = ShadingFrame::new(ns);
             let wo = frame.to_local(-path.ray.dir);
             // Light sampling finds nothing through a mirror alone.
-            if bsdf.has_diffuse() || !bsdf.is_delta() {
+            if bsdf.has_non_delta_lobe() {
                 let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
                 let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
                 path.l += path.beta * next_event(scene, hit.point, ns, brdf, pdf, sampler);

@@ -216,7 +216,7 @@ impl Scatter {
     /// Every lobe is a delta: no connection or merge can use this vertex.
     pub fn is_delta(&self) -> bool {
         match self.lobes {
-            Lobes::Pbr(bsdf) => bsdf.is_delta() && !bsdf.has_diffuse(),
+            Lobes::Pbr(bsdf) => !bsdf.has_non_delta_lobe(),
             Lobes::Lambert { p_diffuse, .. } => p_diffuse == 0.0,
             Lobes::Glass(glass, _) => glass.is_smooth(),
             Lobes::Medium(_) => false,

@@ -4,6 +4,7 @@
 //! test can load the same scene from both formats and compare the images).
 
 use super::LUMENS_PER_WATT;
+use super::materials::CLEARCOAT;
 use crate::light::Light;
 use crate::material::{Material, Rgb};
 use crate::scene::Scene;
@@ -27,6 +28,9 @@ pub struct PbrMaterial {
     /// `KHR_materials_specular`'s factor: 1 is glTF's default dielectric
     /// (F0 = 0.04), 0 a pure Lambertian.
     pub specular: f32,
+    /// `KHR_materials_clearcoat`'s factor and roughness (factor 0: none).
+    pub clearcoat: f32,
+    pub clearcoat_roughness: f32,
     pub double_sided: bool,
     /// `baseColorFactor`'s alpha.
     pub alpha: f32,
@@ -50,6 +54,8 @@ impl Default for PbrMaterial {
             emission: Rgb::ZERO,
             glass_ior: None,
             specular: 1.0,
+            clearcoat: 0.0,
+            clearcoat_roughness: 0.0,
             double_sided: true,
             alpha: 1.0,
             alpha_cutoff: None,
@@ -184,6 +190,16 @@ impl GltfBuilder {
                 specular_color_texture: None,
                 extras: Default::default(),
             });
+        }
+        if m.clearcoat > 0.0 {
+            // gltf-json has no type for it: written as raw JSON.
+            extensions.others.insert(
+                CLEARCOAT.into(),
+                json::Value::from_iter([
+                    ("clearcoatFactor", json::Value::from(m.clearcoat)),
+                    ("clearcoatRoughnessFactor", json::Value::from(m.clearcoat_roughness)),
+                ]),
+            );
         }
         if let Some(ior) = m.glass_ior {
             extensions.transmission = Some(json::extensions::material::Transmission {
@@ -432,6 +448,7 @@ impl GltfBuilder {
                 (ext.is_some_and(|e| e.ior.is_some()), "KHR_materials_ior"),
                 (ext.is_some_and(|e| e.emissive_strength.is_some()), "KHR_materials_emissive_strength"),
                 (ext.is_some_and(|e| e.specular.is_some()), "KHR_materials_specular"),
+                (ext.is_some_and(|e| e.others.contains_key(CLEARCOAT)), CLEARCOAT),
             ] {
                 if used && !self.root.extensions_used.iter().any(|e| e == name) {
                     self.root.extensions_used.push(name.into());
@@ -504,6 +521,8 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
                 metallic: b.metallic,
                 roughness: b.roughness,
                 specular: b.specular,
+                clearcoat: b.clearcoat,
+                clearcoat_roughness: b.clearcoat_roughness,
                 ..Default::default()
             },
             (Material::Mirror { reflectance }, _) => {

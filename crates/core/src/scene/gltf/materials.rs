@@ -45,6 +45,9 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut approximated = 0;
     let mut blended = 0;
     let mut coloured_specular = 0;
+    let mut coat_textures = 0;
+    let mut malformed_coats = 0;
+    let mut coated_glass = 0;
     let mut textures = Vec::new();
     let (mut materials, mut emissions): (Vec<Material>, Vec<Option<Emission>>) = doc
         .materials()
@@ -72,7 +75,11 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let metallic = sane(Vec3::splat(pbr.metallic_factor()), 1.0).x;
             let roughness = sane(Vec3::splat(pbr.roughness_factor()), 1.0).x;
             let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+            let coat = Clearcoat::of(&m);
+            coat_textures += coat.textured as usize;
+            malformed_coats += coat.malformed as usize;
             let material = if transmission >= 0.5 {
+                coated_glass += (coat.factor > 0.0) as usize;
                 approximated += (transmission < 1.0) as usize;
                 // The base colour tints what crosses (glTF's BTDF, and Cycles').
                 Material::Glass(Dielectric { ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0), roughness, tint: base })
@@ -82,7 +89,10 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 // Fresnel (0: a pure Lambertian, as hikari's "diffuse").
                 let specular = m.specular().map_or(1.0, |s| s.specular_factor());
                 coloured_specular += m.specular().is_some_and(|s| s.specular_color_factor() != [1.0; 3]) as usize;
-                Material::from_bsdf(Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x))
+                Material::from_bsdf(
+                    Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
+                        .with_clearcoat(coat.factor, coat.roughness),
+                )
             };
             // An emissive texture varies the radiance over the surface; the
             // light (uniform over its mesh) emits the texture's mean.
@@ -134,10 +144,60 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     if coloured_specular > 0 {
         notes.push(format!("{coloured_specular} material(s) have a specularColorFactor, which is ignored (white)"));
     }
+    if coat_textures > 0 {
+        notes.push(format!(
+            "{coat_textures} material(s) have clear-coat textures, which are not read yet: their clearcoatFactor and \
+             clearcoatRoughnessFactor apply uniformly"
+        ));
+    }
+    if malformed_coats > 0 {
+        notes.push(format!(
+            "{malformed_coats} material(s) have a KHR_materials_clearcoat factor that is not a number: read as 0"
+        ));
+    }
+    if coated_glass > 0 {
+        notes.push(format!("{coated_glass} transmissive material(s) have a clear coat, which is ignored on glass"));
+    }
     if blended > 0 {
         notes.push(format!("{blended} material(s) with alphaMode BLEND are rendered opaque"));
     }
     Converted { materials, emissions, textures, names }
+}
+
+/// The extension's name, as it appears in a material's `extensions`
+/// (gltf 1.4 has no type for it: read from the JSON).
+pub const CLEARCOAT: &str = "KHR_materials_clearcoat";
+
+/// A material's `KHR_materials_clearcoat` (factor 0 without it).
+struct Clearcoat {
+    factor: f32,
+    roughness: f32,
+    /// It names a texture (coat, coat roughness or coat normal).
+    textured: bool,
+    /// A factor is not a number (read as the default, 0).
+    malformed: bool,
+}
+
+impl Clearcoat {
+    fn of(m: &gltf::Material) -> Clearcoat {
+        let Some(v) = m.extension_value(CLEARCOAT) else {
+            return Clearcoat { factor: 0.0, roughness: 0.0, textured: false, malformed: false };
+        };
+        let malformed = ["clearcoatFactor", "clearcoatRoughnessFactor"]
+            .iter()
+            .any(|key| v.get(*key).is_some_and(|x| !x.is_number()));
+        // The specification's defaults are 0.
+        let number = |key: &str| sane(Vec3::splat(v.get(key).and_then(|x| x.as_f64()).unwrap_or(0.0) as f32), 1.0).x;
+        let textured = ["clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"]
+            .iter()
+            .any(|key| v.get(*key).is_some());
+        Clearcoat {
+            factor: number("clearcoatFactor"),
+            roughness: number("clearcoatRoughnessFactor"),
+            textured,
+            malformed,
+        }
+    }
 }
 
 /// Each component made finite and clamped to [0, max] (the specification's

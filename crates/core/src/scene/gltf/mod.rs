@@ -43,6 +43,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_specular",
+    materials::CLEARCOAT,
     "KHR_texture_transform",
     "KHR_mesh_quantization",
     compressed::MESHOPT,

@@ -286,13 +286,13 @@ fn indices_beyond_the_vertices_are_refused() {
 fn unused_optional_extensions_are_one_note() {
     let (mut root, bin) = valid();
     root.extensions_used.push("KHR_materials_sheen".into());
-    root.extensions_used.push("KHR_materials_clearcoat".into());
+    root.extensions_used.push("KHR_materials_anisotropy".into());
     let dir = folder("optional");
     let path = write(&dir, "o.glb", &glb(&root, bin));
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
     let ext_notes: Vec<&String> = scene.notes.iter().filter(|n| n.contains("extensions ignored")).collect();
     assert_eq!(ext_notes.len(), 1);
-    assert_says(ext_notes[0], &["KHR_materials_sheen", "KHR_materials_clearcoat"]);
+    assert_says(ext_notes[0], &["KHR_materials_sheen", "KHR_materials_anisotropy"]);
 }
 
 /// A TOML scene whose one `[[object]]` is `object` (its fields), with a
@@ -353,6 +353,41 @@ fn loading_reports_progress_per_placed_primitive() {
     crate::scene::Scene::load_with_progress(path.to_str().unwrap(), &options, &recorder).unwrap();
     let stages = recorder.0.into_inner().unwrap();
     assert_eq!(stages, vec![("reading meshes".to_string(), 2, 2), ("building the BVH".to_string(), 1, 1)]);
+}
+
+/// `KHR_materials_clearcoat`'s factors are read (not noted as ignored);
+/// its textures, not yet read, are noted; a coat over a Lambertian base
+/// keeps the material glossy.
+#[test]
+fn the_clearcoat_extension_is_read() {
+    let mut b = GltfBuilder::new();
+    let coat = PbrMaterial {
+        base_color: Vec3::splat(0.5),
+        specular: 0.0,
+        clearcoat: 0.8,
+        clearcoat_roughness: 0.25,
+        ..Default::default()
+    };
+    let m = b.material(&coat);
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let (mut root, bin) = b.finish(vec![node]);
+    let dir = folder("clearcoat");
+    let path = write(&dir, "c.glb", &glb(&root, bin.clone()));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(!scene.notes.iter().any(|n| n.contains("clearcoat") || n.contains("ignored")), "{:?}", scene.notes);
+    assert_eq!(
+        scene.materials[0],
+        Material::Pbr(crate::bsdf::Bsdf::new(Vec3::splat(0.5), 0.0, 1.0, 0.0).with_clearcoat(0.8, 0.25))
+    );
+    // A coat texture is named: the factors still apply, with a note.
+    let ext = root.materials[0].extensions.as_mut().unwrap();
+    let value = ext.others.get_mut(materials::CLEARCOAT).unwrap().as_object_mut().unwrap();
+    value.insert("clearcoatTexture".into(), json::Value::from_iter([("index", json::Value::from(0))]));
+    let path = write(&dir, "t.glb", &glb(&root, bin));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(scene.notes.iter().any(|n| n.contains("clear-coat textures")), "{:?}", scene.notes);
+    assert!(matches!(scene.materials[0], Material::Pbr(b) if b.clearcoat == 0.8));
 }
 
 /// `KHR_materials_specular` is read, not listed as ignored: its factor 0

@@ -1,0 +1,43 @@
+# What the scripts comparing hikari with Cycles share: the sky written as
+# an EXR for hikari's --environment, the glTF export and the Cycles render
+# (GGX, 64 bounces of every kind, no denoising, linear EXR output).
+import bpy, os
+import numpy as np, OpenEXR, Imath
+
+
+def box(loc, size, material):
+    bpy.ops.mesh.primitive_cube_add(location=loc)
+    o = bpy.context.object
+    o.scale = (size[0] / 2, size[1] / 2, size[2] / 2)
+    bpy.ops.object.transform_apply(scale=True)
+    o.data.materials.append(material)
+
+
+def constant_sky(scene, out, sky):
+    """A constant world of colour `sky`, and OUT/sky.exr (8x4) with the same."""
+    world = bpy.data.worlds.new("w"); scene.world = world; world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (*sky, 1)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    # Written directly: a Blender image saved as EXR goes through its colour
+    # management (0.8 came out as 0.906).
+    header = OpenEXR.Header(8, 4)
+    header["channels"] = {c: Imath.Channel(Imath.PixelType(Imath.PixelType.FLOAT)) for c in "RGB"}
+    exr = OpenEXR.OutputFile(os.path.join(out, "sky.exr"), header)
+    exr.writePixels({c: np.full(32, v, np.float32).tobytes() for c, v in zip("RGB", sky)})
+    exr.close()
+
+
+def export_and_render(scene, out, name, size=(240, 160)):
+    """OUT/NAME.glb (Blender's glTF export) and OUT/cycles.exr at `size`."""
+    scene.render.resolution_x, scene.render.resolution_y = size
+    bpy.ops.export_scene.gltf(filepath=os.path.join(out, name + ".glb"), export_format="GLB",
+                              export_lights=True, export_cameras=True)
+    scene.render.engine = "CYCLES"; scene.cycles.samples = int(os.environ.get("SPP", "1024"))
+    scene.cycles.device = "CPU"; scene.cycles.use_denoising = False
+    for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces", "transparent_max_bounces"):
+        setattr(scene.cycles, attr, 64)
+    scene.cycles.blur_glossy = 0.0
+    scene.render.image_settings.file_format = "OPEN_EXR"; scene.render.image_settings.color_depth = "32"
+    scene.view_settings.view_transform = "Standard"
+    scene.render.filepath = os.path.join(out, "cycles.exr")
+    bpy.ops.render.render(write_still=True)
