@@ -15,6 +15,35 @@ pub fn direct_diffuse(scene: &Scene, x: Vec3, normal: Vec3, albedo: Rgb, area_sa
     direct_reflected(scene, x, normal, |_| albedo / PI, area_samples, rng)
 }
 
+/// Which lights a surface point's light sampling reaches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LitSides {
+    /// Those above the normal: the surface only reflects.
+    Front,
+    /// Those on both sides: a rough glass boundary also transmits (the
+    /// cosine is |ω_i · n|; a light beyond is seen through the boundary).
+    Both,
+    /// All lights above the normal, and below it only point, spot and sun
+    /// lights: for a renderer whose sampled transmitted directions count
+    /// the area lights and skies they meet (photon-cpu), and so would miss
+    /// only the lights no direction meets.
+    FrontAndDeltaBehind,
+}
+
+impl LitSides {
+    /// |cos θ| of `wi` about `normal` where a light (`delta` or not) on
+    /// that side is sampled here, else ≤ 0.
+    pub fn cos(self, wi: Vec3, normal: Vec3, delta: bool) -> f32 {
+        let cos = wi.dot(normal);
+        match self {
+            LitSides::Front => cos,
+            LitSides::Both => cos.abs(),
+            LitSides::FrontAndDeltaBehind if delta => cos.abs(),
+            LitSides::FrontAndDeltaBehind => cos,
+        }
+    }
+}
+
 /// Reflected radiance ∫ f_r(ω_i) L_i cos θ dω from all lights, sampled as
 /// [`direct_diffuse`] does; `brdf` is f_r for the world direction ω_i
 /// toward the light (the viewer's direction fixed by the caller).
@@ -26,6 +55,20 @@ pub fn direct_reflected(
     area_samples: u32,
     rng: &mut Rng,
 ) -> Rgb {
+    direct_scattered(scene, x, normal, LitSides::Front, brdf, area_samples, rng)
+}
+
+/// [`direct_reflected`] from the lights on `sides` of `normal`: with
+/// `LitSides::Both`, `bsdf` is f for reflected and transmitted ω_i alike.
+pub fn direct_scattered(
+    scene: &Scene,
+    x: Vec3,
+    normal: Vec3,
+    sides: LitSides,
+    bsdf: impl Fn(Vec3) -> Rgb,
+    area_samples: u32,
+    rng: &mut Rng,
+) -> Rgb {
     let mut sum = Rgb::ZERO;
     for light in &scene.lights {
         let samples = if light.is_delta() { 1 } else { area_samples.max(1) };
@@ -34,7 +77,7 @@ pub fn direct_reflected(
             let Some(s) = light.sample_incident(x, rng.next_2d()) else {
                 continue;
             };
-            let cos = s.wi.dot(normal);
+            let cos = sides.cos(s.wi, normal, s.is_delta);
             if cos <= 0.0 || s.pdf <= 0.0 {
                 continue;
             }
@@ -42,7 +85,7 @@ pub fn direct_reflected(
             shadow.t_max = s.distance * (1.0 - 1e-4);
             if !scene.accel.occluded(&shadow) {
                 let transmittance = scene.media.transmittance(x, s.wi, s.distance);
-                light_sum += brdf(s.wi) * s.radiance * transmittance * (cos / s.pdf);
+                light_sum += bsdf(s.wi) * s.radiance * transmittance * (cos / s.pdf);
             }
         }
         sum += light_sum / samples as f32;

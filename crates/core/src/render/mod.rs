@@ -9,7 +9,7 @@ pub mod photon_cpu;
 pub mod vcm;
 
 pub use self::image::Image;
-pub use direct::{direct_diffuse, direct_reflected};
+pub use direct::{LitSides, direct_diffuse, direct_reflected, direct_scattered};
 
 use crate::camera::Camera;
 use crate::material::Rgb;

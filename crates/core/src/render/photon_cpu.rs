@@ -6,7 +6,7 @@
 //! (from the eye or a mirror or glass) see the sky; emissive surfaces seen
 //! add their light to what their material reflects.
 
-use super::{Image, direct_diffuse, direct_reflected, render_pixels};
+use super::{Image, LitSides, direct_diffuse, direct_reflected, direct_scattered, render_pixels};
 use crate::bsdf::ShadingFrame;
 use crate::bsdf::dielectric::Transport;
 use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf};
@@ -255,16 +255,22 @@ impl<'a> PhotonCpuRenderer<'a> {
                     }
                     return l;
                 }
-                // Rough glass: lights on this side by shadow rays through the
-                // reflection, then one sampled direction per eye ray; a
-                // reflected one leaves out what its shadow rays counted.
+                // Rough glass: lights on this side by shadow rays through
+                // the reflection, and point, spot and sun lights beyond by
+                // shadow rays through the transmission (a shadow ray stops
+                // at glass, so a light beyond the far side of a glass body is
+                // counted where the path leaves it). Then one sampled
+                // direction per eye ray: a transmitted one counts the area
+                // lights and skies it meets, a reflected one leaves out
+                // what its shadow rays counted.
                 let frame = ShadingFrame::new(hit.geometric_normal);
                 let wo = frame.to_local(-ray.dir);
                 let mut l = Rgb::ZERO;
                 if self.settings.components.direct {
                     let ng = hit.geometric_normal * facing;
                     let f = |wi: glam::Vec3| glass.f(wo, frame.to_local(wi), Transport::Radiance);
-                    l += direct_reflected(self.scene, hit.point, ng, f, self.settings.area_light_samples, rng);
+                    let samples = self.settings.area_light_samples;
+                    l += direct_scattered(self.scene, hit.point, ng, LitSides::FrontAndDeltaBehind, f, samples, rng);
                 }
                 if can_recurse {
                     let u_lobe = rng.next_f32();

@@ -15,7 +15,7 @@
 
 mod lanes;
 
-use super::{Image, finite_mean, render_row_batches};
+use super::{Image, LitSides, finite_mean, render_row_batches};
 use crate::bsdf::ShadingFrame;
 use crate::bsdf::dielectric::Transport;
 use crate::geometry::Ray;
@@ -166,12 +166,14 @@ fn advance(
                 // The boundary's own frame: +z its outward (geometric) normal.
                 let frame = ShadingFrame::new(hit.geometric_normal);
                 let wo = frame.to_local(-path.ray.dir);
-                // Lights on this side, through the rough reflection (shadow
-                // rays stop at glass, so lights beyond it are left to the
-                // transmitted samples, which count what they hit in full).
+                // Lights on both sides, through the rough reflection and
+                // transmission (a point light behind frosted glass glows
+                // through it; shadow rays stop at glass, so a light beyond
+                // the glass's far side is the transmitted samples' alone,
+                // as MIS expects).
                 let f = |wi: Vec3| glass.f(wo, frame.to_local(wi), Transport::Radiance);
                 let pdf = |wi: Vec3| glass.pdf(wo, frame.to_local(wi));
-                path.l += path.beta * next_event(scene, hit.point, ng, f, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ng, LitSides::Both, f, pdf, sampler);
             }
             let u_lobe = sampler.next_f32();
             let u = if glass.is_smooth() { Vec2::ZERO } else { sampler.next_2d() };
@@ -181,11 +183,8 @@ fn advance(
             path.beta *= s.weight;
             // Radiance crossing scales by 1/η'²; roulette looks past it.
             path.eta_scale *= s.eta * s.eta;
-            path.previous = if s.is_delta || s.transmitted {
-                Previous::Specular
-            } else {
-                Previous::Diffuse { point: hit.point, pdf: s.pdf }
-            };
+            path.previous =
+                if s.is_delta { Previous::Specular } else { Previous::Diffuse { point: hit.point, pdf: s.pdf } };
             s.wi
         }
         Material::Pbr(bsdf) => {
@@ -195,7 +194,7 @@ fn advance(
             if bsdf.has_non_delta_lobe() {
                 let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
                 let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
-                path.l += path.beta * next_event(scene, hit.point, ns, brdf, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ns, LitSides::Front, brdf, pdf, sampler);
             }
             let Some(s) = bsdf.sample(wo, sampler.next_f32(), sampler.next_2d()) else { return false };
             path.beta *= s.weight;
@@ -216,7 +215,7 @@ fn advance(
             let p_diffuse = p_d / (p_d + p_s);
             if p_d > 0.0 {
                 let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
-                path.l += path.beta * next_event(scene, hit.point, ns, |_| albedo / PI, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ns, LitSides::Front, |_| albedo / PI, pdf, sampler);
             }
             if p_s == 0.0 || sampler.next_f32() < p_diffuse {
                 path.beta *= albedo / p_diffuse;
@@ -342,13 +341,15 @@ fn sky(scene: &Scene, ray: &Ray, previous: Previous) -> Rgb {
     sum
 }
 
-/// Direct light at a vertex: one sample per light, MIS-weighted against
-/// the vertex's own sampling. `brdf` and `pdf` are f_r and the density with
-/// which the vertex samples the world direction ω_i toward the light.
+/// Direct light at a vertex from the lights on `sides` of `n`: one sample
+/// per light, MIS-weighted against the vertex's own sampling. `brdf` and
+/// `pdf` are f and the density with which the vertex samples the world
+/// direction ω_i toward the light.
 fn next_event(
     scene: &Scene,
     x: Vec3,
     n: Vec3,
+    sides: LitSides,
     brdf: impl Fn(Vec3) -> Rgb,
     pdf: impl Fn(Vec3) -> f32,
     sampler: &mut impl Sampler,
@@ -360,7 +361,7 @@ fn next_event(
         let Some(s) = light.sample_incident(x, u) else {
             continue;
         };
-        let cos = s.wi.dot(n);
+        let cos = sides.cos(s.wi, n, s.is_delta);
         if cos <= 0.0 || s.pdf <= 0.0 {
             continue;
         }
