@@ -469,3 +469,48 @@ pub fn wavy_grid_glb(triangles: u64) -> Vec<u8> {
     let light = builder.node(GltfBuilder::light_node(light, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY));
     builder.to_glb(vec![grid, light])
 }
+
+/// A frosted pane (a closed slab of rough glass, roughness 0.6) before a
+/// point light 0.55 behind it, over a grey floor, seen head-on at
+/// `size`×`size`: everything the pane's pixels show is the light glowing
+/// through its two rough boundaries.
+pub fn frosted_pane(size: u32) -> Scene {
+    let text = format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 40.0
+resolution = [{size}, {size}]
+
+[[material]]
+name = "frosted"
+type = "glass"
+roughness = 0.6
+
+[[material]]
+name = "grey"
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+
+[[object]]
+shape = "box"
+center = [0.0, 0.0, 0.0]
+size = [1.6, 1.6, 0.1]
+material = "frosted"
+
+[[object]]
+shape = "quad"
+corner = [-3.0, -1.0, -3.0]
+edge_u = [0.0, 0.0, 6.0]
+edge_v = [6.0, 0.0, 0.0]
+material = "grey"
+
+[[light]]
+type = "point"
+position = [0.0, 0.0, -0.6]
+intensity = [3.0, 3.0, 3.0]
+"#
+    );
+    Scene::from_toml(&text, "frosted-pane", None).unwrap_or_else(|e| panic!("{e}"))
+}

@@ -148,46 +148,7 @@ fn rough_glass_renders_alike_in_every_cpu_renderer() {
 /// subpaths found it. The three agree on the glow and on the whole image.
 #[test]
 fn a_point_light_glows_through_frosted_glass() {
-    let scene = Scene::from_toml(
-        r#"
-[camera]
-position = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-fov_y = 40.0
-resolution = [16, 16]
-
-[[material]]
-name = "frosted"
-type = "glass"
-roughness = 0.6
-
-[[material]]
-name = "grey"
-type = "diffuse"
-albedo = [0.5, 0.5, 0.5]
-
-[[object]]
-shape = "box"
-center = [0.0, 0.0, 0.0]
-size = [1.6, 1.6, 0.1]
-material = "frosted"
-
-[[object]]
-shape = "quad"
-corner = [-3.0, -1.0, -3.0]
-edge_u = [0.0, 0.0, 6.0]
-edge_v = [6.0, 0.0, 0.0]
-material = "grey"
-
-[[light]]
-type = "point"
-position = [0.0, 0.0, -0.6]
-intensity = [3.0, 3.0, 3.0]
-"#,
-        "frosted pane",
-        None,
-    )
-    .unwrap();
+    let scene = hikari_core::test_scenes::frosted_pane(16);
     // The glow: the pane's central quarter.
     let glow = |image: &Image| {
         let mut sum = 0.0;

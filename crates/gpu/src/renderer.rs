@@ -228,30 +228,6 @@ fn depth_range((lo, hi): (Vec3, Vec3), eye: Vec3) -> (f32, f32) {
     (far * 1e-4, far)
 }
 
-/// Why the GPU's shaders cannot draw the materials of `scene`, if so:
-/// rough glass (or glass whose roughness a texture varies) lit by point,
-/// spot or sun lights. The specular pass follows one sampled direction of
-/// rough glass per pass and sees what it meets, with no light sampling
-/// there: area lights, emissive meshes and skies converge, but the
-/// highlights of delta lights (which no sampled direction meets) would be
-/// missing. Such scenes render on the CPU, with this reason.
-pub(crate) fn undrawn_materials(scene: &Scene) -> Option<String> {
-    if !scene.lights.iter().any(|l| l.is_delta()) {
-        return None;
-    }
-    let textured = |m: usize| {
-        let textures = scene.texturing.as_ref().and_then(|t| t.materials.get(m).copied().flatten());
-        textures.is_some_and(|t| t.metallic_roughness.is_some())
-    };
-    let rough = scene.materials.iter().enumerate().any(|(m, material)| match material {
-        hikari_core::material::Material::Glass(glass) => !glass.is_smooth() || textured(m),
-        _ => false,
-    });
-    rough.then(|| {
-        "rough glass (roughness from 0.05) under point, spot or sun lights is not drawn on the GPU yet".to_string()
-    })
-}
-
 impl GpuRenderer {
     /// Why `ctx` cannot draw `scene` correctly, if so. Media need 32-bit
     /// float blending: the volume splat adds thousands of small in-scattered
@@ -259,14 +235,9 @@ impl GpuRenderer {
     /// crossings, and 16-bit sums lose both (measured on Mesa's GL: slab
     /// optical depths off by 8e-4 where they are 0, fog frames off by more
     /// than 2%).
-    ///
-    /// Rough glass under point, spot or sun lights is refused too
-    /// ([`undrawn_materials`]).
     pub fn unsupported(ctx: &GpuContext, scene: &Scene) -> Option<String> {
-        if !ctx.float32_blend && !scene.media.is_empty() {
-            return Some("participating media need 32-bit float blending, which this adapter lacks".to_string());
-        }
-        undrawn_materials(scene)
+        (!ctx.float32_blend && !scene.media.is_empty())
+            .then(|| "participating media need 32-bit float blending, which this adapter lacks".to_string())
     }
 
     /// What a frame of `scene` with `settings` allocates, for `photons`

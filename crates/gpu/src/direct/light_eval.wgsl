@@ -576,6 +576,26 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
 }
 
 // Direct radiance leaving x (normal n toward the viewer) toward the viewer.
+// The fraction of light `l`'s shadow-mapped samples seen from x (normal
+// `n`, the side they are seen from), each attenuated by the media between.
+fn shadowed_fraction(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var seen = vec3<f32>(0.0);
+    for (var k = 0u; k < l.sample_count; k++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let s = light_sample(l.first_sample + k);
+        if (visible(s, x, n)) {
+            var end = s.position;
+            if (l.kind == KIND_SUN) {
+                end = distant_start(l, x, l.axis);
+            }
+            seen += light_transmittance(x, end);
+        }
+    }
+    return seen / f32(l.sample_count);
+}
+
 fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, u32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var i = 0u; i < direct_params.light_count; i++) {
@@ -591,21 +611,7 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, 
         if (all(e == vec3<f32>(0.0))) {
             continue;
         }
-        var seen = vec3<f32>(0.0);
-        for (var k = 0u; k < l.sample_count; k++) {
-            if (!loop_iteration()) {
-                break;
-            }
-            let s = light_sample(l.first_sample + k);
-            if (visible(s, x, n)) {
-                var end = s.position;
-                if (l.kind == KIND_SUN) {
-                    end = distant_start(l, x, l.axis);
-                }
-                seen += light_transmittance(x, end);
-            }
-        }
-        let fraction = seen / f32(l.sample_count);
+        let fraction = shadowed_fraction(l, x, n);
         if (!r.glossy) {
             sum += r.albedo / PI * e * fraction;
         } else if (l.kind == 2u || l.kind == 3u) {

@@ -311,6 +311,37 @@ fn may_follow_lobe(s: Surface) -> bool {
             || (COATED && s.clearcoat > 0.0 && s.clearcoat_roughness < GATHER_ROUGHNESS));
 }
 
+// Point, spot and sun light reaching rough glass `g` at x from either side
+// of its outward normal `ng`, through its reflection and transmission
+// (glass_f in radiance mode; `wo` toward the viewer in ng's frame): the
+// lights no sampled direction meets. Area lights and skies are left to the
+// sampled directions (photon-cpu's `LitSides::FrontAndDeltaBehind`, which
+// samples those on the viewer's side instead: the same expectation).
+fn delta_light_through_glass(x: vec3<f32>, ng: vec3<f32>, g: Dielectric, wo: vec3<f32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var i = 0u; i < direct_params.light_count; i++) {
+        if (!loop_iteration()) {
+            break;
+        }
+        let l = light_record(i);
+        if (l.kind != 0u && l.kind != 1u && l.kind != KIND_SUN) {
+            continue;
+        }
+        var wi = l.axis;
+        if (l.kind != KIND_SUN) {
+            wi = unit(l.position - x);
+        }
+        // The side the light is on: its irradiance there is E |cos θ|.
+        let side = select(-ng, ng, dot(wi, ng) >= 0.0);
+        let e = unshadowed_irradiance(l, x, side);
+        if (all(e == vec3<f32>(0.0))) {
+            continue;
+        }
+        sum += glass_f(g, wo, to_shading(wi, ng), true) * e * shadowed_fraction(l, x, side);
+    }
+    return sum;
+}
+
 const STACK: u32 = 16u;
 
 // Workgroups of WORKGROUP × WORKGROUP pixels (set by the pipeline).
@@ -426,10 +457,13 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             case 2u: {
                 let g = Dielectric(s.ior, point.roughness, point.base);
                 if (!glass_is_smooth(g)) {
-                    // Rough glass: one sampled direction per pass, which sees
-                    // what it meets emitted (no light sampling here, so
-                    // nothing is counted twice; delta lights are left to the
-                    // CPU: `undrawn_materials`).
+                    // Rough glass: point, spot and sun light through it by
+                    // shadow maps (slice 0 alone: each slice would add it),
+                    // then one sampled direction per pass, which sees the
+                    // area lights and skies it meets emitted.
+                    if (slice.index == 0u) {
+                        radiance += weight * delta_light_through_glass(x, ng, g, to_shading(-b.dir, ng));
+                    }
                     let u_lobe = stream_next_f32(&path_rng);
                     let u = stream_next_2d(&path_rng);
                     let sample = glass_sample_rough(g, to_shading(-b.dir, ng), u_lobe, u, true);

@@ -460,9 +460,6 @@ impl GpuTracer {
     /// must include the scene's (tests compare `SceneFeatures::ALL`).
     #[doc(hidden)]
     pub fn with_features(ctx: &GpuContext, scene: &Scene, features: SceneFeatures) -> Result<Self, GpuError> {
-        if let Some(why) = crate::renderer::undrawn_materials(scene) {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let device = &ctx.device;
         ctx.scoped(|| {
             use crate::binding::{entry, storage, uniform};
@@ -537,9 +534,6 @@ impl GpuTracer {
 
     /// Traces from a moved or edited scene from now on.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) -> Result<(), GpuError> {
-        if let Some(why) = crate::renderer::undrawn_materials(scene) {
-            return Err(GpuError::SceneUnsupported(why));
-        }
         let features = SceneFeatures::of_scene(scene);
         if features.union(self.features) != self.features {
             let device = &ctx.device;
