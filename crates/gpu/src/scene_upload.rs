@@ -79,6 +79,10 @@ pub struct GpuSurface {
     /// roughness, where `glossy` is 1.
     pub clearcoat: f32,
     pub clearcoat_roughness: f32,
+    /// The glTF BRDF's dielectric reflectance at normal incidence
+    /// (`Bsdf::f0`, from KHR_materials_ior).
+    pub dielectric_f0: f32,
+    pub _pad: [u32; 3],
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -256,6 +260,8 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 normal_scale: textures.normal_scale,
                 clearcoat: glossy.map_or(0.0, |b| b.clearcoat),
                 clearcoat_roughness: glossy.map_or(0.0, |b| b.clearcoat_roughness),
+                dielectric_f0: glossy.map_or(hikari_core::bsdf::DIELECTRIC_F0, |b| b.f0),
+                _pad: [0; 3],
             }
         })
         .collect()

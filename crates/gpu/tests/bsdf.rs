@@ -7,10 +7,10 @@ use hikari_core::sampling::{Rng, uniform_sphere};
 use hikari_gpu::test_support::{run_kernel, test_context};
 use hikari_gpu::wgsl::BSDF;
 
-/// Words per item: 17 inputs, then the outputs the kernel writes.
-const ITEM: usize = 42;
+/// Words per item: 18 inputs, then the outputs the kernel writes.
+const ITEM: usize = 43;
 /// Input words per item.
-const INPUTS: usize = 17;
+const INPUTS: usize = 18;
 
 /// A random material, roughness spread over the smooth, followed and
 /// gathered ranges, with the extremes (black, pure metal or dielectric,
@@ -25,7 +25,9 @@ fn random_bsdf(rng: &mut Rng) -> Bsdf {
     let metallic = pick(rng, &[0.0, 1.0]);
     let roughness = pick(rng, &[0.0, 0.03, 0.2, 0.35, 1.0]);
     let specular = pick(rng, &[0.0, 1.0]);
-    let bsdf = Bsdf::new(base, metallic, roughness, specular);
+    // Half at glTF's index 1.5, the rest from 1 to 3 (KHR_materials_ior).
+    let ior = if rng.next_f32() < 0.5 { 1.5 } else { 1.0 + 2.0 * rng.next_f32() };
+    let bsdf = Bsdf::new(base, metallic, roughness, specular).with_ior(ior);
     // A third under a clear coat, smooth, followed or gathered.
     if rng.next_f32() < 0.33 { bsdf.with_clearcoat(pick(rng, &[1.0]), pick(rng, &[0.0, 0.2, 0.5])) } else { bsdf }
 }
@@ -73,6 +75,7 @@ fn wgsl_bsdf_matches_the_cpu() {
             u.y,
             b.clearcoat,
             b.clearcoat_roughness,
+            b.f0,
         ];
         for (k, w) in words.iter().enumerate() {
             item[k] = w.to_bits();
@@ -83,7 +86,7 @@ fn wgsl_bsdf_matches_the_cpu() {
         "let o = {ITEM}u * id.x; if (o >= arrayLength(&io)) {{ return; }}\n\
          var w: array<f32, {INPUTS}>;\n\
          for (var k = 0u; k < {INPUTS}u; k++) {{ w[k] = bitcast<f32>(io[o + k]); }}\n\
-         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16]);\n\
+         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16], w[17]);\n\
          let wo = vec3<f32>(w[6], w[7], w[8]);\n\
          let wi = vec3<f32>(w[9], w[10], w[11]);\n\
          let u = vec2<f32>(w[13], w[14]);\n\

@@ -104,7 +104,9 @@ fn shared_structs_match_wgsl_layouts() {
             normal_texture,
             normal_scale,
             clearcoat,
-            clearcoat_roughness
+            clearcoat_roughness,
+            dielectric_f0,
+            _pad
         ]
     );
     let splat = hikari_gpu::splat::shader_source();

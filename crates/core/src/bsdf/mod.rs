@@ -4,11 +4,13 @@
 //! # The model
 //!
 //! glTF 2.0, Appendix B ("BRDF Implementation"), with KHR_materials_specular's
-//! `specularFactor` s scaling the dielectric's Fresnel:
+//! `specularFactor` s scaling the dielectric's Fresnel and KHR_materials_ior's
+//! index η setting its reflectance at normal incidence, F0 = ((η − 1)/(η + 1))²
+//! (0.04 at glTF's default 1.5):
 //!
 //! ```text
 //! f          = mix(dielectric, metal, metallic)
-//! dielectric = (1 − s·F_d)·base/π + s·F_d·D·V     F_d = 0.04 + 0.96 (1 − |v·h|)^5
+//! dielectric = (1 − s·F_d)·base/π + s·F_d·D·V     F_d = F0 + (1 − F0)(1 − |v·h|)^5
 //! metal      = F_m·D·V                            F_m = base + (1 − base)(1 − |v·h|)^5
 //! ```
 //!
@@ -105,6 +107,10 @@ pub struct Bsdf {
     pub clearcoat: f32,
     /// The coat's perceptual roughness (α = roughness²).
     pub clearcoat_roughness: f32,
+    /// The dielectric's reflectance at normal incidence, F0 = ((η − 1)/(η +
+    /// 1))² of KHR_materials_ior's index η: `DIELECTRIC_F0` at glTF's
+    /// default 1.5 ([`Bsdf::with_ior`]).
+    pub f0: f32,
 }
 
 /// A direction drawn by [`Bsdf::sample`].
@@ -150,7 +156,18 @@ impl Bsdf {
             specular: specular.clamp(0.0, 1.0),
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
+            f0: DIELECTRIC_F0,
         }
+    }
+
+    /// This material with its dielectric of index of refraction `ior`
+    /// (KHR_materials_ior; 1.5 is glTF's default, F0 = 0.04). An index
+    /// below 1 gives the F0 of its reciprocal; non-finite ones are 1.5.
+    pub fn with_ior(self, ior: f32) -> Self {
+        let ior = if ior.is_finite() && ior > 0.0 { ior as f64 } else { 1.5 };
+        // In f64, so that 1.5 gives DIELECTRIC_F0 to the bit.
+        let r = (ior - 1.0) / (ior + 1.0);
+        Bsdf { f0: (r * r) as f32, ..self }
     }
 
     /// This material under a clear coat of factor `clearcoat` and
@@ -211,14 +228,14 @@ impl Bsdf {
     /// `cos` = |v·h|.
     fn specular_fresnel(&self, cos: f32) -> Rgb {
         let w = schlick_weight(cos);
-        let f_dielectric = self.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * w);
+        let f_dielectric = self.specular * (self.f0 + (1.0 - self.f0) * w);
         let f_metal = self.base_color + (Rgb::ONE - self.base_color) * w;
         Rgb::splat((1.0 - self.metallic) * f_dielectric) + self.metallic * f_metal
     }
 
     /// (1 − metallic)(1 − s·F_d)·base at `cos` = |v·h|: π times the diffuse lobe.
     fn diffuse_reflectance(&self, cos: f32) -> Rgb {
-        let f_dielectric = DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * schlick_weight(cos);
+        let f_dielectric = self.f0 + (1.0 - self.f0) * schlick_weight(cos);
         self.base_color * ((1.0 - self.metallic) * (1.0 - self.specular * f_dielectric))
     }
 
@@ -423,7 +440,7 @@ impl Bsdf {
     /// `albedo_estimate` of the base lobes.
     pub(crate) fn base_albedo_estimate(&self) -> Rgb {
         let average = |f0: Rgb| f0 + (Rgb::ONE - f0) / 21.0;
-        let f_dielectric = self.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+        let f_dielectric = self.specular * (self.f0 + (1.0 - self.f0) / 21.0);
         let diffuse = self.base_color * ((1.0 - self.metallic) * (1.0 - f_dielectric));
         let specular = Rgb::splat((1.0 - self.metallic) * f_dielectric) + self.metallic * average(self.base_color);
         diffuse + specular
@@ -705,6 +722,23 @@ pub(crate) mod tests {
                 assert_eq!(bsdf.pdf(wo, mirror_direction(wo)), 0.0);
             }
         }
+    }
+
+    /// KHR_materials_ior: a smooth black dielectric reflects F0 = ((η −
+    /// 1)/(η + 1))² at normal incidence (1/9 at η = 2), glTF's 4% at 1.5,
+    /// and all of it at grazing; the diffuse lobe keeps 1 − F0.
+    #[test]
+    fn the_index_of_refraction_sets_the_dielectric_reflectance() {
+        assert_eq!(Bsdf::new(Rgb::ONE, 0.0, 0.5, 1.0).with_ior(1.5), Bsdf::new(Rgb::ONE, 0.0, 0.5, 1.0));
+        let black = Bsdf::new(Rgb::ZERO, 0.0, 0.0, 1.0).with_ior(2.0);
+        let normal = black.sample(Vec3::Z, 0.0, Vec2::ZERO).unwrap();
+        assert!(normal.is_delta && (normal.weight.x * normal.pdf - 1.0 / 9.0).abs() < 1e-6, "{normal:?}");
+        let grazing = black.sample(direction_at(89.99), 0.0, Vec2::ZERO).unwrap();
+        assert!((grazing.weight.x * grazing.pdf - 1.0).abs() < 1e-3);
+        let white = Bsdf::new(Rgb::ONE, 0.0, 0.0, 1.0).with_ior(2.0);
+        assert!((white.lambert_albedo().x - (1.0 - 1.0 / 9.0)).abs() < 1e-6);
+        // An index below 1 reflects as its reciprocal does.
+        assert!((Bsdf::new(Rgb::ONE, 0.0, 0.5, 1.0).with_ior(0.5).f0 - 1.0 / 9.0).abs() < 1e-6);
     }
 
     #[test]

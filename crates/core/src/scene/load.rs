@@ -495,7 +495,7 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
             p.only(
                 "a pbr material",
                 &given,
-                &["base_color", "metallic", "roughness", "specular", "clearcoat", "clearcoat_roughness"],
+                &["base_color", "metallic", "roughness", "specular", "ior", "clearcoat", "clearcoat_roughness"],
             )?;
             let unit = |field: &str, v: Option<f32>, default: f32| p.in_range(field, v.unwrap_or(default), (0.0, 1.0));
             Ok(Material::from_bsdf(
@@ -508,7 +508,8 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
                 .with_clearcoat(
                     unit("clearcoat", m.clearcoat, 0.0)?,
                     unit("clearcoat_roughness", m.clearcoat_roughness, 0.0)?,
-                ),
+                )
+                .with_ior(p.in_range("ior", m.ior.unwrap_or(1.5), (1.0, 3.0))?),
             ))
         }
         other => Err(p.error(format!("unknown material type \"{other}\" (expected diffuse, mirror, glass or pbr)"))),
@@ -937,6 +938,11 @@ intensity = [1.0, 1.0, 1.0]
         let s = parse(&coated, "test.toml", SceneFiles::beside(None)).unwrap();
         let Material::Pbr(b) = s.materials[0] else { panic!("{:?}", s.materials[0]) };
         assert_eq!((b.clearcoat, b.clearcoat_roughness), (1.0, 0.1));
+        // A pbr material takes an index of refraction (F0 = 1/9 at 2).
+        let s = parse(&coated.replace("clearcoat = 1.0", "ior = 2.0"), "test.toml", SceneFiles::beside(None)).unwrap();
+        let Material::Pbr(b) = s.materials[0] else { panic!("{:?}", s.materials[0]) };
+        assert!((b.f0 - 1.0 / 9.0).abs() < 1e-6 && b.clearcoat == 0.0);
+        assert!(err(&coated.replace("clearcoat = 1.0", "ior = 0.5")).to_string().contains("ior"));
         let e = err(&coated.replace("clearcoat = 1.0", "clearcoat = 1.5"));
         assert!(e.to_string().contains("clearcoat") && e.to_string().contains("test.toml"), "{e}");
         let glass = BASE.replace("type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", "type = \"glass\"\nclearcoat = 1.0");

@@ -17,6 +17,8 @@ struct Bsdf {
     specular: f32,
     clearcoat: f32,
     clearcoat_roughness: f32,
+    // The dielectric's reflectance at normal incidence (KHR_materials_ior).
+    f0: f32,
 }
 
 // The largest f32 below 1 (clearcoat.rs's ONE_BELOW).
@@ -116,13 +118,13 @@ fn bsdf_gathers_specular(b: Bsdf) -> bool {
 
 fn bsdf_specular_fresnel(b: Bsdf, cos: f32) -> vec3<f32> {
     let w = schlick_weight(cos);
-    let f_dielectric = b.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * w);
+    let f_dielectric = b.specular * (b.f0 + (1.0 - b.f0) * w);
     let f_metal = b.base_color + (vec3<f32>(1.0) - b.base_color) * w;
     return vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * f_metal;
 }
 
 fn bsdf_diffuse_reflectance(b: Bsdf, cos: f32) -> vec3<f32> {
-    let f_dielectric = DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * schlick_weight(cos);
+    let f_dielectric = b.f0 + (1.0 - b.f0) * schlick_weight(cos);
     return b.base_color * ((1.0 - b.metallic) * (1.0 - b.specular * f_dielectric));
 }
 
@@ -255,7 +257,7 @@ fn bsdf_sample_specular_lobe(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample
 
 // Bsdf::base_albedo_estimate.
 fn bsdf_base_albedo_estimate(b: Bsdf) -> vec3<f32> {
-    let f_dielectric = b.specular * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+    let f_dielectric = b.specular * (b.f0 + (1.0 - b.f0) / 21.0);
     let diffuse = b.base_color * ((1.0 - b.metallic) * (1.0 - f_dielectric));
     let average = b.base_color + (vec3<f32>(1.0) - b.base_color) / 21.0;
     return diffuse + vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * average;
@@ -495,13 +497,13 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // The BRDF of a glossy kind-0 surface whose base colour is `base` (the
 // G-buffer's, textures applied; `s.albedo` where no texture is).
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
-    return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness);
+    return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0);
 }
 
 // The BRDF of glossy surface `s` at a point whose textures gave `base`,
 // `metallic` and `roughness` (textures.wgsl's `surface_point`).
 fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsdf {
-    return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness);
+    return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0);
 }
 
 // The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the

@@ -34,4 +34,7 @@ struct Surface {
     // The clear coat over the glTF BRDF (bsdf.wgsl; 0: none).
     clearcoat: f32,
     clearcoat_roughness: f32,
+    // The glTF BRDF's dielectric reflectance at normal incidence.
+    dielectric_f0: f32,
+    _pad: array<u32, 3>,
 }

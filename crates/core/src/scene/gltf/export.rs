@@ -28,6 +28,9 @@ pub struct PbrMaterial {
     /// `KHR_materials_specular`'s factor: 1 is glTF's default dielectric
     /// (F0 = 0.04), 0 a pure Lambertian.
     pub specular: f32,
+    /// `KHR_materials_ior` of an opaque material (1.5, glTF's default: not
+    /// written).
+    pub ior: f32,
     /// `KHR_materials_clearcoat`'s factor and roughness (factor 0: none).
     pub clearcoat: f32,
     pub clearcoat_roughness: f32,
@@ -54,6 +57,7 @@ impl Default for PbrMaterial {
             emission: Rgb::ZERO,
             glass_ior: None,
             specular: 1.0,
+            ior: 1.5,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
             double_sided: true,
@@ -200,6 +204,12 @@ impl GltfBuilder {
                     ("clearcoatRoughnessFactor", json::Value::from(m.clearcoat_roughness)),
                 ]),
             );
+        }
+        if m.glass_ior.is_none() && m.ior != 1.5 {
+            extensions.ior = Some(json::extensions::material::Ior {
+                ior: json::extensions::material::IndexOfRefraction(m.ior),
+                extras: Default::default(),
+            });
         }
         if let Some(ior) = m.glass_ior {
             extensions.transmission = Some(json::extensions::material::Transmission {
@@ -523,6 +533,8 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
                 specular: b.specular,
                 clearcoat: b.clearcoat,
                 clearcoat_roughness: b.clearcoat_roughness,
+                // F0 = ((η − 1)/(η + 1))² back to η ≥ 1.
+                ior: (1.0 + b.f0.sqrt()) / (1.0 - b.f0.sqrt()),
                 ..Default::default()
             },
             (Material::Mirror { reflectance }, _) => {

@@ -2,8 +2,9 @@
 //! [`Material::Pbr`] (the specification's BRDF, `crate::bsdf`); a
 //! transmissive material (`KHR_materials_transmission` ≥ 0.5) is glass
 //! ([`Dielectric`]) of the base colour's tint, the roughness and
-//! `KHR_materials_ior`; `KHR_materials_specular`'s factor scales
-//! the dielectric's Fresnel (its colour is ignored). Base-colour,
+//! `KHR_materials_ior` (which also sets an opaque dielectric's
+//! reflectance); `KHR_materials_specular`'s factor scales the
+//! dielectric's Fresnel (its colour is ignored). Base-colour,
 //! metallic–roughness, emissive and normal textures are read
 //! (`crate::texture`; normal maps bend the CPU renderers' shading normals);
 //! occlusion textures are not. `alphaMode` MASK makes cut-outs,
@@ -89,9 +90,11 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 // Fresnel (0: a pure Lambertian, as hikari's "diffuse").
                 let specular = m.specular().map_or(1.0, |s| s.specular_factor());
                 coloured_specular += m.specular().is_some_and(|s| s.specular_color_factor() != [1.0; 3]) as usize;
+                // KHR_materials_ior sets the dielectric's reflectance.
                 Material::from_bsdf(
                     Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
-                        .with_clearcoat(coat.factor, coat.roughness),
+                        .with_clearcoat(coat.factor, coat.roughness)
+                        .with_ior(m.ior().unwrap_or(1.5).clamp(1.0, 3.0)),
                 )
             };
             // An emissive texture varies the radiance over the surface; the

@@ -390,6 +390,28 @@ fn the_clearcoat_extension_is_read() {
     assert!(matches!(scene.materials[0], Material::Pbr(b) if b.clearcoat == 0.8));
 }
 
+/// `KHR_materials_ior` sets an opaque dielectric's reflectance at normal
+/// incidence (it was read for glass alone): index 2 reflects 1/9, and the
+/// exporter writes it back.
+#[test]
+fn the_ior_extension_is_read_for_opaque_materials() {
+    let mut b = GltfBuilder::new();
+    let m = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), roughness: 0.3, ior: 2.0, ..Default::default() });
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let dir = folder("ior");
+    write(&dir, "i.glb", &b.to_glb(vec![node]));
+    let scene = crate::scene::Scene::from_toml(&placing("gltf = \"i.glb\""), "t.toml", Some(&dir)).unwrap();
+    assert!(!scene.notes.iter().any(|n| n.contains("ior")), "{:?}", scene.notes);
+    let Material::Pbr(bsdf) = scene.materials[0] else { panic!("{:?}", scene.materials[0]) };
+    assert!((bsdf.f0 - 1.0 / 9.0).abs() < 1e-6, "{}", bsdf.f0);
+    let again = super::export::scene_to_glb(&scene).unwrap();
+    let path = write(&dir, "again.glb", &again);
+    let reloaded = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    let Material::Pbr(back) = reloaded.materials[0] else { panic!("{:?}", reloaded.materials[0]) };
+    assert!((back.f0 - bsdf.f0).abs() < 1e-5, "{} against {}", back.f0, bsdf.f0);
+}
+
 /// `KHR_materials_specular` is read, not listed as ignored: its factor 0
 /// makes an exact Lambertian (as hikari's own diffuse material).
 #[test]
