@@ -159,15 +159,7 @@ impl Bsdf {
         let p = self.coat_probability(wo.z);
         if u_lobe < p {
             if self.coat_is_smooth() {
-                let fc = self.coat_fresnel(wo.z);
-                return Some(BsdfSample {
-                    wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                    f: Rgb::splat(fc / wo.z),
-                    pdf: p,
-                    weight: Rgb::splat(fc / p),
-                    is_delta: true,
-                    followed: true,
-                });
+                return Some(self.coat_mirror(wo, p));
             }
             let wi = ggx::reflect(wo, ggx::sample_visible_normal(wo, self.coat_alpha(), u));
             return self.coated_finish(wo, wi, !self.coat_is_gathered());
@@ -181,6 +173,19 @@ impl Bsdf {
             return Some(BsdfSample { f: s.f * through, pdf, weight: s.f * (through * wo.z / pdf), ..s });
         }
         self.coated_finish(wo, s.wi, s.followed)
+    }
+
+    /// The smooth coat's mirror at `wo`, chosen with probability `p`.
+    fn coat_mirror(&self, wo: Vec3, p: f32) -> BsdfSample {
+        let fc = self.coat_fresnel(wo.z);
+        BsdfSample {
+            wi: Vec3::new(-wo.x, -wo.y, wo.z),
+            f: Rgb::splat(fc / wo.z),
+            pdf: p,
+            weight: Rgb::splat(fc / p),
+            is_delta: true,
+            followed: true,
+        }
     }
 
     fn coated_finish(&self, wo: Vec3, wi: Vec3, followed: bool) -> Option<BsdfSample> {
@@ -215,15 +220,7 @@ impl Bsdf {
         if u.x < p {
             let u = Vec2::new((u.x / p).min(ONE_BELOW), u.y);
             if self.coat_is_smooth() {
-                let fc = self.coat_fresnel(wo.z);
-                return Some(BsdfSample {
-                    wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                    f: Rgb::splat(fc / wo.z),
-                    pdf: p,
-                    weight: Rgb::splat(fc / p),
-                    is_delta: true,
-                    followed: true,
-                });
+                return Some(self.coat_mirror(wo, p));
             }
             let alpha = self.coat_alpha();
             let h = ggx::sample_visible_normal(wo, alpha, u);

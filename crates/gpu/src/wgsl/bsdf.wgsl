@@ -343,6 +343,12 @@ fn coated_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     return pdf;
 }
 
+// The smooth coat's mirror at wo, chosen with probability p.
+fn coat_mirror(b: Bsdf, wo: vec3<f32>, p: f32) -> BsdfSample {
+    let fc = coat_fresnel(b, wo.z);
+    return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p, vec3<f32>(fc / wo.z), true, vec3<f32>(fc / p), true, true);
+}
+
 fn coated_finish(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, followed: bool) -> BsdfSample {
     if (wi.z <= 0.0) {
         return no_bsdf_sample();
@@ -362,8 +368,7 @@ fn coated_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSampl
     let p = coat_probability(b, wo.z);
     if (u_lobe < p) {
         if (coat_is_smooth(b)) {
-            let fc = coat_fresnel(b, wo.z);
-            return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p, vec3<f32>(fc / wo.z), true, vec3<f32>(fc / p), true, true);
+            return coat_mirror(b, wo, p);
         }
         let wi = ggx_reflect(wo, ggx_sample_visible_normal(wo, coat_alpha(b), u));
         return coated_finish(b, wo, wi, !coat_is_gathered(b));
@@ -399,8 +404,7 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     if (u.x < p) {
         let uc = vec2<f32>(min(u.x / p, ONE_BELOW), u.y);
         if (coat_is_smooth(b)) {
-            let fc = coat_fresnel(b, wo.z);
-            return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p, vec3<f32>(fc / wo.z), true, vec3<f32>(fc / p), true, true);
+            return coat_mirror(b, wo, p);
         }
         let alpha = coat_alpha(b);
         let h = ggx_sample_visible_normal(wo, alpha, uc);
