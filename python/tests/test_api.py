@@ -419,3 +419,22 @@ def test_clear_coat_edited_and_rendered():
     assert clear.clearcoat is None
     with pytest.raises(ValueError, match="has none"):
         clear.clearcoat = 0.5
+
+
+def test_sheen_edited_and_rendered():
+    scene = hk.load(pathlib.Path(__file__).resolve().parents[2] / "scenes" / "showcase.glb")
+    pbr = next(m for m in scene.materials.values() if m.kind == "pbr" and max(m.emission) == 0)
+    assert pbr.sheen_color == (0.0, 0.0, 0.0)
+    before = scene.render("path", **small(spp=2))
+    pbr.sheen_color = (1.0, 0.8, 0.6)
+    pbr.sheen_roughness = 0.3
+    assert pbr.sheen_color == pytest.approx((1.0, 0.8, 0.6)) and pbr.sheen_roughness == pytest.approx(0.3)
+    after = scene.render("path", **small(spp=2))
+    assert not np.array_equal(after, before), "the sheen changed nothing"
+    with pytest.raises(ValueError, match="sheen_color"):
+        pbr.sheen_color = (1.5, 0.0, 0.0)
+    glass = hk.load("cornell-caustic")
+    clear = next(m for m in glass.materials.values() if m.kind == "glass")
+    assert clear.sheen_color is None
+    with pytest.raises(ValueError, match="has none"):
+        clear.sheen_roughness = 0.5

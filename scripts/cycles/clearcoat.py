@@ -11,9 +11,9 @@
 #   hikari render OUT/clearcoat.glb --environment OUT/sky.exr --renderer path \
 #       --resolution 240x160 --spp 512 -o path.exr
 #   python shared/relerr.py path.exr OUT/cycles.exr
-import bpy, sys, math, os
+import bpy, sys, os
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import box, constant_sky, export_and_render
+from common import balls_before_a_wall, constant_sky, export_and_render
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
@@ -30,21 +30,12 @@ def principled(name, color, roughness, metallic=0.0, coat=0.0, coat_roughness=0.
     p.inputs["Coat IOR"].default_value = 1.5
     return m
 grey = principled("grey", (0.6, 0.6, 0.6), 1.0, specular=0.0)
-box((0, 0, -0.05), (10, 6, 0.1), grey)      # floor
-box((0, 2.0, 1.5), (10, 0.2, 3), grey)      # back wall
 balls = [
     (-2.7, principled("plain red", (0.63, 0.07, 0.05), 0.6)),
     (-0.9, principled("car paint", (0.63, 0.07, 0.05), 0.6, coat=1.0, coat_roughness=0.0)),
     (0.9, principled("coated gold", (0.9, 0.75, 0.45), 0.4, metallic=1.0, coat=1.0, coat_roughness=0.2)),
     (2.7, principled("coated matte", (0.1, 0.2, 0.6), 1.0, specular=0.0, coat=1.0, coat_roughness=0.5)),
 ]
-for x, mat in balls:
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=0.8, location=(x, 0, 0.8))
-    o = bpy.context.object; bpy.ops.object.shade_smooth(); o.data.materials.append(mat)
-bpy.ops.object.light_add(type="POINT", location=(1.5, -2.5, 3.5))
-light = bpy.context.object; light.data.energy = 800.0; light.data.shadow_soft_size = 0.0
-bpy.ops.object.camera_add(location=(0, -7, 1.8)); cam = bpy.context.object
-cam.rotation_euler = (math.radians(83), 0, 0); cam.data.lens = 30
-scene.camera = cam
+balls_before_a_wall(scene, grey, balls)
 constant_sky(scene, out, (0.5, 0.55, 0.6))
 export_and_render(scene, out, "clearcoat")

@@ -1,7 +1,7 @@
 # What the scripts comparing hikari with Cycles share: the sky written as
 # an EXR for hikari's --environment, the glTF export and the Cycles render
 # (GGX, 64 bounces of every kind, no denoising, linear EXR output).
-import bpy, os
+import bpy, math, os
 import numpy as np, OpenEXR, Imath
 
 
@@ -11,6 +11,22 @@ def box(loc, size, material):
     o.scale = (size[0] / 2, size[1] / 2, size[2] / 2)
     bpy.ops.object.transform_apply(scale=True)
     o.data.materials.append(material)
+
+
+def balls_before_a_wall(scene, floor_material, balls):
+    """A floor and a back wall of `floor_material`, a ball of radius 0.8 at
+    each (x, material) of `balls`, an 800 W point light of radius 0 and the
+    camera the comparisons share."""
+    box((0, 0, -0.05), (10, 6, 0.1), floor_material)      # floor
+    box((0, 2.0, 1.5), (10, 0.2, 3), floor_material)      # back wall
+    for x, mat in balls:
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=0.8, location=(x, 0, 0.8))
+        o = bpy.context.object; bpy.ops.object.shade_smooth(); o.data.materials.append(mat)
+    bpy.ops.object.light_add(type="POINT", location=(1.5, -2.5, 3.5))
+    light = bpy.context.object; light.data.energy = 800.0; light.data.shadow_soft_size = 0.0
+    bpy.ops.object.camera_add(location=(0, -7, 1.8)); cam = bpy.context.object
+    cam.rotation_euler = (math.radians(83), 0, 0); cam.data.lens = 30
+    scene.camera = cam
 
 
 def constant_sky(scene, out, sky):

@@ -40,7 +40,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub no_tracing: bool,
     /// Pipelines made as if every scene also used these features
-    /// (comma-separated: textured, cut-outs, glossy, coated,
+    /// (comma-separated: textured, cut-outs, glossy, coated, sheened,
     /// sampled-lights, sky-image, media, or all): what each costs a scene without it.
     #[arg(long, value_delimiter = ',', value_parser = parse_feature)]
     pub with_features: Vec<SceneFeatures>,
@@ -60,13 +60,14 @@ fn parse_feature(name: &str) -> Result<SceneFeatures, String> {
         "cut-outs" => SceneFeatures { cut_outs: true, ..none },
         "glossy" => SceneFeatures { glossy: true, ..none },
         "coated" => SceneFeatures { glossy: true, coated: true, ..none },
+        "sheened" => SceneFeatures { glossy: true, sheened: true, ..none },
         "sampled-lights" => SceneFeatures { sampled_lights: true, ..none },
         "sky-image" => SceneFeatures { sky_image: true, ..none },
         "media" => SceneFeatures { media: true, ..none },
         "all" => SceneFeatures::ALL,
         _ => {
             return Err(format!(
-                "{name:?} is none of textured, cut-outs, glossy, coated, sampled-lights, sky-image, media, all"
+                "{name:?} is none of textured, cut-outs, glossy, coated, sheened, sampled-lights, sky-image, media, all"
             ));
         }
     })

@@ -175,6 +175,27 @@ pub fn coated_box(light: &str, size: u32) -> Scene {
         .unwrap_or_else(|e| panic!("{e}"))
 }
 
+/// `glossy_box` with sheens (KHR_materials_sheen): velvet on the green
+/// wall (a white sheen of roughness 0.3 over a Lambertian green), a warm
+/// sheen of roughness 0.8 over the rough steel block, and a smooth sheen
+/// (the smallest roughness drawn) under a gathered clear coat over every
+/// satin white surface.
+pub fn sheen_box(light: &str, size: u32) -> Scene {
+    let text = glossy_box_toml(light, size)
+        .replace(
+            "base_color = [0.14, 0.45, 0.09]\nroughness = 1.0\n",
+            "base_color = [0.14, 0.45, 0.09]\nroughness = 1.0\nspecular = 0.0\nsheen_color = [1.0, 1.0, 1.0]\nsheen_roughness = 0.3\n",
+        )
+        .replace("roughness = 0.7\n", "roughness = 0.7\nsheen_color = [0.9, 0.6, 0.3]\nsheen_roughness = 0.8\n")
+        .replace(
+            "roughness = 0.5\n",
+            "roughness = 0.5\nsheen_color = [0.5, 0.5, 0.6]\nsheen_roughness = 0.0\nclearcoat = 1.0\nclearcoat_roughness = 0.5\n",
+        );
+    assert_eq!(text.matches("sheen_color =").count(), 3, "glossy_box's materials changed: update sheen_box");
+    Scene::from_toml(&text, &format!("sheen-box ({})", light.lines().nth(1).unwrap_or(light)), None)
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 fn glossy_box_toml(light: &str, size: u32) -> String {
     format!(
         r#"

@@ -9,7 +9,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, pho
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights::*, quad_lights_as_meshes};
+use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights::*, quad_lights_as_meshes, sheen_box};
 
 /// The mean of passes 1..=n of `photons` paths each, at the default first radii.
 fn progressive(scene: &Scene, photons: u64, passes: u32) -> Image {
@@ -96,6 +96,18 @@ fn glossy_box_under_an_emissive_mesh() {
 #[test]
 fn coated_box_under_a_quad_light() {
     converges("coated, quad", coated_box(QUAD, 32));
+}
+
+/// Sheens (velvet over a Lambertian, over a rough metal, and a smooth one
+/// under a coat): gathered from the photon maps, sampled by the path tracer.
+#[test]
+fn sheen_box_under_a_quad_light() {
+    converges("sheen, quad", sheen_box(QUAD, 32));
+}
+
+#[test]
+fn sheen_box_under_a_point_light() {
+    converges("sheen, point", sheen_box(POINT, 32));
 }
 
 #[test]

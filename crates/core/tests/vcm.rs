@@ -196,3 +196,14 @@ fn vcm_converges_to_path_under_clear_coats() {
     converges_to("coated-box", &scene, with(Strategies::Connections), 1.2, &reference, 0.02);
     converges_to("coated-box", &scene, with(Strategies::All), 1.2, &reference, 0.03);
 }
+
+/// Sheens, over a Lambertian, a rough metal and under a coat: VCM's
+/// connections and merges evaluate them both ways.
+#[test]
+fn vcm_converges_to_path_under_sheens() {
+    use hikari_core::test_scenes::{glossy_lights, sheen_box};
+    let scene = sheen_box(glossy_lights::QUAD, 24);
+    let reference = reference(&scene, 1024);
+    converges_to("sheen-box", &scene, with(Strategies::Connections), 1.2, &reference, 0.02);
+    converges_to("sheen-box", &scene, with(Strategies::All), 1.2, &reference, 0.03);
+}

@@ -82,7 +82,21 @@ pub struct GpuSurface {
     /// The glTF BRDF's dielectric reflectance at normal incidence
     /// (`Bsdf::f0`, from KHR_materials_ior).
     pub dielectric_f0: f32,
-    pub _pad: [u32; 3],
+    /// The glTF BRDF's sheen roughness (`Bsdf::sheen_roughness`).
+    pub sheen_roughness: f32,
+    pub _pad: [u32; 2],
+    /// The glTF BRDF's sheen colour (`Bsdf::sheen_color`, black: none).
+    pub sheen_color: [f32; 3],
+    pub _pad2: u32,
+}
+
+/// The surfaces buffer's contents, as surface.wgsl's `Surfaces` reads it:
+/// the sheen's albedo table (`hikari_core::bsdf::sheen::SHEEN_ALBEDO`,
+/// which bsdf.wgsl reads wherever it shades), then `surfaces`.
+pub fn surfaces_contents(surfaces: &[GpuSurface]) -> Vec<u8> {
+    let mut bytes = bytemuck::cast_slice::<f32, u8>(&hikari_core::bsdf::sheen::SHEEN_ALBEDO).to_vec();
+    bytes.extend_from_slice(bytemuck::cast_slice(surfaces));
+    bytes
 }
 
 /// Segments around a tessellated sphere: fine enough that its silhouette is
@@ -227,7 +241,7 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
             let mean = textures.emissive_mean;
             let per_texel =
                 Vec3::select(mean.cmpgt(Vec3::ZERO), emission / mean.max(Vec3::splat(f32::MIN_POSITIVE)), Vec3::ZERO);
-            // The glTF BRDF where it has a specular lobe or a coat; exactly
+            // The glTF BRDF where it has a specular lobe, a coat or a sheen; exactly
             // Lambertian ones (and the old materials) take the cheaper path.
             let glossy = match material {
                 Material::Pbr(bsdf) if bsdf.is_glossy() => Some(bsdf),
@@ -261,7 +275,10 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 clearcoat: glossy.map_or(0.0, |b| b.clearcoat),
                 clearcoat_roughness: glossy.map_or(0.0, |b| b.clearcoat_roughness),
                 dielectric_f0: glossy.map_or(hikari_core::bsdf::DIELECTRIC_F0, |b| b.f0),
-                _pad: [0; 3],
+                sheen_roughness: glossy.map_or(0.0, |b| b.sheen_roughness),
+                _pad: [0; 2],
+                sheen_color: glossy.map_or([0.0; 3], |b| b.sheen_color.to_array()),
+                _pad2: 0,
             }
         })
         .collect()
@@ -295,7 +312,7 @@ impl SceneBuffers {
             }),
             surfaces: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("scene surfaces"),
-                contents: bytemuck::cast_slice(&surfaces),
+                contents: &surfaces_contents(&surfaces),
                 usage: wgpu::BufferUsages::STORAGE,
             }),
         }

@@ -43,11 +43,21 @@ pub fn run_kernel_on(
     buffer: &str,
     input: &[u32],
 ) -> Vec<u32> {
+    let composed = crate::wgsl::compose(modules);
+    // Kernels over the surface modules get the surfaces buffer's sheen
+    // table (bsdf.wgsl reads it), as every pass does; the phony read keeps
+    // the binding in the pipeline's layout when the kernel never shades.
+    let with_surfaces = composed.contains("struct Surfaces {");
+    let (surfaces_decl, touch) = if with_surfaces {
+        ("@group(0) @binding(1) var<storage, read> surfaces: Surfaces;\n", "_ = surfaces.sheen_albedo[0];\n")
+    } else {
+        ("", "")
+    };
     let kernel = format!(
-        "@group(0) @binding(0) var<storage, read_write> {buffer}: array<u32>;\n\
-         @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n{main}\n}}\n"
+        "@group(0) @binding(0) var<storage, read_write> {buffer}: array<u32>;\n{surfaces_decl}\
+         @compute @workgroup_size(64) fn main(@builtin(global_invocation_id) id: vec3<u32>) {{\n{touch}{main}\n}}\n"
     );
-    let source = crate::wgsl::compose(modules) + &kernel;
+    let source = composed + &kernel;
     let device = &ctx.device;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some("kernel"),
@@ -67,10 +77,19 @@ pub fn run_kernel_on(
         contents: bytemuck::cast_slice(input),
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
     });
+    let surfaces = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: &crate::scene_upload::surfaces_contents(&[bytemuck::Zeroable::zeroed()]),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let mut entries = vec![wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }];
+    if with_surfaces {
+        entries.push(wgpu::BindGroupEntry { binding: 1, resource: surfaces.as_entire_binding() });
+    }
     let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: None,
         layout: &pipeline.get_bind_group_layout(0),
-        entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+        entries: &entries,
     });
     let mut encoder = device.create_command_encoder(&Default::default());
     {

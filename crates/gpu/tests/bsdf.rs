@@ -7,10 +7,10 @@ use hikari_core::sampling::{Rng, uniform_sphere};
 use hikari_gpu::test_support::{run_kernel, test_context};
 use hikari_gpu::wgsl::BSDF;
 
-/// Words per item: 18 inputs, then the outputs the kernel writes.
-const ITEM: usize = 43;
+/// Words per item: 22 inputs, then the outputs the kernel writes.
+const ITEM: usize = 47;
 /// Input words per item.
-const INPUTS: usize = 18;
+const INPUTS: usize = 22;
 
 /// A random material, roughness spread over the smooth, followed and
 /// gathered ranges, with the extremes (black, pure metal or dielectric,
@@ -29,7 +29,15 @@ fn random_bsdf(rng: &mut Rng) -> Bsdf {
     let ior = if rng.next_f32() < 0.5 { 1.5 } else { 1.0 + 2.0 * rng.next_f32() };
     let bsdf = Bsdf::new(base, metallic, roughness, specular).with_ior(ior);
     // A third under a clear coat, smooth, followed or gathered.
-    if rng.next_f32() < 0.33 { bsdf.with_clearcoat(pick(rng, &[1.0]), pick(rng, &[0.0, 0.2, 0.5])) } else { bsdf }
+    let bsdf =
+        if rng.next_f32() < 0.33 { bsdf.with_clearcoat(pick(rng, &[1.0]), pick(rng, &[0.0, 0.2, 0.5])) } else { bsdf };
+    // A third under a sheen, from the smoothest to roughness 1.
+    if rng.next_f32() < 0.33 {
+        let color = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+        bsdf.with_sheen(color, pick(rng, &[0.0, 0.3, 1.0]))
+    } else {
+        bsdf
+    }
 }
 
 /// A direction toward the viewer or light: mostly above the surface,
@@ -76,6 +84,10 @@ fn wgsl_bsdf_matches_the_cpu() {
             b.clearcoat,
             b.clearcoat_roughness,
             b.f0,
+            b.sheen_color.x,
+            b.sheen_color.y,
+            b.sheen_color.z,
+            b.sheen_roughness,
         ];
         for (k, w) in words.iter().enumerate() {
             item[k] = w.to_bits();
@@ -86,7 +98,7 @@ fn wgsl_bsdf_matches_the_cpu() {
         "let o = {ITEM}u * id.x; if (o >= arrayLength(&io)) {{ return; }}\n\
          var w: array<f32, {INPUTS}>;\n\
          for (var k = 0u; k < {INPUTS}u; k++) {{ w[k] = bitcast<f32>(io[o + k]); }}\n\
-         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16], w[17]);\n\
+         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16], w[17], vec3<f32>(w[18], w[19], w[20]), w[21]);\n\
          let wo = vec3<f32>(w[6], w[7], w[8]);\n\
          let wi = vec3<f32>(w[9], w[10], w[11]);\n\
          let u = vec2<f32>(w[13], w[14]);\n\
@@ -158,6 +170,8 @@ fn wgsl_bsdf_matches_the_cpu() {
     assert!(smooth > 500 && followed > 500 && gathered > 500, "{smooth} {followed} {gathered}");
     let coats = |r: f32| items.iter().filter(|(b, ..)| b.has_coat() && b.clearcoat_roughness == r).count();
     assert!(coats(0.0) > 200 && coats(0.2) > 200 && coats(0.5) > 200, "{} {} {}", coats(0.0), coats(0.2), coats(0.5));
+    let sheens = |r: f32| items.iter().filter(|(b, ..)| b.has_sheen() && b.sheen_roughness == r).count();
+    assert!(sheens(0.0) > 200 && sheens(0.3) > 200 && sheens(1.0) > 200, "{} {}", sheens(0.0), sheens(1.0));
 }
 
 /// dielectric.wgsl against hikari_core::bsdf::dielectric: rough glass's f

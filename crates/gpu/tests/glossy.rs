@@ -10,7 +10,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, compare, pas
 use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
-use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights, quad_lights_as_meshes};
+use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights, quad_lights_as_meshes, sheen_box};
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
@@ -132,4 +132,16 @@ fn coated_box_on_the_gpu_under_a_quad_light() {
 #[test]
 fn coated_box_on_the_gpu_under_a_point_light() {
     converges("coated, point", coated_box(glossy_lights::POINT, 32), 4);
+}
+
+/// Sheens (bsdf.wgsl's, its albedo table read from the surfaces buffer):
+/// gathered by the splat, evaluated whole by the direct pass and the tracer.
+#[test]
+fn sheen_box_on_the_gpu_under_a_quad_light() {
+    converges("sheen, quad", sheen_box(glossy_lights::QUAD, 32), 4);
+}
+
+#[test]
+fn sheen_box_on_the_gpu_under_a_point_light() {
+    converges("sheen, point", sheen_box(glossy_lights::POINT, 32), 4);
 }

@@ -19,6 +19,12 @@ fn shaders() -> Vec<(&'static str, String)> {
         ("present.wgsl", hikari_gpu::present::shader_source()),
         ("splat.wgsl", hikari_gpu::splat::shader_source()),
         ("estimate.wgsl", hikari_gpu::wgsl::compose(&[&hikari_gpu::wgsl::ESTIMATE])),
+        // Its includers bind the surfaces buffer (bsdf.wgsl reads the sheen table there).
+        (
+            "photon_brdf.wgsl",
+            hikari_gpu::wgsl::compose(&[&hikari_gpu::wgsl::PHOTON_BRDF])
+                + "@group(0) @binding(0) var<storage, read> surfaces: Surfaces;\n",
+        ),
         ("shadow.wgsl", hikari_gpu::shadow::shader_source()),
         ("direct.wgsl", hikari_gpu::direct::shader_source()),
         ("lod.wgsl", hikari_gpu::lod::shader_source()),
@@ -39,7 +45,7 @@ fn parse(name: &str, source: &str) -> naga::Module {
         naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
         .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
     module
 }
 
@@ -106,7 +112,10 @@ fn shared_structs_match_wgsl_layouts() {
             clearcoat,
             clearcoat_roughness,
             dielectric_f0,
-            _pad
+            sheen_roughness,
+            _pad,
+            sheen_color,
+            _pad2
         ]
     );
     let splat = hikari_gpu::splat::shader_source();

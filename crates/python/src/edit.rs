@@ -408,6 +408,40 @@ impl MaterialView {
         Ok(())
     }
 
+    /// A glTF material's sheen colour (KHR_materials_sheen's
+    /// sheenColorFactor, (0, 0, 0): none); None for the others.
+    #[getter]
+    fn sheen_color(&self) -> Option<(f32, f32, f32)> {
+        if let Material::Pbr(b) = self.get() { Some(tuple(b.sheen_color)) } else { None }
+    }
+    #[setter]
+    fn set_sheen_color(&self, rgb: (f32, f32, f32)) -> PyResult<()> {
+        let c = vec3(rgb, "material.sheen_color")?;
+        if c.min_element() < 0.0 || c.max_element() > 1.0 {
+            return Err(PyValueError::new_err(format!("material.sheen_color: {rgb:?} is outside 0 to 1")));
+        }
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.sheen_color: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(b.with_sheen(c, b.sheen_roughness)));
+        Ok(())
+    }
+
+    /// A glTF material's sheen roughness; None for the others.
+    #[getter]
+    fn sheen_roughness(&self) -> Option<f32> {
+        if let Material::Pbr(b) = self.get() { Some(b.sheen_roughness) } else { None }
+    }
+    #[setter]
+    fn set_sheen_roughness(&self, v: f32) -> PyResult<()> {
+        let v = unit_interval(v, "material.sheen_roughness")?;
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.sheen_roughness: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(b.with_sheen(b.sheen_color, v)));
+        Ok(())
+    }
+
     /// The RGB radiance (W/(m² sr)) the material's surfaces emit: a glTF
     /// emissive factor times its strength (an emissive texture's mean where
     /// it has one, the texture's pattern kept), an area light's body's

@@ -48,7 +48,7 @@
 //! `crates/gpu/tests/bsdf.rs`; keep the arithmetic the same on both sides.
 
 use super::{
-    Bsdf, BsdfSample, DIELECTRIC_F0, GATHER_ROUGHNESS, MIN_LOBE_WEIGHT, SMOOTH_ROUGHNESS, ggx, schlick_weight,
+    Bsdf, BsdfSample, DIELECTRIC_F0, GATHER_ROUGHNESS, Lobes, MIN_LOBE_WEIGHT, SMOOTH_ROUGHNESS, ggx, schlick_weight,
 };
 use crate::material::{Rgb, mean};
 use glam::{Vec2, Vec3};
@@ -121,23 +121,23 @@ impl Bsdf {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
         }
-        let (diffuse, specular) = self.f_lobes(wo, wi);
-        self.under_coat(wo, wi, diffuse, specular) + Rgb::splat(self.coat_lobe(wo, wi))
+        self.under_coat(wo, wi, self.f_lobes(wo, wi)) + Rgb::splat(self.coat_lobe(wo, wi))
     }
 
-    /// The base's `diffuse` and `specular` lobes as the coat leaves them.
-    fn under_coat(&self, wo: Vec3, wi: Vec3, diffuse: Rgb, specular: Rgb) -> Rgb {
-        diffuse * self.coat_diffuse_through(wo.z, wi.z) + specular * self.coat_specular_through(wo.z, wi.z)
+    /// The base's lobes as the coat leaves them (the sheen dimmed like the
+    /// specular lobe).
+    fn under_coat(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> Rgb {
+        lobes.diffuse * self.coat_diffuse_through(wo.z, wi.z)
+            + (lobes.specular + lobes.sheen) * self.coat_specular_through(wo.z, wi.z)
     }
 
-    /// `f_gathered` under the coat: `diffuse` and `specular` are the base's
-    /// gathered lobes.
-    pub(super) fn coated_gathered(&self, wo: Vec3, wi: Vec3, diffuse: Rgb, specular: Rgb) -> Rgb {
+    /// `f_gathered` under the coat: `lobes` are the base's gathered lobes.
+    pub(super) fn coated_gathered(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
         }
         let coat = if self.coat_is_gathered() { self.coat_lobe(wo, wi) } else { 0.0 };
-        self.under_coat(wo, wi, diffuse, specular) + Rgb::splat(coat)
+        self.under_coat(wo, wi, lobes) + Rgb::splat(coat)
     }
 
     pub(super) fn coated_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -298,8 +298,7 @@ mod tests {
         for deg in [0.0, 40.0, 75.0] {
             let wo = direction_at(deg);
             let under = integrate_about(Vec3::Z, |wi| {
-                let (d, s) = lambert.f_lobes(wo, wi);
-                (mean(lambert.under_coat(wo, wi, d, s)) * wi.z.max(0.0)) as f64
+                (mean(lambert.under_coat(wo, wi, lambert.f_lobes(wo, wi))) * wi.z.max(0.0)) as f64
             });
             let want = 0.5 * lambert.coat_transmission(wo.z) as f64;
             assert!((under - want).abs() < 1e-3, "{deg}°: {under} against {want}");

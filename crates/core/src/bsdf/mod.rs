@@ -20,6 +20,10 @@
 //! height-correlated G2 = 1/(1 + Λ(v) + Λ(l)) (Heitz 2014), as Khronos' sample
 //! renderer does: it is the more accurate of the two and never darker.
 //!
+//! Two layers can lie over it: `KHR_materials_sheen`'s Charlie sheen
+//! ([`sheen`], which dims these lobes by its albedo scaling) and, over
+//! that, `KHR_materials_clearcoat`'s coat ([`clearcoat`]).
+//!
 //! Old materials are settings of this one: `Bsdf::diffuse(ρ)` (metallic 0,
 //! roughness 1, specular 0) is exactly Lambertian ρ/π, `Bsdf::mirror(f0)`
 //! (metallic 1, roughness 0) a perfect mirror tinted by Schlick's Fresnel.
@@ -58,9 +62,10 @@
 pub mod clearcoat;
 pub mod dielectric;
 pub mod ggx;
+pub mod sheen;
 
 use crate::material::{Rgb, mean};
-use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, orthonormal_basis};
+use crate::sampling::{cosine_hemisphere, cosine_hemisphere_pdf, orthonormal_basis, uniform_cone, uniform_cone_pdf};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -111,6 +116,12 @@ pub struct Bsdf {
     /// 1))² of KHR_materials_ior's index η: `DIELECTRIC_F0` at glTF's
     /// default 1.5 ([`Bsdf::with_ior`]).
     pub f0: f32,
+    /// KHR_materials_sheen's sheenColorFactor: the colour of a Charlie sheen
+    /// over the base ([`sheen`]); black is no sheen.
+    pub sheen_color: Rgb,
+    /// The sheen's roughness r (α = r²), drawn at no less than
+    /// `sheen::MIN_SHEEN_ROUGHNESS`.
+    pub sheen_roughness: f32,
 }
 
 /// A direction drawn by [`Bsdf::sample`].
@@ -132,6 +143,20 @@ pub struct BsdfSample {
     /// smoother than `GATHER_ROUGHNESS`, which the photon maps do not stand
     /// for): photon paths count such a bounce as specular.
     pub followed: bool,
+}
+
+/// The parts of f at one pair of directions ([`Bsdf::f_lobes`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Lobes {
+    pub diffuse: Rgb,
+    pub specular: Rgb,
+    pub sheen: Rgb,
+}
+
+/// Probabilities with which `sample` picks the specular and the sheen lobe.
+struct LobeChoice {
+    specular: f32,
+    sheen: f32,
 }
 
 /// Schlick's (1 − cos)^5, as products.
@@ -157,6 +182,8 @@ impl Bsdf {
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
             f0: DIELECTRIC_F0,
+            sheen_color: Rgb::ZERO,
+            sheen_roughness: 0.0,
         }
     }
 
@@ -210,13 +237,16 @@ impl Bsdf {
     /// Some lobe is not a delta: light sampling and photon merges can use
     /// this surface.
     pub fn has_non_delta_lobe(&self) -> bool {
-        self.has_diffuse() || (self.has_specular() && !self.is_smooth()) || (self.has_coat() && !self.coat_is_smooth())
+        self.has_diffuse()
+            || (self.has_specular() && !self.is_smooth())
+            || (self.has_coat() && !self.coat_is_smooth())
+            || self.has_sheen()
     }
 
-    /// Some lobe reflects anything: the base's or the coat's. (Surfaces
-    /// without are Lambertian: `Material::from_bsdf`.)
+    /// Some lobe reflects anything: the base's, the coat's or the sheen's.
+    /// (Surfaces without are Lambertian: `Material::from_bsdf`.)
     pub fn is_glossy(&self) -> bool {
-        self.has_specular() || self.has_coat()
+        self.has_specular() || self.has_coat() || self.has_sheen()
     }
 
     /// The diffuse lobe carries anything: photon maps store photons here.
@@ -239,30 +269,38 @@ impl Bsdf {
         self.base_color * ((1.0 - self.metallic) * (1.0 - self.specular * f_dielectric))
     }
 
-    /// Probability of sampling the specular lobe at `wo`; None when neither
-    /// lobe reflects anything.
-    fn specular_probability(&self, cos_o: f32) -> Option<f32> {
+    /// Probabilities of sampling the specular and the sheen lobe at `wo`
+    /// (the diffuse one has the rest); None when no lobe reflects anything.
+    fn lobe_probabilities(&self, cos_o: f32) -> Option<LobeChoice> {
         let diffuse = if self.has_diffuse() { mean(self.diffuse_reflectance(cos_o)).max(MIN_LOBE_WEIGHT) } else { 0.0 };
         let specular = if self.has_specular() { mean(self.specular_fresnel(cos_o)).max(MIN_LOBE_WEIGHT) } else { 0.0 };
-        let total = diffuse + specular;
-        (total > 0.0).then(|| specular / total)
+        let sheen = if self.has_sheen() { self.sheen_weight(cos_o).max(MIN_LOBE_WEIGHT) } else { 0.0 };
+        let total = diffuse + specular + sheen;
+        (total > 0.0).then(|| LobeChoice { specular: specular / total, sheen: sheen / total })
     }
 
-    /// The diffuse and specular (microfacet) parts of f; the specular one is
-    /// zero on smooth surfaces, whose mirror is a delta.
-    fn f_lobes(&self, wo: Vec3, wi: Vec3) -> (Rgb, Rgb) {
+    /// The parts of f: the diffuse and specular (microfacet) lobes as the
+    /// sheen leaves them, and the sheen; the specular one is zero on smooth
+    /// surfaces, whose mirror is a delta.
+    fn f_lobes(&self, wo: Vec3, wi: Vec3) -> Lobes {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return (Rgb::ZERO, Rgb::ZERO);
+            return Lobes::default();
         }
         let h = (wo + wi).normalize();
         // |v·h| = |l·h|; averaging the two makes f(wo, wi) = f(wi, wo) to the bit.
         let cos = 0.5 * (wo.dot(h) + wi.dot(h));
-        let diffuse = self.diffuse_reflectance(cos) / PI;
-        if self.is_smooth() || !self.has_specular() {
-            return (diffuse, Rgb::ZERO);
+        let mut lobes = Lobes { diffuse: self.diffuse_reflectance(cos) / PI, ..Lobes::default() };
+        if !self.is_smooth() && self.has_specular() {
+            let alpha = self.alpha();
+            lobes.specular = self.specular_fresnel(cos) * (ggx::d(h, alpha) * ggx::visibility(wo, wi, alpha));
         }
-        let alpha = self.alpha();
-        (diffuse, self.specular_fresnel(cos) * (ggx::d(h, alpha) * ggx::visibility(wo, wi, alpha)))
+        if self.has_sheen() {
+            let scaling = self.sheen_scaling(wo.z, wi.z);
+            lobes.diffuse *= scaling;
+            lobes.specular *= scaling;
+            lobes.sheen = self.sheen_lobe(wo, wi);
+        }
+        lobes
     }
 
     /// f(wo, wi) per steradian, without the mirrors of smooth lobes.
@@ -287,8 +325,8 @@ impl Bsdf {
 
     /// The base lobes' f (diffuse and specular, no coat).
     pub(crate) fn base_f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let (diffuse, specular) = self.f_lobes(wo, wi);
-        diffuse + specular
+        let lobes = self.f_lobes(wo, wi);
+        lobes.diffuse + lobes.specular + lobes.sheen
     }
 
     /// The base lobes' sampling density.
@@ -296,10 +334,13 @@ impl Bsdf {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let Some(p_specular) = self.specular_probability(wo.z) else { return 0.0 };
-        let mut pdf = (1.0 - p_specular) * cosine_hemisphere_pdf(wi.z);
-        if p_specular > 0.0 && !self.is_smooth() {
-            pdf += p_specular * ggx::reflection_pdf(wo, (wo + wi).normalize(), self.alpha());
+        let Some(p) = self.lobe_probabilities(wo.z) else { return 0.0 };
+        let mut pdf = (1.0 - p.specular - p.sheen) * cosine_hemisphere_pdf(wi.z);
+        if p.specular > 0.0 && !self.is_smooth() {
+            pdf += p.specular * ggx::reflection_pdf(wo, (wo + wi).normalize(), self.alpha());
+        }
+        if p.sheen > 0.0 {
+            pdf += p.sheen * uniform_cone_pdf(0.0);
         }
         pdf
     }
@@ -309,7 +350,8 @@ impl Bsdf {
         if wo.z <= 0.0 {
             return None;
         }
-        let p_specular = self.specular_probability(wo.z)?;
+        let p = self.lobe_probabilities(wo.z)?;
+        let p_specular = p.specular;
         let specular = u_lobe < p_specular;
         let wi = if specular {
             if self.is_smooth() {
@@ -325,6 +367,9 @@ impl Bsdf {
                 });
             }
             ggx::reflect(wo, ggx::sample_visible_normal(wo, self.alpha(), u))
+        } else if u_lobe < p_specular + p.sheen {
+            // The whole hemisphere (a cone of half-angle 90°).
+            uniform_cone(u, 0.0)
         } else {
             cosine_hemisphere(u)
         };
@@ -354,9 +399,11 @@ impl Bsdf {
     /// GPU's splat): every lobe at least `GATHER_ROUGHNESS` rough and the
     /// diffuse one. The rest is followed by the eye ([`Bsdf::sample_followed`]).
     pub fn f_gathered(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let (diffuse, specular) = self.f_lobes(wo, wi);
-        let specular = if self.gathers_specular() { specular } else { Rgb::ZERO };
-        if self.has_coat() { self.coated_gathered(wo, wi, diffuse, specular) } else { diffuse + specular }
+        let mut lobes = self.f_lobes(wo, wi);
+        if !self.gathers_specular() {
+            lobes.specular = Rgb::ZERO;
+        }
+        if self.has_coat() { self.coated_gathered(wo, wi, lobes) } else { lobes.diffuse + lobes.specular + lobes.sheen }
     }
 
     /// The base's specular lobe, if any, is at least `GATHER_ROUGHNESS`
@@ -370,6 +417,7 @@ impl Bsdf {
         self.has_diffuse()
             || (self.has_specular() && self.gathers_specular())
             || (self.has_coat() && self.coat_is_gathered())
+            || self.has_sheen()
     }
 
     /// Some lobe is followed by the eye rather than estimated from the
@@ -422,7 +470,7 @@ impl Bsdf {
         if wi.z <= 0.0 || pdf <= 0.0 {
             return None;
         }
-        let f = self.f_lobes(wo, wi).1;
+        let f = self.f_lobes(wo, wi).specular;
         let followed = !self.gathers_specular();
         Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed })
     }
@@ -443,6 +491,11 @@ impl Bsdf {
         let f_dielectric = self.specular * (self.f0 + (1.0 - self.f0) / 21.0);
         let diffuse = self.base_color * ((1.0 - self.metallic) * (1.0 - f_dielectric));
         let specular = Rgb::splat((1.0 - self.metallic) * f_dielectric) + self.metallic * average(self.base_color);
+        if self.has_sheen() {
+            // The sheen's albedo at 60°, a middling view.
+            let e = self.sheen_albedo_at(0.5);
+            return (diffuse + specular) * (1.0 - self.sheen_color.max_element().min(1.0) * e) + self.sheen_color * e;
+        }
         diffuse + specular
     }
 }

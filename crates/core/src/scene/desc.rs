@@ -67,6 +67,9 @@ pub struct MaterialDesc {
     /// A clear coat over a pbr material (KHR_materials_clearcoat).
     pub clearcoat: Option<f32>,
     pub clearcoat_roughness: Option<f32>,
+    /// A sheen over a pbr material (KHR_materials_sheen).
+    pub sheen_color: Option<V3>,
+    pub sheen_roughness: Option<f32>,
 }
 
 #[derive(Deserialize, Debug)]

@@ -466,6 +466,8 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
         ("specular", m.specular.is_some()),
         ("clearcoat", m.clearcoat.is_some()),
         ("clearcoat_roughness", m.clearcoat_roughness.is_some()),
+        ("sheen_color", m.sheen_color.is_some()),
+        ("sheen_roughness", m.sheen_roughness.is_some()),
     ];
     match m.kind.as_str() {
         "diffuse" => {
@@ -495,7 +497,17 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
             p.only(
                 "a pbr material",
                 &given,
-                &["base_color", "metallic", "roughness", "specular", "ior", "clearcoat", "clearcoat_roughness"],
+                &[
+                    "base_color",
+                    "metallic",
+                    "roughness",
+                    "specular",
+                    "ior",
+                    "clearcoat",
+                    "clearcoat_roughness",
+                    "sheen_color",
+                    "sheen_roughness",
+                ],
             )?;
             let unit = |field: &str, v: Option<f32>, default: f32| p.in_range(field, v.unwrap_or(default), (0.0, 1.0));
             Ok(Material::from_bsdf(
@@ -508,6 +520,10 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
                 .with_clearcoat(
                     unit("clearcoat", m.clearcoat, 0.0)?,
                     unit("clearcoat_roughness", m.clearcoat_roughness, 0.0)?,
+                )
+                .with_sheen(
+                    p.color("sheen_color", m.sheen_color.unwrap_or([0.0; 3]), 1.0)?,
+                    unit("sheen_roughness", m.sheen_roughness, 0.5)?,
                 )
                 .with_ior(p.in_range("ior", m.ior.unwrap_or(1.5), (1.0, 3.0))?),
             ))
@@ -947,6 +963,13 @@ intensity = [1.0, 1.0, 1.0]
         assert!(e.to_string().contains("clearcoat") && e.to_string().contains("test.toml"), "{e}");
         let glass = BASE.replace("type = \"diffuse\"\nalbedo = [0.5, 0.5, 0.5]", "type = \"glass\"\nclearcoat = 1.0");
         assert!(err(&glass).to_string().contains("clearcoat"));
+        // And a sheen (KHR_materials_sheen), its colour checked per channel.
+        let sheened = coated.replace("clearcoat = 1.0", "sheen_color = [0.9, 0.8, 0.7]\nsheen_roughness = 0.3");
+        let s = parse(&sheened, "test.toml", SceneFiles::beside(None)).unwrap();
+        let Material::Pbr(b) = s.materials[0] else { panic!("{:?}", s.materials[0]) };
+        assert_eq!((b.sheen_color, b.sheen_roughness), (Vec3::new(0.9, 0.8, 0.7), 0.3));
+        let e = err(&sheened.replace("0.9, 0.8", "1.9, 0.8"));
+        assert!(e.to_string().contains("sheen_color") && e.to_string().contains("test.toml"), "{e}");
     }
 
     #[test]

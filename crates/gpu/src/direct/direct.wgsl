@@ -11,7 +11,7 @@
 @group(0) @binding(7) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(8) var<uniform> media: MediaParams;
 @group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
-@group(0) @binding(10) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(10) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(11) var gbuffer_emission: texture_2d<f32>;
 
 
@@ -27,7 +27,7 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let x = position.xyz;
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let n = g.xyz;
-    let s = surfaces[u32(g.w)];
+    let s = surfaces.all[u32(g.w)];
     let b = pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let r = surface_reflector(s, b, unit(media.camera_position - x), n);
     // Glossy points sample their lobe and area lights: a new stream each pass.

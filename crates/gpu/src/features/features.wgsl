@@ -13,6 +13,8 @@ override CUT_OUTS: bool = true;
 override GLOSSY: bool = true;
 // Some glossy surface has a clear coat (`Surface::clearcoat`; bsdf.wgsl's coat).
 override COATED: bool = true;
+// Some glossy surface has a sheen (`Surface::sheen_color`; bsdf.wgsl's sheen).
+override SHEENED: bool = true;
 // Some light is a sky or an emissive mesh (light_eval.wgsl's `sampled_radiance`).
 override SAMPLED_LIGHTS: bool = true;
 // The sky is an image (environment.wgsl).

@@ -21,6 +21,7 @@ pub struct SceneFeatures {
     pub cut_outs: bool,
     pub glossy: bool,
     pub coated: bool,
+    pub sheened: bool,
     pub sampled_lights: bool,
     pub sky_image: bool,
     pub media: bool,
@@ -33,6 +34,7 @@ impl SceneFeatures {
         cut_outs: false,
         glossy: false,
         coated: false,
+        sheened: false,
         sampled_lights: false,
         sky_image: false,
         media: false,
@@ -42,6 +44,7 @@ impl SceneFeatures {
         cut_outs: true,
         glossy: true,
         coated: true,
+        sheened: true,
         sampled_lights: true,
         sky_image: true,
         media: true,
@@ -59,6 +62,7 @@ impl SceneFeatures {
             cut_outs: surfaces.iter().any(|s| s.alpha_cutoff >= 0.0),
             glossy: surfaces.iter().any(|s| s.glossy != 0),
             coated: surfaces.iter().any(|s| s.glossy != 0 && s.clearcoat > 0.0),
+            sheened: surfaces.iter().any(|s| s.glossy != 0 && s.sheen_color.iter().any(|&c| c > 0.0)),
             sampled_lights: lights.iter().any(|l| matches!(l, Light::Environment { .. } | Light::Mesh(_))),
             sky_image: lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. })),
             media,
@@ -72,6 +76,7 @@ impl SceneFeatures {
             cut_outs: self.cut_outs || other.cut_outs,
             glossy: self.glossy || other.glossy,
             coated: self.coated || other.coated,
+            sheened: self.sheened || other.sheened,
             sampled_lights: self.sampled_lights || other.sampled_lights,
             sky_image: self.sky_image || other.sky_image,
             media: self.media || other.media,
@@ -92,6 +97,7 @@ impl SceneFeatures {
             ("CUT_OUTS", self.cut_outs),
             ("GLOSSY", self.glossy),
             ("COATED", self.coated),
+            ("SHEENED", self.sheened),
             ("SAMPLED_LIGHTS", self.sampled_lights),
             ("SKY_IMAGE", self.sky_image),
             ("MEDIA", self.media),
@@ -116,6 +122,7 @@ mod tests {
             ("CUT_OUTS", 1.0),
             ("GLOSSY", 1.0),
             ("COATED", 1.0),
+            ("SHEENED", 1.0),
             ("SAMPLED_LIGHTS", 0.0),
             ("SKY_IMAGE", 1.0),
             ("MEDIA", 1.0),
@@ -133,8 +140,10 @@ mod tests {
         let showcase = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/showcase.glb");
         let showcase = SceneFeatures::of_scene(&Scene::load(showcase).unwrap());
         assert!(showcase.glossy && showcase.sampled_lights && !showcase.sky_image, "{showcase:?}");
-        assert!(!showcase.coated);
+        assert!(!showcase.coated && !showcase.sheened);
         let coated = hikari_core::test_scenes::coated_box(hikari_core::test_scenes::glossy_lights::QUAD, 8);
         assert!(SceneFeatures::of_scene(&coated).coated);
+        let sheened = hikari_core::test_scenes::sheen_box(hikari_core::test_scenes::glossy_lights::QUAD, 8);
+        assert!(SceneFeatures::of_scene(&sheened).sheened);
     }
 }

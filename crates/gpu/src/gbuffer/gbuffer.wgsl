@@ -11,7 +11,7 @@ struct GBufferParams {
 
 
 @group(0) @binding(0) var<uniform> params: GBufferParams;
-@group(0) @binding(1) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(1) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(2) var<storage, read> texture_data: array<u32>;
 
 // scene_upload::HAS_UV: the vertex's surface id carries whether `uv` is set.
@@ -70,7 +70,7 @@ fn fragment_point(in: VertexOut) -> SurfacePoint {
     let dx = dpdx(in.uv);
     let dy = dpdy(in.uv);
     let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
-    return surface_point(surfaces[in.surface & ~HAS_UV], uv, dx, dy);
+    return surface_point(surfaces.all[in.surface & ~HAS_UV], uv, dx, dy);
 }
 
 // What a pixel stores (fs_main's outputs; gbuffer_storage.wgsl stores the
@@ -93,7 +93,7 @@ fn shade(in: VertexOut) -> GBufferOut {
         discard;
     }
     let id = in.surface & ~HAS_UV;
-    let surface = surfaces[id];
+    let surface = surfaces.all[id];
     let view = in.world - params.camera_position;
     let front = dot(in.geometric_normal, view) < 0.0;
     let side = select(-1.0, 1.0, front);

@@ -4,7 +4,7 @@
 // Cut-outs (alphaMode MASK) cast no shadow where they are cut.
 
 @group(0) @binding(0) var<uniform> view: ShadowView;
-@group(1) @binding(0) var<storage, read> surfaces: array<Surface>;
+@group(1) @binding(0) var<storage, read> surfaces: Surfaces;
 @group(1) @binding(1) var<storage, read> texture_data: array<u32>;
 
 // scene_upload::HAS_UV, and light_samples::NO_SURFACE (an emissive mesh's
@@ -36,7 +36,7 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let id = in.surface & ~HAS_UV;
     if (CUT_OUTS && id != NO_SURFACE) {
         let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
-        if (!surface_point(surfaces[id], uv, dx, dy).opaque) {
+        if (!surface_point(surfaces.all[id], uv, dx, dy).opaque) {
             discard;
         }
     }

@@ -43,12 +43,12 @@ pub fn has_specular_surfaces(scene: &Scene) -> bool {
 }
 
 pub fn shader_source() -> String {
-    use crate::wgsl::{BVH, ESTIMATE, Module, OPTICS, compose};
+    use crate::wgsl::{BVH, Module, OPTICS, compose};
     static LOOP_BUDGET: Module =
         Module { name: "loop_budget.wgsl", source: include_str!("loop_budget.wgsl"), requires: &[] };
     static SPECULAR: Module = Module { name: "specular.wgsl", source: include_str!("specular.wgsl"), requires: &[] };
     compose(&[
-        &ESTIMATE,
+        &crate::wgsl::PHOTON_BRDF,
         &crate::media::MEDIA,
         &crate::direct::LIGHT_EVAL,
         &LOOP_BUDGET,

@@ -61,7 +61,7 @@ struct SpecularParams {
 @group(0) @binding(0) var<uniform> params: SpecularParams;
 @group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
 @group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;
-@group(0) @binding(3) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(3) var<storage, read> surfaces: Surfaces;
 // The three photon grids (global, caustic, volume) in one buffer: their
 // bucket starts, then their photons (5 words each); the offsets are words.
 @group(0) @binding(4) var<storage, read> grid: array<u32>;
@@ -356,7 +356,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // The G-buffer's normal.w is the surface id (the background's is 0 with
     // w = 0 everywhere, so check coverage through the normal's length).
     let g = textureLoad(gbuffer_normal, pixel, 0);
-    let first = surfaces[u32(g.w)];
+    let first = surfaces.all[u32(g.w)];
     let mirror_part = first.kind == 0u && (any(first.specular > vec3<f32>(0.0)) || may_follow_lobe(first));
     if (dot(g.xyz, g.xyz) == 0.0 || (first.kind != 1u && first.kind != 2u && !mirror_part)) {
         if (slice.index + 1u == slice.count) {
@@ -406,7 +406,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         if (p.is_sphere != 0u) {
             ng = normalize(x - p.a);
         }
-        let s = surfaces[p.surface];
+        let s = surfaces.all[p.surface];
         // The surface here with its textures (level 0, as the CPU reads).
         let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
         let front = dot(b.dir, ng) < 0.0;

@@ -35,7 +35,7 @@ pub fn shader_source() -> String {
     use crate::wgsl::{ESTIMATE, Module, compose};
     static SPLAT: Module =
         Module { name: "splat.wgsl", source: include_str!("splat.wgsl"), requires: &[&depth_tiles::TILE_CONSTANTS] };
-    compose(&[&ESTIMATE, &FOOTPRINT, &SPLAT])
+    compose(&[&ESTIMATE, &crate::wgsl::PHOTON_BRDF, &FOOTPRINT, &SPLAT])
 }
 
 /// A render pipeline (`vs_main`, `fs_main`) that adds its fragments into a

@@ -19,7 +19,7 @@ struct SplatParams {
 @group(0) @binding(1) var gbuffer_position: texture_2d<f32>;
 @group(0) @binding(2) var gbuffer_normal: texture_2d<f32>;
 @group(0) @binding(3) var gbuffer_albedo: texture_2d<f32>;
-@group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(4) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(5) var gbuffer_emission: texture_2d<f32>;
 
 // Tiles of the G-buffer's depth range (depth_tiles.rs), read by the
@@ -87,7 +87,7 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     // that pay for the eye, the BRDF and the G-buffer's metal-roughness)
     // the BRDF for the photon's own direction over π r².
     var weight = radiance_per_power(albedo.rgb, params.radius);
-    let surface = surfaces[u32(g.w)];
+    let surface = surfaces.all[u32(g.w)];
     if (GLOSSY && surface.glossy != 0u) {
         let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
         let eye = unit(params.camera_position - position.xyz);

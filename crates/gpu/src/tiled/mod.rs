@@ -57,6 +57,7 @@ pub fn shader_source(radiance_format: wgpu::TextureFormat) -> String {
         requires: &[
             &crate::wgsl::UNCOUNTED_LOOPS,
             &ESTIMATE,
+            &crate::wgsl::PHOTON_BRDF,
             &crate::splat::FOOTPRINT_RECT,
             &PREFIX_SUM,
             &crate::lod::LOD_PHOTON,

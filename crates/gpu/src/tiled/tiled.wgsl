@@ -61,7 +61,7 @@ struct TiledParams {
 @group(0) @binding(13) var<uniform> media: MediaParams;
 @group(0) @binding(14) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(15) var slices_tex: texture_2d_array<f32>;
-@group(0) @binding(16) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(16) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(17) var gbuffer_emission: texture_2d<f32>;
 
 const TILE: u32 = 16u;
@@ -242,7 +242,7 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     // A glossy surface weights each photon by its BRDF (photon_brdf) in
     // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
-    let surface = surfaces[u32(g.w)];
+    let surface = surfaces.all[u32(g.w)];
     let glossy = GLOSSY && surface.glossy != 0u;
     let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let eye = unit(media.camera_position - position.xyz);

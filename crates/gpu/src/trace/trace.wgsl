@@ -118,7 +118,7 @@ struct FlatShading {
 @group(0) @binding(1) var<storage, read> nodes: array<FlatNode>;
 @group(0) @binding(2) var<storage, read> prims: array<FlatPrim>;
 @group(0) @binding(3) var<storage, read> shading: array<FlatShading>;
-@group(0) @binding(4) var<storage, read> surfaces: array<Surface>;
+@group(0) @binding(4) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(5) var<storage, read_write> records: array<PhotonRecord>;
 // Photons stored per path: global map, then caustic, then volume (each `paths` long).
 @group(0) @binding(6) var<storage, read_write> counts: array<u32>;
@@ -508,7 +508,7 @@ fn trace_one(rng: ptr<function, Rng>) {
         }
         let x = ray.origin + ray.dir * hit.t;
         let normals = hit_normals(hit.prim, ray.origin, ray.dir, x);
-        let s = surfaces[prims[hit.prim].surface];
+        let s = surfaces.all[prims[hit.prim].surface];
         // The surface here with its textures (Scene::material_at).
         let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
         // Normals on the side the photon arrives from.

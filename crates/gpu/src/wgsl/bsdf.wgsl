@@ -3,6 +3,9 @@
 // the viewer, wi toward the light. A test (tests/bsdf.rs) pins every
 // function here to its Rust twin on random inputs. `unit` is optics.wgsl's
 // glam-exact normalize, so the GPU tracer keeps the CPU's bits.
+//
+// The sheen's albedo table (bsdf::sheen::SHEEN_ALBEDO) is read from the
+// `surfaces` buffer (surface.wgsl's `Surfaces`), which every includer binds.
 
 const SMOOTH_ROUGHNESS: f32 = 0.05;
 const GATHER_ROUGHNESS: f32 = 0.35;
@@ -19,6 +22,9 @@ struct Bsdf {
     clearcoat_roughness: f32,
     // The dielectric's reflectance at normal incidence (KHR_materials_ior).
     f0: f32,
+    // The Charlie sheen over the base (KHR_materials_sheen; black: none).
+    sheen_color: vec3<f32>,
+    sheen_roughness: f32,
 }
 
 // The largest f32 below 1 (clearcoat.rs's ONE_BELOW).
@@ -132,9 +138,107 @@ fn rgb_mean(c: vec3<f32>) -> f32 {
     return (c.x + c.y + c.z) / 3.0;
 }
 
-// Probability of sampling the specular lobe at wo; negative when neither
-// lobe reflects anything (Bsdf::specular_probability's None).
-fn bsdf_specular_probability(b: Bsdf, cos_o: f32) -> f32 {
+// ---- the sheen (bsdf::sheen) ----
+
+const MIN_SHEEN_ROUGHNESS: f32 = 0.07;
+const SHEEN_TABLE_SIZE: u32 = 32u;
+
+// SHEENED (features.wgsl) folds the sheen's code away in scenes without one.
+fn bsdf_has_sheen(b: Bsdf) -> bool {
+    return SHEENED && max(b.sheen_color.x, max(b.sheen_color.y, b.sheen_color.z)) > 0.0;
+}
+
+fn sheen_effective_roughness(roughness: f32) -> f32 {
+    return clamp(roughness, MIN_SHEEN_ROUGHNESS, 1.0);
+}
+
+fn charlie_d(cos_h: f32, alpha: f32) -> f32 {
+    let inv = 1.0 / alpha;
+    let sin2 = max(1.0 - cos_h * cos_h, 0.0);
+    return (2.0 + inv) * pow(sin2, 0.5 * inv) / (2.0 * PI);
+}
+
+fn charlie_lambda_fit(x: f32, alpha: f32) -> f32 {
+    let t = (1.0 - alpha) * (1.0 - alpha);
+    let a = 21.5473 + (25.3245 - 21.5473) * t;
+    let b = 3.82987 + (3.32435 - 3.82987) * t;
+    let c = 0.19823 + (0.16801 - 0.19823) * t;
+    let d = -1.97760 + (-1.27393 - -1.97760) * t;
+    let e = -4.32054 + (-4.85967 - -4.32054) * t;
+    return a / (1.0 + b * pow(x, c)) + d * x + e;
+}
+
+fn charlie_lambda(cos: f32, alpha: f32) -> f32 {
+    let c = abs(cos);
+    if (c < 0.5) {
+        return exp(charlie_lambda_fit(c, alpha));
+    }
+    return exp(2.0 * charlie_lambda_fit(0.5, alpha) - charlie_lambda_fit(1.0 - c, alpha));
+}
+
+fn charlie_visibility(cos_o: f32, cos_i: f32, alpha: f32) -> f32 {
+    let g = 1.0 + charlie_lambda(cos_o, alpha) + charlie_lambda(cos_i, alpha);
+    return min(1.0 / (g * 4.0 * cos_o * cos_i), 1.0);
+}
+
+fn white_sheen(wo: vec3<f32>, wi: vec3<f32>, roughness: f32) -> f32 {
+    let alpha = roughness * roughness;
+    let h = unit(wo + wi);
+    return charlie_d(h.z, alpha) * charlie_visibility(wo.z, wi.z, alpha);
+}
+
+// E(cos θ, r), bilinear in (√cos θ, r) (sheen::sheen_albedo).
+fn sheen_albedo(cos: f32, roughness: f32) -> f32 {
+    let last = f32(SHEEN_TABLE_SIZE - 1u);
+    let x = sqrt(clamp(cos, 0.0, 1.0)) * last;
+    let y = sheen_effective_roughness(roughness) * last;
+    let i = min(u32(x), SHEEN_TABLE_SIZE - 2u);
+    let j = min(u32(y), SHEEN_TABLE_SIZE - 2u);
+    let fx = x - f32(i);
+    let fy = y - f32(j);
+    let k = j * SHEEN_TABLE_SIZE + i;
+    let a = surfaces.sheen_albedo[k];
+    let b = surfaces.sheen_albedo[k + 1u];
+    let c = surfaces.sheen_albedo[k + SHEEN_TABLE_SIZE];
+    let d = surfaces.sheen_albedo[k + SHEEN_TABLE_SIZE + 1u];
+    let row0 = a + (b - a) * fx;
+    let row1 = c + (d - c) * fx;
+    return row0 + (row1 - row0) * fy;
+}
+
+fn sheen_albedo_at(b: Bsdf, cos: f32) -> f32 {
+    return min(sheen_albedo(cos, b.sheen_roughness), 1.0);
+}
+
+fn sheen_lobe(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (!bsdf_has_sheen(b)) {
+        return vec3<f32>(0.0);
+    }
+    let r = sheen_effective_roughness(b.sheen_roughness);
+    let norm = max(max(sheen_albedo(wo.z, r), sheen_albedo(wi.z, r)), 1.0);
+    return b.sheen_color * (white_sheen(wo, wi, r) / norm);
+}
+
+fn sheen_scaling(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
+    if (!bsdf_has_sheen(b)) {
+        return 1.0;
+    }
+    let m = min(max(b.sheen_color.x, max(b.sheen_color.y, b.sheen_color.z)), 1.0);
+    return 1.0 - m * max(sheen_albedo_at(b, cos_o), sheen_albedo_at(b, cos_i));
+}
+
+fn sheen_weight(b: Bsdf, cos_o: f32) -> f32 {
+    if (!bsdf_has_sheen(b)) {
+        return 0.0;
+    }
+    return rgb_mean(b.sheen_color) * sheen_albedo_at(b, cos_o);
+}
+
+// ---- the base's lobes ----
+
+// Probabilities of sampling the specular (x) and the sheen (y) lobe at wo;
+// x negative when no lobe reflects anything (Bsdf::lobe_probabilities's None).
+fn bsdf_lobe_probabilities(b: Bsdf, cos_o: f32) -> vec2<f32> {
     var diffuse = 0.0;
     if (bsdf_has_diffuse(b)) {
         diffuse = max(rgb_mean(bsdf_diffuse_reflectance(b, cos_o)), MIN_LOBE_WEIGHT);
@@ -143,49 +247,64 @@ fn bsdf_specular_probability(b: Bsdf, cos_o: f32) -> f32 {
     if (bsdf_has_specular(b)) {
         specular = max(rgb_mean(bsdf_specular_fresnel(b, cos_o)), MIN_LOBE_WEIGHT);
     }
-    let total = diffuse + specular;
-    if (total > 0.0) {
-        return specular / total;
+    var sheen = 0.0;
+    if (bsdf_has_sheen(b)) {
+        sheen = max(sheen_weight(b, cos_o), MIN_LOBE_WEIGHT);
     }
-    return -1.0;
+    let total = diffuse + specular + sheen;
+    if (total > 0.0) {
+        return vec2<f32>(specular / total, sheen / total);
+    }
+    return vec2<f32>(-1.0, 0.0);
 }
 
-// The diffuse and microfacet parts of f (Bsdf::f_lobes).
+// The parts of f (Bsdf::f_lobes): diffuse and microfacet as the sheen
+// leaves them, and the sheen.
 struct Lobes {
     diffuse: vec3<f32>,
     specular: vec3<f32>,
+    sheen: vec3<f32>,
 }
 
 fn bsdf_f_lobes(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> Lobes {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
-        return Lobes(vec3<f32>(0.0), vec3<f32>(0.0));
+        return Lobes(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     }
     let h = unit(wo + wi);
     let cos = 0.5 * (dot(wo, h) + dot(wi, h));
-    let diffuse = bsdf_diffuse_reflectance(b, cos) / PI;
-    if (bsdf_is_smooth(b) || !bsdf_has_specular(b)) {
-        return Lobes(diffuse, vec3<f32>(0.0));
+    var lobes = Lobes(bsdf_diffuse_reflectance(b, cos) / PI, vec3<f32>(0.0), vec3<f32>(0.0));
+    if (!bsdf_is_smooth(b) && bsdf_has_specular(b)) {
+        let alpha = bsdf_alpha(b);
+        lobes.specular = bsdf_specular_fresnel(b, cos) * (ggx_d(h, alpha) * ggx_visibility(wo, wi, alpha));
     }
-    let alpha = bsdf_alpha(b);
-    return Lobes(diffuse, bsdf_specular_fresnel(b, cos) * (ggx_d(h, alpha) * ggx_visibility(wo, wi, alpha)));
+    if (bsdf_has_sheen(b)) {
+        let scaling = sheen_scaling(b, wo.z, wi.z);
+        lobes.diffuse *= scaling;
+        lobes.specular *= scaling;
+        lobes.sheen = sheen_lobe(b, wo, wi);
+    }
+    return lobes;
 }
 
 fn bsdf_base_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let lobes = bsdf_f_lobes(b, wo, wi);
-    return lobes.diffuse + lobes.specular;
+    return lobes.diffuse + lobes.specular + lobes.sheen;
 }
 
 fn bsdf_base_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
-    let p_specular = bsdf_specular_probability(b, wo.z);
-    if (p_specular < 0.0) {
+    let p = bsdf_lobe_probabilities(b, wo.z);
+    if (p.x < 0.0) {
         return 0.0;
     }
-    var pdf = (1.0 - p_specular) * max(wi.z, 0.0) / PI;
-    if (p_specular > 0.0 && !bsdf_is_smooth(b)) {
-        pdf += p_specular * ggx_reflection_pdf(wo, unit(wo + wi), bsdf_alpha(b));
+    var pdf = (1.0 - p.x - p.y) * max(wi.z, 0.0) / PI;
+    if (p.x > 0.0 && !bsdf_is_smooth(b)) {
+        pdf += p.x * ggx_reflection_pdf(wo, unit(wo + wi), bsdf_alpha(b));
+    }
+    if (p.y > 0.0) {
+        pdf += p.y * (1.0 / (2.0 * PI));
     }
     return pdf;
 }
@@ -209,7 +328,8 @@ fn bsdf_base_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSa
     if (wo.z <= 0.0) {
         return no_bsdf_sample();
     }
-    let p_specular = bsdf_specular_probability(b, wo.z);
+    let p = bsdf_lobe_probabilities(b, wo.z);
+    let p_specular = p.x;
     if (p_specular < 0.0) {
         return no_bsdf_sample();
     }
@@ -221,6 +341,8 @@ fn bsdf_base_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSa
             return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p_specular, fresnel / wo.z, true, fresnel / p_specular, true, true);
         }
         wi = ggx_reflect(wo, ggx_sample_visible_normal(wo, bsdf_alpha(b), u));
+    } else if (u_lobe < p_specular + p.y) {
+        wi = uniform_cone(u, 0.0);
     } else {
         wi = cosine_hemisphere(u);
     }
@@ -260,7 +382,13 @@ fn bsdf_base_albedo_estimate(b: Bsdf) -> vec3<f32> {
     let f_dielectric = b.specular * (b.f0 + (1.0 - b.f0) / 21.0);
     let diffuse = b.base_color * ((1.0 - b.metallic) * (1.0 - f_dielectric));
     let average = b.base_color + (vec3<f32>(1.0) - b.base_color) / 21.0;
-    return diffuse + vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * average;
+    let specular = vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * average;
+    if (bsdf_has_sheen(b)) {
+        let e = sheen_albedo_at(b, 0.5);
+        let m = min(max(b.sheen_color.x, max(b.sheen_color.y, b.sheen_color.z)), 1.0);
+        return (diffuse + specular) * (1.0 - m * e) + b.sheen_color * e;
+    }
+    return diffuse + specular;
 }
 
 // ---- the clear coat (bsdf::clearcoat) ----
@@ -299,8 +427,10 @@ fn coat_specular_through(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
     return sqrt(coat_transmission(b, cos_o) * coat_transmission(b, cos_i));
 }
 
-fn under_coat(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, diffuse: vec3<f32>, specular: vec3<f32>) -> vec3<f32> {
-    return diffuse * coat_diffuse_through(b, wo.z, wi.z) + specular * coat_specular_through(b, wo.z, wi.z);
+// The base's lobes as the coat leaves them (the sheen dimmed like the specular lobe).
+fn under_coat(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, lobes: Lobes) -> vec3<f32> {
+    return lobes.diffuse * coat_diffuse_through(b, wo.z, wi.z)
+        + (lobes.specular + lobes.sheen) * coat_specular_through(b, wo.z, wi.z);
 }
 
 fn coat_lobe(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
@@ -327,8 +457,7 @@ fn coated_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let lobes = bsdf_f_lobes(b, wo, wi);
-    return under_coat(b, wo, wi, lobes.diffuse, lobes.specular) + vec3<f32>(coat_lobe(b, wo, wi));
+    return under_coat(b, wo, wi, bsdf_f_lobes(b, wo, wi)) + vec3<f32>(coat_lobe(b, wo, wi));
 }
 
 fn coated_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
@@ -451,13 +580,12 @@ fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample 
 // What the photon maps stand for at this surface (Bsdf::f_gathered): the
 // diffuse lobe and every lobe at least GATHER_ROUGHNESS rough.
 fn bsdf_f_gathered(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    let lobes = bsdf_f_lobes(b, wo, wi);
-    var specular = vec3<f32>(0.0);
-    if (bsdf_gathers_specular(b)) {
-        specular = lobes.specular;
+    var lobes = bsdf_f_lobes(b, wo, wi);
+    if (!bsdf_gathers_specular(b)) {
+        lobes.specular = vec3<f32>(0.0);
     }
     if (!bsdf_has_coat(b)) {
-        return lobes.diffuse + specular;
+        return lobes.diffuse + lobes.specular + lobes.sheen;
     }
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return vec3<f32>(0.0);
@@ -466,13 +594,13 @@ fn bsdf_f_gathered(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     if (coat_is_gathered(b)) {
         coat = coat_lobe(b, wo, wi);
     }
-    return under_coat(b, wo, wi, lobes.diffuse, specular) + vec3<f32>(coat);
+    return under_coat(b, wo, wi, lobes) + vec3<f32>(coat);
 }
 
 // Photons are stored here (Bsdf::stores_photons).
 fn bsdf_stores_photons(b: Bsdf) -> bool {
     return bsdf_has_diffuse(b) || (bsdf_has_specular(b) && bsdf_gathers_specular(b))
-        || (bsdf_has_coat(b) && coat_is_gathered(b));
+        || (bsdf_has_coat(b) && coat_is_gathered(b)) || bsdf_has_sheen(b);
 }
 
 // Some lobe is followed by the eye (Bsdf::follows_any).
@@ -501,13 +629,15 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // The BRDF of a glossy kind-0 surface whose base colour is `base` (the
 // G-buffer's, textures applied; `s.albedo` where no texture is).
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
-    return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0);
+    return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
+        s.sheen_color, s.sheen_roughness);
 }
 
 // The BRDF of glossy surface `s` at a point whose textures gave `base`,
 // `metallic` and `roughness` (textures.wgsl's `surface_point`).
 fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsdf {
-    return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0);
+    return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
+        s.sheen_color, s.sheen_roughness);
 }
 
 // The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the

@@ -88,7 +88,7 @@ pub static CUT_OUTS: Module = Module {
              if (!CUT_OUTS) { return true; }\n\
              let p = prims[prim];\n\
              if (p.is_sphere != 0u) { return true; }\n\
-             let s = surfaces[p.surface];\n\
+             let s = surfaces.all[p.surface];\n\
              if (s.alpha_cutoff < 0.0) { return true; }\n\
              return surface_point(s, primitive_uv(prim, b), vec2<f32>(0.0), vec2<f32>(0.0)).opaque;\n\
              }\n",
@@ -109,10 +109,15 @@ pub static VOLUME_CHORD: Module = Module {
 };
 
 /// The radiance estimate (hikari_core::estimate).
-pub static ESTIMATE: Module = Module {
-    name: "estimate.wgsl",
-    source: include_str!("estimate.wgsl"),
-    requires: &[&CONSTANTS, &PHOTON_ENCODING, &SURFACE, &BSDF],
+pub static ESTIMATE: Module =
+    Module { name: "estimate.wgsl", source: include_str!("estimate.wgsl"), requires: &[&CONSTANTS, &PHOTON_ENCODING] };
+
+/// A photon's weight at a glossy point (the gathered lobes of bsdf.wgsl), for
+/// the passes that estimate over glossy surfaces (they bind `surfaces`).
+pub static PHOTON_BRDF: Module = Module {
+    name: "photon_brdf.wgsl",
+    source: include_str!("photon_brdf.wgsl"),
+    requires: &[&ESTIMATE, &SURFACE, &BSDF],
 };
 
 /// `loop_iteration()` for the passes whose loops the host bounds exactly

@@ -5,8 +5,8 @@
 // `two_sided` is 1; emissive meshes emit from surfaces of any kind. A
 // kind-0 surface with `glossy` 1 reflects by the glTF BRDF (bsdf.wgsl) of
 // base colour `albedo` (the G-buffer's, with textures), `metallic`,
-// `roughness`, `specular_factor` and `clearcoat` (with its roughness);
-// otherwise it is Lambertian.
+// `roughness`, `specular_factor`, `clearcoat` (with its roughness) and
+// `sheen_color` (with its roughness); otherwise it is Lambertian.
 
 struct Surface {
     albedo: vec3<f32>,
@@ -36,5 +36,17 @@ struct Surface {
     clearcoat_roughness: f32,
     // The glTF BRDF's dielectric reflectance at normal incidence.
     dielectric_f0: f32,
-    _pad: array<u32, 3>,
+    // The sheen over the glTF BRDF (bsdf.wgsl; black: none).
+    sheen_roughness: f32,
+    _pad: array<u32, 2>,
+    sheen_color: vec3<f32>,
+    _pad2: u32,
+}
+
+// The surfaces buffer (scene_upload::surfaces_contents): the sheen's albedo
+// table, which bsdf.wgsl reads, then one record per surface. Passes bind it
+// as `surfaces` and read `surfaces.all[id]`.
+struct Surfaces {
+    sheen_albedo: array<f32, 1024>,
+    all: array<Surface>,
 }

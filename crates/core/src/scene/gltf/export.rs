@@ -4,7 +4,7 @@
 //! test can load the same scene from both formats and compare the images).
 
 use super::LUMENS_PER_WATT;
-use super::materials::CLEARCOAT;
+use super::materials::{CLEARCOAT, SHEEN};
 use crate::light::Light;
 use crate::material::{Material, Rgb};
 use crate::scene::Scene;
@@ -34,6 +34,9 @@ pub struct PbrMaterial {
     /// `KHR_materials_clearcoat`'s factor and roughness (factor 0: none).
     pub clearcoat: f32,
     pub clearcoat_roughness: f32,
+    /// `KHR_materials_sheen`'s colour and roughness (black: none).
+    pub sheen_color: Rgb,
+    pub sheen_roughness: f32,
     pub double_sided: bool,
     /// `baseColorFactor`'s alpha.
     pub alpha: f32,
@@ -60,6 +63,8 @@ impl Default for PbrMaterial {
             ior: 1.5,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
+            sheen_color: Rgb::ZERO,
+            sheen_roughness: 0.0,
             double_sided: true,
             alpha: 1.0,
             alpha_cutoff: None,
@@ -202,6 +207,15 @@ impl GltfBuilder {
                 json::Value::from_iter([
                     ("clearcoatFactor", json::Value::from(m.clearcoat)),
                     ("clearcoatRoughnessFactor", json::Value::from(m.clearcoat_roughness)),
+                ]),
+            );
+        }
+        if m.sheen_color.max_element() > 0.0 {
+            extensions.others.insert(
+                SHEEN.into(),
+                json::Value::from_iter([
+                    ("sheenColorFactor", json::Value::from(m.sheen_color.to_array().to_vec())),
+                    ("sheenRoughnessFactor", json::Value::from(m.sheen_roughness)),
                 ]),
             );
         }
@@ -459,6 +473,7 @@ impl GltfBuilder {
                 (ext.is_some_and(|e| e.emissive_strength.is_some()), "KHR_materials_emissive_strength"),
                 (ext.is_some_and(|e| e.specular.is_some()), "KHR_materials_specular"),
                 (ext.is_some_and(|e| e.others.contains_key(CLEARCOAT)), CLEARCOAT),
+                (ext.is_some_and(|e| e.others.contains_key(SHEEN)), SHEEN),
             ] {
                 if used && !self.root.extensions_used.iter().any(|e| e == name) {
                     self.root.extensions_used.push(name.into());
@@ -533,6 +548,8 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
                 specular: b.specular,
                 clearcoat: b.clearcoat,
                 clearcoat_roughness: b.clearcoat_roughness,
+                sheen_color: b.sheen_color,
+                sheen_roughness: b.sheen_roughness,
                 // F0 = ((η − 1)/(η + 1))² back to η ≥ 1.
                 ior: (1.0 + b.f0.sqrt()) / (1.0 - b.f0.sqrt()),
                 ..Default::default()

@@ -4,7 +4,9 @@
 //! ([`Dielectric`]) of the base colour's tint, the roughness and
 //! `KHR_materials_ior` (which also sets an opaque dielectric's
 //! reflectance); `KHR_materials_specular`'s factor scales the
-//! dielectric's Fresnel (its colour is ignored). Base-colour,
+//! dielectric's Fresnel (its colour is ignored); `KHR_materials_clearcoat`
+//! and `KHR_materials_sheen` add their layers (factors; their textures are
+//! noted as not read). Base-colour,
 //! metallic–roughness, emissive and normal textures are read
 //! (`crate::texture`; normal maps bend the CPU renderers' shading normals);
 //! occlusion textures are not. `alphaMode` MASK makes cut-outs,
@@ -49,6 +51,9 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut coat_textures = 0;
     let mut malformed_coats = 0;
     let mut coated_glass = 0;
+    let mut sheen_textures = 0;
+    let mut malformed_sheens = 0;
+    let mut sheened_glass = 0;
     let mut textures = Vec::new();
     let (mut materials, mut emissions): (Vec<Material>, Vec<Option<Emission>>) = doc
         .materials()
@@ -79,8 +84,12 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let coat = Clearcoat::of(&m);
             coat_textures += coat.textured as usize;
             malformed_coats += coat.malformed as usize;
+            let sheen = Sheen::of(&m);
+            sheen_textures += sheen.textured as usize;
+            malformed_sheens += sheen.malformed as usize;
             let material = if transmission >= 0.5 {
                 coated_glass += (coat.factor > 0.0) as usize;
+                sheened_glass += (sheen.color.max_element() > 0.0) as usize;
                 approximated += (transmission < 1.0) as usize;
                 // The base colour tints what crosses (glTF's BTDF, and Cycles').
                 Material::Glass(Dielectric { ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0), roughness, tint: base })
@@ -94,6 +103,7 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 Material::from_bsdf(
                     Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
                         .with_clearcoat(coat.factor, coat.roughness)
+                        .with_sheen(sheen.color, sheen.roughness)
                         .with_ior(m.ior().unwrap_or(1.5).clamp(1.0, 3.0)),
                 )
             };
@@ -161,6 +171,21 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     if coated_glass > 0 {
         notes.push(format!("{coated_glass} transmissive material(s) have a clear coat, which is ignored on glass"));
     }
+    if sheen_textures > 0 {
+        notes.push(format!(
+            "{sheen_textures} material(s) have sheen textures, which are not read yet: their sheenColorFactor and \
+             sheenRoughnessFactor apply uniformly"
+        ));
+    }
+    if malformed_sheens > 0 {
+        notes.push(format!(
+            "{malformed_sheens} material(s) have a KHR_materials_sheen factor that is not a number (or a colour not \
+             of 3 numbers): read as 0"
+        ));
+    }
+    if sheened_glass > 0 {
+        notes.push(format!("{sheened_glass} transmissive material(s) have a sheen, which is ignored on glass"));
+    }
     if blended > 0 {
         notes.push(format!("{blended} material(s) with alphaMode BLEND are rendered opaque"));
     }
@@ -197,6 +222,43 @@ impl Clearcoat {
         Clearcoat {
             factor: number("clearcoatFactor"),
             roughness: number("clearcoatRoughnessFactor"),
+            textured,
+            malformed,
+        }
+    }
+}
+
+/// The extension's name (read from the JSON, as [`CLEARCOAT`]).
+pub const SHEEN: &str = "KHR_materials_sheen";
+
+/// A material's `KHR_materials_sheen` (black, no sheen, without it).
+struct Sheen {
+    color: Rgb,
+    roughness: f32,
+    /// It names a texture (sheen colour or sheen roughness).
+    textured: bool,
+    /// A factor is not a number, or the colour not three of them (read as
+    /// the default, 0).
+    malformed: bool,
+}
+
+impl Sheen {
+    fn of(m: &gltf::Material) -> Sheen {
+        let Some(v) = m.extension_value(SHEEN) else {
+            return Sheen { color: Rgb::ZERO, roughness: 0.0, textured: false, malformed: false };
+        };
+        let color = v.get("sheenColorFactor").map(|c| {
+            c.as_array()
+                .filter(|a| a.len() == 3 && a.iter().all(|x| x.is_number()))
+                .map(|a| Vec3::from_array([0, 1, 2].map(|i| a[i].as_f64().unwrap_or(0.0) as f32)))
+        });
+        let roughness = v.get("sheenRoughnessFactor");
+        let malformed = color.is_some_and(|c| c.is_none()) || roughness.is_some_and(|x| !x.is_number());
+        let textured = ["sheenColorTexture", "sheenRoughnessTexture"].iter().any(|key| v.get(*key).is_some());
+        // The specification's defaults are 0.
+        Sheen {
+            color: sane(color.flatten().unwrap_or(Vec3::ZERO), 1.0),
+            roughness: sane(Vec3::splat(roughness.and_then(|x| x.as_f64()).unwrap_or(0.0) as f32), 1.0).x,
             textured,
             malformed,
         }

@@ -44,6 +44,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_transmission",
     "KHR_materials_specular",
     materials::CLEARCOAT,
+    materials::SHEEN,
     "KHR_texture_transform",
     "KHR_mesh_quantization",
     compressed::MESHOPT,

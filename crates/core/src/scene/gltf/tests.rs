@@ -285,14 +285,14 @@ fn indices_beyond_the_vertices_are_refused() {
 #[test]
 fn unused_optional_extensions_are_one_note() {
     let (mut root, bin) = valid();
-    root.extensions_used.push("KHR_materials_sheen".into());
+    root.extensions_used.push("KHR_materials_iridescence".into());
     root.extensions_used.push("KHR_materials_anisotropy".into());
     let dir = folder("optional");
     let path = write(&dir, "o.glb", &glb(&root, bin));
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
     let ext_notes: Vec<&String> = scene.notes.iter().filter(|n| n.contains("extensions ignored")).collect();
     assert_eq!(ext_notes.len(), 1);
-    assert_says(ext_notes[0], &["KHR_materials_sheen", "KHR_materials_anisotropy"]);
+    assert_says(ext_notes[0], &["KHR_materials_iridescence", "KHR_materials_anisotropy"]);
 }
 
 /// A TOML scene whose one `[[object]]` is `object` (its fields), with a
@@ -388,6 +388,53 @@ fn the_clearcoat_extension_is_read() {
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
     assert!(scene.notes.iter().any(|n| n.contains("clear-coat textures")), "{:?}", scene.notes);
     assert!(matches!(scene.materials[0], Material::Pbr(b) if b.clearcoat == 0.8));
+}
+
+/// `KHR_materials_sheen`'s factors are read (not noted as ignored), come
+/// back from the exporter, and its textures are noted as not read; a
+/// malformed colour is noted.
+#[test]
+fn the_sheen_extension_is_read() {
+    let mut b = GltfBuilder::new();
+    let velvet = PbrMaterial {
+        base_color: Vec3::new(0.3, 0.05, 0.1),
+        sheen_color: Vec3::new(0.9, 0.6, 0.7),
+        sheen_roughness: 0.4,
+        ..Default::default()
+    };
+    let m = b.material(&velvet);
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let (mut root, bin) = b.finish(vec![node]);
+    let dir = folder("sheen");
+    let path = write(&dir, "s.glb", &glb(&root, bin.clone()));
+    let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+    assert!(!scene.notes.iter().any(|n| n.contains("sheen") || n.contains("ignored")), "{:?}", scene.notes);
+    let want =
+        crate::bsdf::Bsdf::new(Vec3::new(0.3, 0.05, 0.1), 0.0, 1.0, 1.0).with_sheen(Vec3::new(0.9, 0.6, 0.7), 0.4);
+    assert_eq!(scene.materials[0], Material::Pbr(want));
+    let placed = crate::scene::Scene::from_toml(&placing("gltf = \"s.glb\""), "t.toml", Some(&dir)).unwrap();
+    let again = super::export::scene_to_glb(&placed).unwrap();
+    let reloaded = crate::scene::Scene::load(write(&dir, "again.glb", &again).to_str().unwrap()).unwrap();
+    assert_eq!(reloaded.materials[0], Material::Pbr(want));
+    // A sheen texture is named: the factors still apply, with a note.
+    let ext = root.materials[0].extensions.as_mut().unwrap();
+    let value = ext.others.get_mut(materials::SHEEN).unwrap().as_object_mut().unwrap();
+    value.insert("sheenRoughnessTexture".into(), json::Value::from_iter([("index", json::Value::from(0))]));
+    let scene = crate::scene::Scene::load(write(&dir, "t.glb", &glb(&root, bin.clone())).to_str().unwrap()).unwrap();
+    assert!(scene.notes.iter().any(|n| n.contains("sheen textures")), "{:?}", scene.notes);
+    assert_eq!(scene.materials[0], Material::Pbr(want));
+    // A colour of two numbers is noted and read as no sheen.
+    let ext = root.materials[0].extensions.as_mut().unwrap();
+    let value = ext.others.get_mut(materials::SHEEN).unwrap().as_object_mut().unwrap();
+    value.insert("sheenColorFactor".into(), json::Value::from(vec![0.5, 0.5]));
+    let scene = crate::scene::Scene::load(write(&dir, "m.glb", &glb(&root, bin)).to_str().unwrap()).unwrap();
+    assert!(
+        scene.notes.iter().any(|n| n.contains("KHR_materials_sheen factor that is not a number")),
+        "{:?}",
+        scene.notes
+    );
+    assert!(matches!(scene.materials[0], Material::Pbr(b) if !b.has_sheen()));
 }
 
 /// `KHR_materials_ior` sets an opaque dielectric's reflectance at normal
@@ -774,11 +821,11 @@ fn a_placed_gltf_object_plays_its_animations_and_keeps_its_notes() {
     assert!(close(triangle(&scene.at_time(0.5)), want), "{:?}", triangle(&scene.at_time(0.5)));
 
     // A note of the file (an extension it uses and hikari ignores) names it.
-    let json = json.replacen("\"asset\"", "\"extensionsUsed\": [\"KHR_materials_sheen\"],\n      \"asset\"", 1);
+    let json = json.replacen("\"asset\"", "\"extensionsUsed\": [\"KHR_materials_iridescence\"],\n      \"asset\"", 1);
     write(&dir, "d.gltf", json.as_bytes());
     let scene = crate::scene::Scene::from_toml(&toml, "t.toml", Some(&dir)).unwrap();
     assert!(
-        scene.notes.iter().any(|n| n.starts_with("d.gltf: ") && n.contains("KHR_materials_sheen")),
+        scene.notes.iter().any(|n| n.starts_with("d.gltf: ") && n.contains("KHR_materials_iridescence")),
         "{:?}",
         scene.notes
     );
