@@ -433,6 +433,10 @@ def test_sheen_edited_and_rendered():
     assert not np.array_equal(after, before), "the sheen changed nothing"
     with pytest.raises(ValueError, match="sheen_color"):
         pbr.sheen_color = (1.5, 0.0, 0.0)
+    pbr.specular_color = (1.0, 3.0, 0.5)
+    assert pbr.specular_color == pytest.approx((1.0, 3.0, 0.5))
+    with pytest.raises(ValueError, match="specular_color"):
+        pbr.specular_color = (-1.0, 0.0, 0.0)
     glass = hk.load("cornell-caustic")
     clear = next(m for m in glass.materials.values() if m.kind == "glass")
     assert clear.sheen_color is None

@@ -88,6 +88,10 @@ pub struct GpuSurface {
     /// The glTF BRDF's sheen colour (`Bsdf::sheen_color`, black: none).
     pub sheen_color: [f32; 3],
     pub _pad2: u32,
+    /// The glTF BRDF's specular colour (`Bsdf::specular_color`, white:
+    /// glTF's default).
+    pub specular_color: [f32; 3],
+    pub _pad3: u32,
 }
 
 /// The surfaces buffer's contents, as surface.wgsl's `Surfaces` reads it:
@@ -279,6 +283,8 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 _pad: [0; 2],
                 sheen_color: glossy.map_or([0.0; 3], |b| b.sheen_color.to_array()),
                 _pad2: 0,
+                specular_color: glossy.map_or([1.0; 3], |b| b.specular_color.to_array()),
+                _pad3: 0,
             }
         })
         .collect()

@@ -7,15 +7,15 @@ use hikari_core::sampling::{Rng, uniform_sphere};
 use hikari_gpu::test_support::{run_kernel, test_context};
 use hikari_gpu::wgsl::BSDF;
 
-/// Words per item: 22 inputs, then the outputs the kernel writes.
-const ITEM: usize = 47;
+/// Words per item: 25 inputs, then the outputs the kernel writes.
+const ITEM: usize = 50;
 /// Input words per item.
-const INPUTS: usize = 22;
+const INPUTS: usize = 25;
 
 /// A random material, roughness spread over the smooth, followed and
 /// gathered ranges, with the extremes (black, pure metal or dielectric,
 /// no specular) often.
-fn random_bsdf(rng: &mut Rng) -> Bsdf {
+fn random_bsdf(rng: &mut Rng, colours: &mut Rng) -> Bsdf {
     let pick = |rng: &mut Rng, values: &[f32]| {
         let i = (rng.next_f32() * (values.len() + 1) as f32) as usize;
         values.get(i).copied().unwrap_or_else(|| rng.next_f32())
@@ -28,6 +28,14 @@ fn random_bsdf(rng: &mut Rng) -> Bsdf {
     // Half at glTF's index 1.5, the rest from 1 to 3 (KHR_materials_ior).
     let ior = if rng.next_f32() < 0.5 { 1.5 } else { 1.0 + 2.0 * rng.next_f32() };
     let bsdf = Bsdf::new(base, metallic, roughness, specular).with_ior(ior);
+    // A third with a specular colour, some channels pushing F0 to 1 (drawn
+    // from a generator of their own, so the other draws stay those the
+    // tolerance below was set on).
+    let bsdf = if colours.next_f32() < 0.33 {
+        bsdf.with_specular_color(Vec3::new(colours.next_f32(), 3.0 * colours.next_f32(), 30.0 * colours.next_f32()))
+    } else {
+        bsdf
+    };
     // A third under a clear coat, smooth, followed or gathered.
     let bsdf =
         if rng.next_f32() < 0.33 { bsdf.with_clearcoat(pick(rng, &[1.0]), pick(rng, &[0.0, 0.2, 0.5])) } else { bsdf };
@@ -59,11 +67,12 @@ fn close(got: f32, want: f32, tolerance: f32) -> bool {
 fn wgsl_bsdf_matches_the_cpu() {
     let ctx = test_context("wgsl_bsdf_matches_the_cpu");
     let mut rng = Rng::for_item(18, 0);
+    let mut colours = Rng::for_item(18, 1);
     let n = 8192;
     let mut items = Vec::new();
     let mut input = vec![0u32; n * ITEM];
     for item in input.chunks_mut(ITEM) {
-        let (b, wo, wi) = (random_bsdf(&mut rng), random_direction(&mut rng), random_direction(&mut rng));
+        let (b, wo, wi) = (random_bsdf(&mut rng, &mut colours), random_direction(&mut rng), random_direction(&mut rng));
         let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
         let words = [
             b.base_color.x,
@@ -88,6 +97,9 @@ fn wgsl_bsdf_matches_the_cpu() {
             b.sheen_color.y,
             b.sheen_color.z,
             b.sheen_roughness,
+            b.specular_color.x,
+            b.specular_color.y,
+            b.specular_color.z,
         ];
         for (k, w) in words.iter().enumerate() {
             item[k] = w.to_bits();
@@ -98,7 +110,7 @@ fn wgsl_bsdf_matches_the_cpu() {
         "let o = {ITEM}u * id.x; if (o >= arrayLength(&io)) {{ return; }}\n\
          var w: array<f32, {INPUTS}>;\n\
          for (var k = 0u; k < {INPUTS}u; k++) {{ w[k] = bitcast<f32>(io[o + k]); }}\n\
-         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16], w[17], vec3<f32>(w[18], w[19], w[20]), w[21]);\n\
+         let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[15], w[16], w[17], vec3<f32>(w[18], w[19], w[20]), w[21], vec3<f32>(w[22], w[23], w[24]));\n\
          let wo = vec3<f32>(w[6], w[7], w[8]);\n\
          let wi = vec3<f32>(w[9], w[10], w[11]);\n\
          let u = vec2<f32>(w[13], w[14]);\n\
@@ -170,6 +182,8 @@ fn wgsl_bsdf_matches_the_cpu() {
     assert!(smooth > 500 && followed > 500 && gathered > 500, "{smooth} {followed} {gathered}");
     let coats = |r: f32| items.iter().filter(|(b, ..)| b.has_coat() && b.clearcoat_roughness == r).count();
     assert!(coats(0.0) > 200 && coats(0.2) > 200 && coats(0.5) > 200, "{} {} {}", coats(0.0), coats(0.2), coats(0.5));
+    let tinted = items.iter().filter(|(b, ..)| b.specular_color != Vec3::ONE && b.specular > 0.0).count();
+    assert!(tinted > 1000, "{tinted}");
     let sheens = |r: f32| items.iter().filter(|(b, ..)| b.has_sheen() && b.sheen_roughness == r).count();
     assert!(sheens(0.0) > 200 && sheens(0.3) > 200 && sheens(1.0) > 200, "{} {}", sheens(0.0), sheens(1.0));
 }

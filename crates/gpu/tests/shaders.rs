@@ -115,7 +115,9 @@ fn shared_structs_match_wgsl_layouts() {
             sheen_roughness,
             _pad,
             sheen_color,
-            _pad2
+            _pad2,
+            specular_color,
+            _pad3
         ]
     );
     let splat = hikari_gpu::splat::shader_source();

@@ -408,6 +408,26 @@ impl MaterialView {
         Ok(())
     }
 
+    /// A glTF material's specular colour (KHR_materials_specular's
+    /// specularColorFactor, scaling the dielectric's F0 per channel; white
+    /// is glTF's default); None for the others.
+    #[getter]
+    fn specular_color(&self) -> Option<(f32, f32, f32)> {
+        if let Material::Pbr(b) = self.get() { Some(tuple(b.specular_color)) } else { None }
+    }
+    #[setter]
+    fn set_specular_color(&self, rgb: (f32, f32, f32)) -> PyResult<()> {
+        let c = vec3(rgb, "material.specular_color")?;
+        if c.min_element() < 0.0 {
+            return Err(PyValueError::new_err(format!("material.specular_color: {rgb:?} has a negative component")));
+        }
+        let Material::Pbr(b) = self.get() else {
+            return Err(PyValueError::new_err(format!("material.specular_color: a {} has none", self.kind())));
+        };
+        self.set(Material::Pbr(b.with_specular_color(c)));
+        Ok(())
+    }
+
     /// A glTF material's sheen colour (KHR_materials_sheen's
     /// sheenColorFactor, (0, 0, 0): none); None for the others.
     #[getter]

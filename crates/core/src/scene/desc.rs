@@ -64,6 +64,8 @@ pub struct MaterialDesc {
     pub metallic: Option<f32>,
     pub roughness: Option<f32>,
     pub specular: Option<f32>,
+    /// KHR_materials_specular's colour (scales F0 per channel).
+    pub specular_color: Option<V3>,
     /// A clear coat over a pbr material (KHR_materials_clearcoat).
     pub clearcoat: Option<f32>,
     pub clearcoat_roughness: Option<f32>,

@@ -464,6 +464,7 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
         ("metallic", m.metallic.is_some()),
         ("roughness", m.roughness.is_some()),
         ("specular", m.specular.is_some()),
+        ("specular_color", m.specular_color.is_some()),
         ("clearcoat", m.clearcoat.is_some()),
         ("clearcoat_roughness", m.clearcoat_roughness.is_some()),
         ("sheen_color", m.sheen_color.is_some()),
@@ -502,6 +503,7 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
                     "metallic",
                     "roughness",
                     "specular",
+                    "specular_color",
                     "ior",
                     "clearcoat",
                     "clearcoat_roughness",
@@ -525,6 +527,7 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
                     p.color("sheen_color", m.sheen_color.unwrap_or([0.0; 3]), 1.0)?,
                     unit("sheen_roughness", m.sheen_roughness, 0.5)?,
                 )
+                .with_specular_color(p.color("specular_color", m.specular_color.unwrap_or([1.0; 3]), 100.0)?)
                 .with_ior(p.in_range("ior", m.ior.unwrap_or(1.5), (1.0, 3.0))?),
             ))
         }
@@ -970,6 +973,12 @@ intensity = [1.0, 1.0, 1.0]
         assert_eq!((b.sheen_color, b.sheen_roughness), (Vec3::new(0.9, 0.8, 0.7), 0.3));
         let e = err(&sheened.replace("0.9, 0.8", "1.9, 0.8"));
         assert!(e.to_string().contains("sheen_color") && e.to_string().contains("test.toml"), "{e}");
+        // And a specular colour (KHR_materials_specular), which may exceed 1.
+        let tinted = coated.replace("clearcoat = 1.0", "specular_color = [1.0, 2.0, 0.5]");
+        let s = parse(&tinted, "test.toml", SceneFiles::beside(None)).unwrap();
+        let Material::Pbr(b) = s.materials[0] else { panic!("{:?}", s.materials[0]) };
+        assert_eq!(b.specular_color, Vec3::new(1.0, 2.0, 0.5));
+        assert!(err(&tinted.replace("2.0, 0.5", "-2.0, 0.5")).to_string().contains("specular_color"));
     }
 
     #[test]

@@ -25,6 +25,8 @@ struct Bsdf {
     // The Charlie sheen over the base (KHR_materials_sheen; black: none).
     sheen_color: vec3<f32>,
     sheen_roughness: f32,
+    // KHR_materials_specular's colour: scales F0 per channel.
+    specular_color: vec3<f32>,
 }
 
 // The largest f32 below 1 (clearcoat.rs's ONE_BELOW).
@@ -122,15 +124,23 @@ fn bsdf_gathers_specular(b: Bsdf) -> bool {
     return b.roughness >= GATHER_ROUGHNESS;
 }
 
+// min(f0·specular_color, 1) per channel (Bsdf::dielectric_f0).
+fn bsdf_dielectric_f0(b: Bsdf) -> vec3<f32> {
+    return min(b.specular_color * b.f0, vec3<f32>(1.0));
+}
+
 fn bsdf_specular_fresnel(b: Bsdf, cos: f32) -> vec3<f32> {
     let w = schlick_weight(cos);
-    let f_dielectric = b.specular * (b.f0 + (1.0 - b.f0) * w);
+    let f0 = bsdf_dielectric_f0(b);
+    let f_dielectric = (f0 + (vec3<f32>(1.0) - f0) * w) * b.specular;
     let f_metal = b.base_color + (vec3<f32>(1.0) - b.base_color) * w;
-    return vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * f_metal;
+    return f_dielectric * (1.0 - b.metallic) + b.metallic * f_metal;
 }
 
 fn bsdf_diffuse_reflectance(b: Bsdf, cos: f32) -> vec3<f32> {
-    let f_dielectric = b.f0 + (1.0 - b.f0) * schlick_weight(cos);
+    let f0 = bsdf_dielectric_f0(b);
+    let f = f0 + (vec3<f32>(1.0) - f0) * schlick_weight(cos);
+    let f_dielectric = max(f.x, max(f.y, f.z));
     return b.base_color * ((1.0 - b.metallic) * (1.0 - b.specular * f_dielectric));
 }
 
@@ -379,10 +389,11 @@ fn bsdf_sample_specular_lobe(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample
 
 // Bsdf::base_albedo_estimate.
 fn bsdf_base_albedo_estimate(b: Bsdf) -> vec3<f32> {
-    let f_dielectric = b.specular * (b.f0 + (1.0 - b.f0) / 21.0);
-    let diffuse = b.base_color * ((1.0 - b.metallic) * (1.0 - f_dielectric));
+    let f0 = bsdf_dielectric_f0(b);
+    let f_dielectric = (f0 + (vec3<f32>(1.0) - f0) / 21.0) * b.specular;
+    let diffuse = b.base_color * ((1.0 - b.metallic) * (1.0 - max(f_dielectric.x, max(f_dielectric.y, f_dielectric.z))));
     let average = b.base_color + (vec3<f32>(1.0) - b.base_color) / 21.0;
-    let specular = vec3<f32>((1.0 - b.metallic) * f_dielectric) + b.metallic * average;
+    let specular = f_dielectric * (1.0 - b.metallic) + b.metallic * average;
     if (bsdf_has_sheen(b)) {
         let e = sheen_albedo_at(b, 0.5);
         let m = min(max(b.sheen_color.x, max(b.sheen_color.y, b.sheen_color.z)), 1.0);
@@ -630,14 +641,14 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // G-buffer's, textures applied; `s.albedo` where no texture is).
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
     return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
-        s.sheen_color, s.sheen_roughness);
+        s.sheen_color, s.sheen_roughness, s.specular_color);
 }
 
 // The BRDF of glossy surface `s` at a point whose textures gave `base`,
 // `metallic` and `roughness` (textures.wgsl's `surface_point`).
 fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsdf {
     return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
-        s.sheen_color, s.sheen_roughness);
+        s.sheen_color, s.sheen_roughness, s.specular_color);
 }
 
 // The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the

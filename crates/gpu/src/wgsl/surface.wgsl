@@ -41,6 +41,9 @@ struct Surface {
     _pad: array<u32, 2>,
     sheen_color: vec3<f32>,
     _pad2: u32,
+    // KHR_materials_specular's colour, scaling the dielectric's F0.
+    specular_color: vec3<f32>,
+    _pad3: u32,
 }
 
 // The surfaces buffer (scene_upload::surfaces_contents): the sheen's albedo

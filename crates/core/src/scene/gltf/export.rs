@@ -28,6 +28,8 @@ pub struct PbrMaterial {
     /// `KHR_materials_specular`'s factor: 1 is glTF's default dielectric
     /// (F0 = 0.04), 0 a pure Lambertian.
     pub specular: f32,
+    /// `KHR_materials_specular`'s colour (white: glTF's default).
+    pub specular_color: Rgb,
     /// `KHR_materials_ior` of an opaque material (1.5, glTF's default: not
     /// written).
     pub ior: f32,
@@ -60,6 +62,7 @@ impl Default for PbrMaterial {
             emission: Rgb::ZERO,
             glass_ior: None,
             specular: 1.0,
+            specular_color: Rgb::ONE,
             ior: 1.5,
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
@@ -191,11 +194,11 @@ impl GltfBuilder {
                 emissive_strength: json::extensions::material::EmissiveStrengthFactor(strength),
             });
         }
-        if m.specular != 1.0 {
+        if m.specular != 1.0 || m.specular_color != Rgb::ONE {
             extensions.specular = Some(json::extensions::material::Specular {
                 specular_factor: json::extensions::material::SpecularFactor(m.specular),
                 specular_texture: None,
-                specular_color_factor: json::extensions::material::SpecularColorFactor([1.0; 3]),
+                specular_color_factor: json::extensions::material::SpecularColorFactor(m.specular_color.to_array()),
                 specular_color_texture: None,
                 extras: Default::default(),
             });
@@ -546,6 +549,7 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
                 metallic: b.metallic,
                 roughness: b.roughness,
                 specular: b.specular,
+                specular_color: b.specular_color,
                 clearcoat: b.clearcoat,
                 clearcoat_roughness: b.clearcoat_roughness,
                 sheen_color: b.sheen_color,

@@ -4,7 +4,7 @@
 //! ([`Dielectric`]) of the base colour's tint, the roughness and
 //! `KHR_materials_ior` (which also sets an opaque dielectric's
 //! reflectance); `KHR_materials_specular`'s factor scales the
-//! dielectric's Fresnel (its colour is ignored); `KHR_materials_clearcoat`
+//! dielectric's Fresnel and its colour F0's; `KHR_materials_clearcoat`
 //! and `KHR_materials_sheen` add their layers (factors; their textures are
 //! noted as not read). Base-colour,
 //! metallic–roughness, emissive and normal textures are read
@@ -47,7 +47,8 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut other_sets = 0;
     let mut approximated = 0;
     let mut blended = 0;
-    let mut coloured_specular = 0;
+    let mut specular_textures = 0;
+    let mut transmission_textures = 0;
     let mut coat_textures = 0;
     let mut malformed_coats = 0;
     let mut coated_glass = 0;
@@ -81,6 +82,7 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let metallic = sane(Vec3::splat(pbr.metallic_factor()), 1.0).x;
             let roughness = sane(Vec3::splat(pbr.roughness_factor()), 1.0).x;
             let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+            transmission_textures += m.transmission().is_some_and(|t| t.transmission_texture().is_some()) as usize;
             let coat = Clearcoat::of(&m);
             coat_textures += coat.textured as usize;
             malformed_coats += coat.malformed as usize;
@@ -98,12 +100,18 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 // KHR_materials_specular's factor scales the dielectric's
                 // Fresnel (0: a pure Lambertian, as hikari's "diffuse").
                 let specular = m.specular().map_or(1.0, |s| s.specular_factor());
-                coloured_specular += m.specular().is_some_and(|s| s.specular_color_factor() != [1.0; 3]) as usize;
+                // Its colour scales F0 per channel.
+                let specular_color = m.specular().map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor()));
+                specular_textures += m
+                    .specular()
+                    .is_some_and(|s| s.specular_texture().is_some() || s.specular_color_texture().is_some())
+                    as usize;
                 // KHR_materials_ior sets the dielectric's reflectance.
                 Material::from_bsdf(
                     Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
                         .with_clearcoat(coat.factor, coat.roughness)
                         .with_sheen(sheen.color, sheen.roughness)
+                        .with_specular_color(specular_color)
                         .with_ior(m.ior().unwrap_or(1.5).clamp(1.0, 3.0)),
                 )
             };
@@ -154,8 +162,17 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             "{approximated} material(s) approximated: transmission from 0.5 as glass (factor 1), below 0.5 as none"
         ));
     }
-    if coloured_specular > 0 {
-        notes.push(format!("{coloured_specular} material(s) have a specularColorFactor, which is ignored (white)"));
+    if specular_textures > 0 {
+        notes.push(format!(
+            "{specular_textures} material(s) have KHR_materials_specular textures, which are not read yet: their \
+             specularFactor and specularColorFactor apply uniformly"
+        ));
+    }
+    if transmission_textures > 0 {
+        notes.push(format!(
+            "{transmission_textures} material(s) have a transmissionTexture, which is not read: the \
+             transmissionFactor applies uniformly"
+        ));
     }
     if coat_textures > 0 {
         notes.push(format!(

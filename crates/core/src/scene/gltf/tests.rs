@@ -474,6 +474,37 @@ fn the_specular_extension_is_read() {
     assert_eq!(scene.materials[0], Material::Diffuse { albedo: Vec3::splat(0.5), specular: Vec3::ZERO });
 }
 
+/// `KHR_materials_specular`'s colour tints F0 (no longer noted as
+/// ignored), comes back from the exporter, and its textures are noted as
+/// not read.
+#[test]
+fn the_specular_colour_is_read() {
+    let mut b = GltfBuilder::new();
+    let tint = Vec3::new(1.0, 2.5, 0.5);
+    let image = b.image(&super::export::png(1, 1, &[255; 4]), "image/png");
+    let texture = b.texture(image, json::texture::WrappingMode::Repeat, json::texture::WrappingMode::Repeat);
+    let m = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular_color: tint, ..Default::default() });
+    let mesh = b.mesh(&TRIANGLE, None, None, Some(m));
+    let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+    let (mut root, bin) = b.finish(vec![node]);
+    let dir = folder("specular-colour");
+    write(&dir, "s.glb", &glb(&root, bin.clone()));
+    let scene = crate::scene::Scene::from_toml(&placing("gltf = \"s.glb\""), "t.toml", Some(&dir)).unwrap();
+    assert!(!scene.notes.iter().any(|n| n.contains("specular")), "{:?}", scene.notes);
+    let Material::Pbr(bsdf) = scene.materials[0] else { panic!("{:?}", scene.materials[0]) };
+    assert_eq!(bsdf.specular_color, tint);
+    assert!((bsdf.dielectric_f0 - Vec3::new(0.04, 0.1, 0.02)).abs().max_element() < 1e-7);
+    let again = super::export::scene_to_glb(&scene).unwrap();
+    let reloaded = crate::scene::Scene::load(write(&dir, "again.glb", &again).to_str().unwrap()).unwrap();
+    assert!(matches!(reloaded.materials[0], Material::Pbr(b) if b.specular_color == tint));
+    // A specular texture is noted.
+    let ext = root.materials[0].extensions.as_mut().unwrap();
+    ext.specular.as_mut().unwrap().specular_texture =
+        Some(json::texture::Info { index: texture, tex_coord: 0, extensions: None, extras: Default::default() });
+    let scene = crate::scene::Scene::load(write(&dir, "t.glb", &glb(&root, bin)).to_str().unwrap()).unwrap();
+    assert!(scene.notes.iter().any(|n| n.contains("KHR_materials_specular textures")), "{:?}", scene.notes);
+}
+
 /// `KHR_materials_transmission` is glass of the material's roughness,
 /// tinted by its base colour, with `KHR_materials_ior`: no longer noted
 /// as approximated (Blender writes rough and coloured glass this way).
