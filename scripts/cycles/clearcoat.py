@@ -13,22 +13,14 @@
 #   python shared/relerr.py path.exr OUT/cycles.exr
 import bpy, sys, os
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import balls_before_a_wall, constant_sky, export_and_render
+from common import balls_before_a_wall, constant_sky, export_and_render, principled_material
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 def principled(name, color, roughness, metallic=0.0, coat=0.0, coat_roughness=0.0, specular=0.5):
-    m = bpy.data.materials.new(name); m.use_nodes = True
-    p = m.node_tree.nodes["Principled BSDF"]
-    p.distribution = "GGX"
-    p.inputs["Base Color"].default_value = (*color, 1)
-    p.inputs["Roughness"].default_value = roughness
-    p.inputs["Metallic"].default_value = metallic
-    p.inputs["Specular IOR Level"].default_value = specular
-    p.inputs["Coat Weight"].default_value = coat
-    p.inputs["Coat Roughness"].default_value = coat_roughness
-    p.inputs["Coat IOR"].default_value = 1.5
-    return m
+    return principled_material(name, {"Base Color": (*color, 1), "Roughness": roughness, "Metallic": metallic,
+                                      "Specular IOR Level": specular, "Coat Weight": coat,
+                                      "Coat Roughness": coat_roughness, "Coat IOR": 1.5})
 grey = principled("grey", (0.6, 0.6, 0.6), 1.0, specular=0.0)
 balls = [
     (-2.7, principled("plain red", (0.63, 0.07, 0.05), 0.6)),

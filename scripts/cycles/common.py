@@ -5,6 +5,16 @@ import bpy, math, os
 import numpy as np, OpenEXR, Imath
 
 
+def principled_material(name, inputs):
+    """A material of one Principled BSDF (GGX) with `inputs` (socket name: value)."""
+    m = bpy.data.materials.new(name); m.use_nodes = True
+    p = m.node_tree.nodes["Principled BSDF"]
+    p.distribution = "GGX"
+    for socket, value in inputs.items():
+        p.inputs[socket].default_value = value
+    return m
+
+
 def box(loc, size, material):
     bpy.ops.mesh.primitive_cube_add(location=loc)
     o = bpy.context.object

@@ -13,19 +13,13 @@
 #   python shared/relerr.py path.exr OUT/cycles.exr
 import bpy, sys, os
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import balls_before_a_wall, constant_sky, export_and_render
+from common import balls_before_a_wall, constant_sky, export_and_render, principled_material
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 def principled(name, color, roughness, tint=(1, 1, 1), specular=0.5):
-    m = bpy.data.materials.new(name); m.use_nodes = True
-    p = m.node_tree.nodes["Principled BSDF"]
-    p.distribution = "GGX"
-    p.inputs["Base Color"].default_value = (*color, 1)
-    p.inputs["Roughness"].default_value = roughness
-    p.inputs["Specular IOR Level"].default_value = specular
-    p.inputs["Specular Tint"].default_value = (*tint, 1)
-    return m
+    return principled_material(name, {"Base Color": (*color, 1), "Roughness": roughness,
+                                      "Specular IOR Level": specular, "Specular Tint": (*tint, 1)})
 grey = principled("grey", (0.6, 0.6, 0.6), 1.0, specular=0.0)
 balls = [
     (-2.7, principled("plain red", (0.63, 0.07, 0.05), 0.3)),
