@@ -4,14 +4,15 @@
 //! # The model
 //!
 //! glTF 2.0, Appendix B ("BRDF Implementation"), with KHR_materials_specular's
-//! `specularFactor` s scaling the dielectric's Fresnel and KHR_materials_ior's
-//! index η setting its reflectance at normal incidence, F0 = ((η − 1)/(η + 1))²
-//! (0.04 at glTF's default 1.5):
+//! `specularFactor` s scaling the dielectric's Fresnel and its
+//! `specularColorFactor` c scaling its reflectance at normal incidence per
+//! channel, which KHR_materials_ior's index η sets: F0 = min(c·((η − 1)/(η +
+//! 1))², 1) (0.04 at glTF's defaults):
 //!
 //! ```text
 //! f          = mix(dielectric, metal, metallic)
-//! dielectric = (1 − s·F_d)·base/π + s·F_d·D·V     F_d = F0 + (1 − F0)(1 − |v·h|)^5
-//! metal      = F_m·D·V                            F_m = base + (1 − base)(1 − |v·h|)^5
+//! dielectric = (1 − s·max(F_d))·base/π + s·F_d·D·V   F_d = F0 + (1 − F0)(1 − |v·h|)^5
+//! metal      = F_m·D·V                              F_m = base + (1 − base)(1 − |v·h|)^5
 //! ```
 //!
 //! with h the half vector, D the Trowbridge–Reitz (GGX) distribution of
@@ -45,19 +46,22 @@
 //!
 //! # Sampling
 //!
-//! `sample` picks the diffuse lobe (cosine-weighted) or the specular lobe
-//! (GGX visible normals, Heitz 2018) with probabilities proportional to the
-//! channel means of their weights at `wo`, (1 − metallic)(1 − s·F_d)·base
-//! against the specular Fresnel, and returns the one-sample mixture density of
+//! `sample` picks the diffuse lobe (cosine-weighted), the specular lobe
+//! (GGX visible normals, Heitz 2018) or the sheen (uniform) with
+//! probabilities proportional to the channel means of their weights at
+//! `wo`, (1 − metallic)(1 − s·max(F_d))·base against the specular Fresnel
+//! and the sheen's albedo, and returns the one-sample mixture density of
 //! both (what MIS needs), so `weight = f·cos/pdf` stays bounded whichever lobe
 //! produced the direction.
 //!
 //! # WGSL twin
 //!
-//! The GPU renderer will carry a WGSL version of `f`, `pdf` and `sample`; a
-//! test will pin it to these functions on random inputs (not written yet).
-//! Hence plain f32 arithmetic only: no lookup tables, powers written as
-//! products, and the sampler's angles through `sampling::unit_circle`.
+//! `crates/gpu/src/wgsl/bsdf.wgsl` carries `f`, `pdf`, `sample` and the
+//! photon-map split operation for operation; `crates/gpu/tests/bsdf.rs` pins
+//! it to these functions on random materials and directions. Hence plain
+//! f32 arithmetic: powers written as products, the sampler's angles through
+//! `sampling::unit_circle`, and the one table (the sheen's albedo) uploaded
+//! as it is here.
 
 pub mod clearcoat;
 pub mod dielectric;
@@ -324,10 +328,10 @@ impl Bsdf {
             lobes.specular = fresnel * (ggx::d(h, alpha) * ggx::visibility(wo, wi, alpha));
         }
         if self.has_sheen() {
-            let scaling = self.sheen_scaling(wo.z, wi.z);
+            let (scaling, sheen) = self.sheen_parts(wo, wi);
             lobes.diffuse *= scaling;
             lobes.specular *= scaling;
-            lobes.sheen = self.sheen_lobe(wo, wi);
+            lobes.sheen = sheen;
         }
         lobes
     }

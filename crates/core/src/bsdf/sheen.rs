@@ -136,25 +136,15 @@ impl Bsdf {
         sheen_albedo(cos, self.sheen_roughness).min(1.0)
     }
 
-    /// The sheen lobe f_sheen (zero without a sheen); both directions
-    /// above the surface.
-    pub(super) fn sheen_lobe(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if !self.has_sheen() {
-            return Rgb::ZERO;
-        }
+    /// S, what the sheen leaves of the base's lobes, and the sheen lobe
+    /// f_sheen between `wo` and `wi` (both above the surface), reading the
+    /// albedo table once per direction: the max of E(θo) and E(θi) sets
+    /// both, max(Ê(θo), Ê(θi)) = min(max(E(θo), E(θi)), 1).
+    pub(super) fn sheen_parts(&self, wo: Vec3, wi: Vec3) -> (f32, Rgb) {
         let r = effective_roughness(self.sheen_roughness);
-        let norm = sheen_albedo(wo.z, r).max(sheen_albedo(wi.z, r)).max(1.0);
-        self.sheen_color * (white_sheen(wo, wi, r) / norm)
-    }
-
-    /// S: what the sheen leaves of the base's lobes between `cos_o` and
-    /// `cos_i` (1 without a sheen).
-    pub(super) fn sheen_scaling(&self, cos_o: f32, cos_i: f32) -> f32 {
-        if !self.has_sheen() {
-            return 1.0;
-        }
+        let e = sheen_albedo(wo.z, r).max(sheen_albedo(wi.z, r));
         let m = self.sheen_color.max_element().min(1.0);
-        1.0 - m * self.sheen_albedo_at(cos_o).max(self.sheen_albedo_at(cos_i))
+        (1.0 - m * e.min(1.0), self.sheen_color * (white_sheen(wo, wi, r) / e.max(1.0)))
     }
 
     /// The sheen's lobe-selection weight at `cos_o`: its albedo there.

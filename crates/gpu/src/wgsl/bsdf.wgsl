@@ -220,21 +220,12 @@ fn sheen_albedo_at(b: Bsdf, cos: f32) -> f32 {
     return min(sheen_albedo(cos, b.sheen_roughness), 1.0);
 }
 
-fn sheen_lobe(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    if (!bsdf_has_sheen(b)) {
-        return vec3<f32>(0.0);
-    }
+// S and f_sheen between wo and wi (Bsdf::sheen_parts): x the scaling, yzw the lobe.
+fn sheen_parts(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec4<f32> {
     let r = sheen_effective_roughness(b.sheen_roughness);
-    let norm = max(max(sheen_albedo(wo.z, r), sheen_albedo(wi.z, r)), 1.0);
-    return b.sheen_color * (white_sheen(wo, wi, r) / norm);
-}
-
-fn sheen_scaling(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
-    if (!bsdf_has_sheen(b)) {
-        return 1.0;
-    }
+    let e = max(sheen_albedo(wo.z, r), sheen_albedo(wi.z, r));
     let m = min(max(b.sheen_color.x, max(b.sheen_color.y, b.sheen_color.z)), 1.0);
-    return 1.0 - m * max(sheen_albedo_at(b, cos_o), sheen_albedo_at(b, cos_i));
+    return vec4<f32>(1.0 - m * min(e, 1.0), b.sheen_color * (white_sheen(wo, wi, r) / max(e, 1.0)));
 }
 
 fn sheen_weight(b: Bsdf, cos_o: f32) -> f32 {
@@ -288,10 +279,10 @@ fn bsdf_f_lobes(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> Lobes {
         lobes.specular = bsdf_specular_fresnel(b, cos) * (ggx_d(h, alpha) * ggx_visibility(wo, wi, alpha));
     }
     if (bsdf_has_sheen(b)) {
-        let scaling = sheen_scaling(b, wo.z, wi.z);
-        lobes.diffuse *= scaling;
-        lobes.specular *= scaling;
-        lobes.sheen = sheen_lobe(b, wo, wi);
+        let parts = sheen_parts(b, wo, wi);
+        lobes.diffuse *= parts.x;
+        lobes.specular *= parts.x;
+        lobes.sheen = parts.yzw;
     }
     return lobes;
 }
