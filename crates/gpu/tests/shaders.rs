@@ -193,7 +193,11 @@ fn shared_structs_match_wgsl_layouts() {
             sample_table,
             view_table,
             region_table,
-            environment_table
+            environment_table,
+            shading_table,
+            _pad0,
+            _pad1,
+            _pad2
         ]
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);

@@ -53,6 +53,7 @@ pub fn shader_source() -> String {
         &crate::direct::LIGHT_EVAL,
         &LOOP_BUDGET,
         &BVH,
+        &crate::wgsl::HIT_NORMALS,
         &OPTICS,
         &crate::wgsl::DIELECTRIC,
         &crate::wgsl::SURFACE,
@@ -107,6 +108,11 @@ pub struct SpecularParams {
     pub view_table: u32,
     pub region_table: u32,
     pub environment_table: u32,
+    /// The flat BVH's vertex normals (`FlatShading` records, hit_normals.wgsl).
+    pub shading_table: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// Mirrors `SliceParams` in specular.wgsl: which share of the photon
@@ -207,8 +213,8 @@ impl SceneData {
 /// rewrite them in place; the sky image once).
 struct SpecularTables {
     buffer: wgpu::Buffer,
-    /// Word offsets: lights, samples, views, regions, sky image.
-    offsets: [u32; 5],
+    /// Word offsets: lights, samples, views, regions, sky image, vertex normals.
+    offsets: [u32; 6],
     views: wgpu::Buffer,
     regions: wgpu::Buffer,
     environment: wgpu::Buffer,
@@ -222,6 +228,7 @@ impl SpecularTables {
         views: &wgpu::Buffer,
         regions: &wgpu::Buffer,
         environment: &wgpu::Buffer,
+        shading: &[hikari_core::geometry::FlatShading],
     ) -> Self {
         let mut tables = crate::tables::PackedTables::after(Vec::new());
         let words = |b: &wgpu::Buffer| (b.size() / 4) as usize;
@@ -231,6 +238,7 @@ impl SpecularTables {
             tables.reserve_words(words(views)),
             tables.reserve_words(words(regions)),
             tables.reserve_words(words(environment)),
+            tables.push(shading),
         ];
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         SpecularTables {
@@ -245,8 +253,16 @@ impl SpecularTables {
 
     /// `params` pointing at these tables.
     fn locate(&self, params: SpecularParams) -> SpecularParams {
-        let [light_table, sample_table, view_table, region_table, environment_table] = self.offsets;
-        SpecularParams { light_table, sample_table, view_table, region_table, environment_table, ..params }
+        let [light_table, sample_table, view_table, region_table, environment_table, shading_table] = self.offsets;
+        SpecularParams {
+            light_table,
+            sample_table,
+            view_table,
+            region_table,
+            environment_table,
+            shading_table,
+            ..params
+        }
     }
 
     /// `lights`' samples in place of the ones it was made with (the same
@@ -257,7 +273,7 @@ impl SpecularTables {
 
     /// Records the copies of what the renderer may have rewritten.
     fn copy_in(&self, encoder: &mut wgpu::CommandEncoder) {
-        let [_, _, views, regions, environment] = self.offsets.map(|words| words as u64 * 4);
+        let [_, _, views, regions, environment, _] = self.offsets.map(|words| words as u64 * 4);
         encoder.copy_buffer_to_buffer(&self.views, 0, &self.buffer, views, self.views.size());
         encoder.copy_buffer_to_buffer(&self.regions, 0, &self.buffer, regions, self.regions.size());
         if !self.environment_copied.replace(true) {
@@ -436,8 +452,14 @@ impl SpecularPass {
 
         let (words, grid_params) = PackedGrids::new(inputs);
         let (forward, right, up, tan_half_fov) = scene.camera.basis();
-        let tables =
-            SpecularTables::new(device, lights, &maps.views_buffer, &media.regions, &scene_buffers.environment);
+        let tables = SpecularTables::new(
+            device,
+            lights,
+            &maps.views_buffer,
+            &media.regions,
+            &scene_buffers.environment,
+            &scene_buffers.bvh.shading,
+        );
         let params = tables.locate(SpecularParams {
             camera_position: scene.camera.position.to_array(),
             tan_half_fov,
@@ -577,7 +599,14 @@ impl SpecularPass {
         b.textures = scene_buffers.textures.clone();
         // The region triangles stay the renderer's (rewritten in place).
         let regions = b.tables.regions.clone();
-        b.tables = SpecularTables::new(device, lights, &maps.views_buffer, &regions, &scene_buffers.environment);
+        b.tables = SpecularTables::new(
+            device,
+            lights,
+            &maps.views_buffer,
+            &regions,
+            &scene_buffers.environment,
+            &scene_buffers.bvh.shading,
+        );
         self.params = b.tables.locate(self.params);
         b.maps = maps.texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

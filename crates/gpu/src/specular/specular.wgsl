@@ -55,6 +55,10 @@ struct SpecularParams {
     view_table: u32,
     region_table: u32,
     environment_table: u32,
+    shading_table: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 
@@ -83,6 +87,14 @@ struct SpecularParams {
 
 fn table_word(at: u32) -> u32 {
     return tables[at];
+}
+
+// hit_normals.wgsl's vertex normals: the flat BVH's FlatShading records
+// (16 words each) in the tables.
+fn flat_shading(index: u32) -> FlatShading {
+    let at = params.shading_table + 16u * index;
+    let normals = array<vec4<f32>, 3>(table_vec4(at + 4u), table_vec4(at + 8u), table_vec4(at + 12u));
+    return FlatShading(table_vec3(at), table_u32(at + 3u), normals);
 }
 
 // The tables' records (tables.wgsl), field by field as the Rust structs
@@ -402,15 +414,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         let p = prims[hit.prim];
         let x = b.origin + b.dir * hit.t;
-        var ng = normalize(cross(p.b, p.c));
-        if (p.is_sphere != 0u) {
-            ng = normalize(x - p.a);
-        }
+        // Glass refracts about the geometric normal, the rest reflects about
+        // the smooth shading one, as the CPU renderers do.
+        let normals = hit_normals(hit.prim, b.origin, b.dir, x);
+        let ng = normals.geometric;
         let s = surfaces.all[p.surface];
         // The surface here with its textures (level 0, as the CPU reads).
         let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
         let front = dot(b.dir, ng) < 0.0;
         let n = select(-ng, ng, front);
+        let ns = select(-normals.shading, normals.shading, front);
         let can_bounce = b.depth < params.max_depth;
         // Emitted light (Light::emitted_radiance), besides what the surface
         // reflects; a primary hit's is the G-buffer's.
@@ -428,29 +441,29 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     if (slice.index == 0u) {
                         // Its own stream, so slice 0's draws leave the path's alone.
                         var light_rng = hash_u32(path_rng ^ 0x68bc21ebu);
-                        let r = surface_reflector(s, bsdf, eye, n);
-                        radiance += weight * direct_radiance(x, n, r, &light_rng);
+                        let r = surface_reflector(s, bsdf, eye, ns);
+                        radiance += weight * direct_radiance(x, ns, r, &light_rng);
                     }
-                    let g = gather(x, n, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
-                    let c = gather(x, n, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    let g = gather(x, ns, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
+                    let c = gather(x, ns, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
                     radiance += weight * (g + c);
                 }
                 if (follows_lobe(s, bsdf)) {
                     // One direction of the specular lobe per pass.
-                    let sample = bsdf_sample_followed(bsdf, to_shading(eye, n), stream_next_2d(&path_rng));
+                    let sample = bsdf_sample_followed(bsdf, to_shading(eye, ns), stream_next_2d(&path_rng));
                     if (sample.valid && can_bounce && top < STACK) {
-                        let dir = local_to_world(sample.wi, n);
+                        let dir = local_to_world(sample.wi, ns);
                         stack[top] = Branch(x, b.depth + 1u, dir, select(0u, 1u, sample.is_delta), weight * sample.weight);
                         top += 1u;
                     }
                 } else if (any(s.specular > vec3<f32>(0.0)) && can_bounce && top < STACK) {
-                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), 1u, weight * s.specular);
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, ns), 1u, weight * s.specular);
                     top += 1u;
                 }
             }
             case 1u: {
                 if (can_bounce && top < STACK) {
-                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, n), 1u, weight * s.albedo);
+                    stack[top] = Branch(x, b.depth + 1u, reflect(b.dir, ns), 1u, weight * s.albedo);
                     top += 1u;
                 }
             }

@@ -43,6 +43,7 @@ pub fn trace_shader_source() -> String {
             &SAMPLING,
             &OPTICS,
             &BVH,
+            &crate::wgsl::HIT_NORMALS,
             &SURFACE,
             &crate::wgsl::BSDF,
             &crate::wgsl::DIELECTRIC,

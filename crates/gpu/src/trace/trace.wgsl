@@ -107,11 +107,6 @@ struct TraceRegionTriangle {
     _pad1: u32,
 }
 
-struct FlatShading {
-    geometric_normal: vec3<f32>,
-    has_vertex_normals: u32,
-    vertex_normals: array<vec4<f32>, 3>,
-}
 
 
 @group(0) @binding(0) var<uniform> params: TraceParams;
@@ -131,6 +126,11 @@ struct FlatShading {
 
 fn table_word(at: u32) -> u32 {
     return texture_data[at];
+}
+
+// hit_normals.wgsl's source of vertex normals.
+fn flat_shading(index: u32) -> FlatShading {
+    return shading[index];
 }
 
 // The tables' records, field by field as the Rust structs lay them out.
@@ -414,40 +414,6 @@ fn mesh_point(l: TraceLight, u: vec2<f32>) -> MeshPoint {
     let b1 = s * (1.0 - u.y);
     let b2 = s * u.y;
     return MeshPoint(tri.v0 * (1.0 - b1 - b2) + tri.v1 * b1 + tri.v2 * b2, tri.normal);
-}
-
-// Accel::intersect's normals at a hit on primitive `index` at x: the
-// geometric one, and the shading one on its side.
-struct HitNormals {
-    geometric: vec3<f32>,
-    shading: vec3<f32>,
-}
-
-fn hit_normals(index: u32, o: vec3<f32>, d: vec3<f32>, x: vec3<f32>) -> HitNormals {
-    let p = prims[index];
-    if (p.is_sphere != 0u) {
-        let n = unit((x - p.a) / p.b.x);
-        return HitNormals(n, n);
-    }
-    let s = shading[index];
-    let ng = s.geometric_normal;
-    if (s.has_vertex_normals == 0u) {
-        return HitNormals(ng, ng);
-    }
-    // The barycentrics of the hit, as Triangle::intersect computes them.
-    let pv = cross(d, p.c);
-    let inv = 1.0 / dot(p.b, pv);
-    let sv = o - p.a;
-    let b1 = dot(sv, pv) * inv;
-    let b2 = dot(d, cross(sv, p.b)) * inv;
-    let blend = s.vertex_normals[0].xyz * (1.0 - b1 - b2) + s.vertex_normals[1].xyz * b1 + s.vertex_normals[2].xyz * b2;
-    let len = length(blend);
-    var ns = ng;
-    // Finite and non-zero (NaN fails both comparisons).
-    if (len > 0.0 && len < 3.0e38) {
-        ns = blend / len;
-    }
-    return HitNormals(ng, select(ns, -ns, dot(ns, ng) < 0.0));
 }
 
 @compute @workgroup_size(WORKGROUP_SIZE)

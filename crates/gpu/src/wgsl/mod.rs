@@ -79,6 +79,11 @@ pub static REGION_CROSSING: Module =
 /// Closest hits in the flat BVH (hikari_core::geometry::FlatBvh).
 pub static BVH: Module = Module { name: "bvh.wgsl", source: include_str!("bvh.wgsl"), requires: &[] };
 
+/// The geometric and shading normals at a BVH hit (Accel::intersect's),
+/// from the includer's `flat_shading`.
+pub static HIT_NORMALS: Module =
+    Module { name: "hit_normals.wgsl", source: include_str!("hit_normals.wgsl"), requires: &[&BVH, &OPTICS] };
+
 /// `prim_is_there` for bvh.wgsl: the alpha test of cut-outs (alphaMode
 /// MASK) at a candidate hit, as `Accel` tests it. The includer declares
 /// `prims`, `surfaces` and `texture_data`.
