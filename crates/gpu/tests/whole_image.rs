@@ -433,11 +433,10 @@ fn gpu_image_matches_photon_cpu_under_a_sun_and_a_sky_in_fog() {
 /// radiance where its rays hit the mesh's front and its light at the
 /// diffuse hits beyond, as photon-cpu's recursion does (the Cornell box of
 /// `cornell_quad_light`, its light as a mesh, its back wall a mirror).
-#[test]
-fn an_emissive_mesh_shows_in_a_mirror() {
-    use hikari_core::test_scenes::quad_lights_as_meshes;
-    let text = hikari_core::scene::builtin::source("cornell-box").unwrap();
-    let text = text
+/// The built-in Cornell box's TOML with its back wall a mirror (reflectance 0.9).
+fn cornell_box_with_a_mirror_back_wall() -> String {
+    hikari_core::scene::builtin::source("cornell-box")
+        .unwrap()
         .replacen(
             "[[material]]",
             "[[material]]\nname = \"mirror\"\ntype = \"mirror\"\nreflectance = [0.9, 0.9, 0.9]\n\n[[material]]",
@@ -447,7 +446,13 @@ fn an_emissive_mesh_shows_in_a_mirror() {
             "edge_u = [2.0, 0.0, 0.0]\nedge_v = [0.0, 2.0, 0.0]\nmaterial = \"white\"",
             "edge_u = [2.0, 0.0, 0.0]\nedge_v = [0.0, 2.0, 0.0]\nmaterial = \"mirror\"",
             1,
-        );
+        )
+}
+
+#[test]
+fn an_emissive_mesh_shows_in_a_mirror() {
+    use hikari_core::test_scenes::quad_lights_as_meshes;
+    let text = cornell_box_with_a_mirror_back_wall();
     let start = text.find("[[light]]").unwrap();
     let quad = "[[light]]\ntype = \"quad\"\ncorner = [-0.25, 0.999, -0.25]\nedge_u = [0.5, 0.0, 0.0]\n\
                 edge_v = [0.0, 0.0, 0.5]\nradiance = [12.0, 12.0, 12.0]\n";
@@ -502,18 +507,7 @@ fn a_smooth_mesh_shows_smooth_in_a_mirror() {
         }
     }
     std::fs::write(dir.join("sphere.obj"), obj).unwrap();
-    let text = hikari_core::scene::builtin::source("cornell-box").unwrap();
-    let text = text
-        .replacen(
-            "[[material]]",
-            "[[material]]\nname = \"mirror\"\ntype = \"mirror\"\nreflectance = [0.9, 0.9, 0.9]\n\n[[material]]",
-            1,
-        )
-        .replacen(
-            "edge_u = [2.0, 0.0, 0.0]\nedge_v = [0.0, 2.0, 0.0]\nmaterial = \"white\"",
-            "edge_u = [2.0, 0.0, 0.0]\nedge_v = [0.0, 2.0, 0.0]\nmaterial = \"mirror\"",
-            1,
-        );
+    let text = cornell_box_with_a_mirror_back_wall();
     let start = text.find("[[light]]").unwrap();
     let sphere =
         "[[object]]\nmesh = \"sphere.obj\"\nscale = 0.25\ntranslate = [0.6, 0.4, 0.8]\nmaterial = \"white\"\n\n";
