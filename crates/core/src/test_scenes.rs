@@ -348,6 +348,39 @@ pub mod gltf_textures {
         b.node(json::Node { mesh: Some(mesh), ..Default::default() })
     }
 
+    /// A normal-mapped quad (one texel tilting its normal 45°; a skewed
+    /// parallelogram, so the tangent frame is neither axis-aligned nor
+    /// orthogonal) facing a smooth metal mirror in the plane z = 0, a point
+    /// light between them, the camera at `size`² looking at the mirror from
+    /// beside the quad.
+    pub fn normal_map_before_a_mirror(tag: &str, size: u32) -> Scene {
+        use crate::scene::gltf::export::GltfBuilder;
+        use json::extensions::scene::khr_lights_punctual::Type;
+        let mut b = GltfBuilder::new();
+        let image = b.image(&png(1, 1, &[218, 128, 218, 255]), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let mapped = b.material(&PbrMaterial {
+            base_color: Vec3::splat(0.7),
+            specular: 0.0,
+            normal_texture: Some((t, 1.0)),
+            ..Default::default()
+        });
+        let mirror =
+            b.material(&PbrMaterial { base_color: Vec3::ONE, metallic: 1.0, roughness: 0.0, ..Default::default() });
+        // Facing −z, toward the mirror, centred on (−0.8, 0, 1).
+        let (eu, ev) = (Vec3::new(1.0, 0.2, 0.1), Vec3::new(0.3, -1.0, 0.0));
+        let quad_node = quad(&mut b, Vec3::new(-0.8, 0.0, 1.0) - 0.5 * (eu + ev), eu, ev, 1.0, mapped);
+        let mirror_node =
+            quad(&mut b, Vec3::new(-2.0, -1.5, 0.0), Vec3::new(3.5, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0), 1.0, mirror);
+        let light = b.light(Type::Point, Vec3::ONE, 4.0 * 683.0, None);
+        let light_node = b.node(GltfBuilder::light_node(light, Vec3::new(-0.5, 0.3, 0.45), glam::Quat::IDENTITY));
+        let mut scene = load(tag, &b.to_glb(vec![quad_node, mirror_node, light_node]));
+        scene.camera =
+            crate::camera::Camera::new(Vec3::new(2.0, 0.0, 3.0), Vec3::new(-0.1, 0.0, 0.0), Vec3::Y, 40.0, size, size)
+                .unwrap();
+        scene
+    }
+
     /// 2×2 greys, sRGB-encoded, rows from the top: 255, 0 / 128, 64.
     pub const GREYS: [u8; 4] = [255, 0, 128, 64];
 

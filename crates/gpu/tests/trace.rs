@@ -328,6 +328,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("glossy box, point light", glossy_box(glossy_lights::POINT, 16)),
         ("textured cut-out", gltf_textures::load("trace-cutout", &gltf_textures::cutout_glb())),
         ("rough tinted glass", rough_caustic("")),
+        ("normal map before a mirror", gltf_textures::normal_map_before_a_mirror("trace-normal-map", 16)),
     ]
 }
 
@@ -387,12 +388,18 @@ fn gpu_tracer_stores_the_cpu_photons() {
             let size_ratio = g.len() as f64 / c.len() as f64;
             assert!((size_ratio - 1.0).abs() < 0.01, "{name} {map}: {} vs {}", g.len(), c.len());
             assert!(near > 0.97, "{name} {map}: only {:.2}% within rounding", 100.0 * near);
-            // Without media every operation is mirrored exactly, and
-            // lavapipe (Vulkan) keeps the CPU's bits for > 99.99% of photons.
+            // Without media and normal textures every operation is mirrored
+            // exactly, and lavapipe (Vulkan) keeps the CPU's bits for > 99.99%
+            // of photons. A normal texture's bend goes through cross products
+            // and square roots WGSL may round otherwise (97.5% of the
+            // normal-mapped scene's global photons identical, 100% within
+            // rounding): only within rounding there.
             // Mesa's GL fuses some products into multiply-adds (cornell-caustic:
             // 92.6% of the global and 37.7% of the caustic map bit-identical,
             // 100% within rounding), as real GPUs may: only reported there.
-            if scene.media.is_empty() && strict_float {
+            let bends =
+                scene.texturing.as_ref().is_some_and(|t| t.materials.iter().flatten().any(|m| m.normal.is_some()));
+            if scene.media.is_empty() && !bends && strict_float {
                 assert!(exact > 0.97, "{name} {map}: only {:.2}% identical", 100.0 * exact);
             }
         }

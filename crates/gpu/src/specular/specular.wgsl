@@ -420,10 +420,18 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let ng = normals.geometric;
         let s = surfaces.all[p.surface];
         // The surface here with its textures (level 0, as the CPU reads).
-        let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
+        let uv = primitive_uv(hit.prim, hit.b);
+        let point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
         let front = dot(b.dir, ng) < 0.0;
         let n = select(-ng, ng, front);
-        let ns = select(-normals.shading, normals.shading, front);
+        // Bent by a normal texture before it turns to the ray's side, as
+        // Scene::shading_normal_at and the G-buffer bend it.
+        var shading = normals.shading;
+        if (TEXTURED && s.normal_texture != NO_TEXTURE && p.is_sphere == 0u) {
+            let edges = primitive_uv_edges(hit.prim);
+            shading = bent_normal_at_hit(s, uv, edges.xy, edges.zw, p.b, p.c, shading);
+        }
+        let ns = select(-shading, shading, front);
         let can_bounce = b.depth < params.max_depth;
         // Emitted light (Light::emitted_radiance), besides what the surface
         // reflects; a primary hit's is the G-buffer's.

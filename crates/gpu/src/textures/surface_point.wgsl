@@ -52,6 +52,11 @@ fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Sur
     return p;
 }
 
+// The surface has a normal texture and the point coordinates to read it at.
+fn reads_normal_texture(s: Surface, uv: vec3<f32>) -> bool {
+    return TEXTURED && s.normal_texture != NO_TEXTURE && uv.z != 0.0;
+}
+
 // The shading normal `n` bent by the surface's normal texture:
 // hikari_core::texture::Texturing::shading_normal, its tangent frame here
 // solved from the fragment's derivatives (`px`, `py` of the position, `dx`,
@@ -67,10 +72,42 @@ fn bent_normal(
     py: vec3<f32>,
     n: vec3<f32>,
 ) -> vec3<f32> {
-    if (!TEXTURED || s.normal_texture == NO_TEXTURE || uv.z == 0.0) {
+    if (!reads_normal_texture(s, uv)) {
         return n;
     }
-    let texel = texture_lookup(s.normal_texture, uv, dx, dy).value;
+    return bend_by_texel(s, texture_lookup(s.normal_texture, uv, dx, dy).value, dx, dy, px, py, n);
+}
+
+// `bent_normal` at a ray's hit on a triangle of corner coordinates' deltas
+// `du1`, `du2` along its edges `e1`, `e2` (the same frame: the triangle's
+// own dp/du and dp/dv), the texel read at level 0 as the CPU reads it.
+fn bent_normal_at_hit(
+    s: Surface,
+    uv: vec3<f32>,
+    du1: vec2<f32>,
+    du2: vec2<f32>,
+    e1: vec3<f32>,
+    e2: vec3<f32>,
+    n: vec3<f32>,
+) -> vec3<f32> {
+    if (!reads_normal_texture(s, uv)) {
+        return n;
+    }
+    let texel = texture_lookup(s.normal_texture, uv, vec2<f32>(0.0), vec2<f32>(0.0)).value;
+    return bend_by_texel(s, texel, du1, du2, e1, e2, n);
+}
+
+// `n` bent by the normal texture's `texel`, in the tangent frame whose
+// position changes `px`, `py` go with coordinate changes `dx`, `dy`.
+fn bend_by_texel(
+    s: Surface,
+    texel: vec4<f32>,
+    dx: vec2<f32>,
+    dy: vec2<f32>,
+    px: vec3<f32>,
+    py: vec3<f32>,
+    n: vec3<f32>,
+) -> vec3<f32> {
     let local = vec3<f32>(
         (2.0 * texel.x - 1.0) * s.normal_scale,
         (2.0 * texel.y - 1.0) * s.normal_scale,
@@ -84,27 +121,29 @@ fn bent_normal(
     let d1 = linear * dx;
     let d2 = linear * dy;
     let det = d1.x * d2.y - d2.x * d1.y;
-    if (abs(det) < 1e-30) {
+    if (abs(det) < 1e-20) {
         return n;
     }
     let tangent = (px * d2.y - py * d1.y) / det;
     let bitangent = (py * d1.x - px * d2.x) / det;
     // Gram–Schmidt against the shading normal; the bitangent keeps the side
-    // the coordinates give it (mirrored textures).
+    // the coordinates give it (mirrored textures). Normalised as glam's
+    // normalize_or_zero (× the reciprocal length), so the tracer keeps the
+    // CPU tracer's bits.
     let t_raw = tangent - n * dot(n, tangent);
-    let t_length = length(t_raw);
-    if (!(t_length > 0.0) || t_length > 1e30) {
+    let t_recip = 1.0 / sqrt(dot(t_raw, t_raw));
+    if (!(t_recip > 0.0) || t_recip > 3.0e38) {
         return n;
     }
-    let t_axis = t_raw / t_length;
+    let t_axis = t_raw * t_recip;
     let handed = select(1.0, -1.0, dot(cross(n, t_axis), bitangent) < 0.0);
     let b_axis = cross(n, t_axis) * handed;
     let bent = t_axis * local.x + b_axis * local.y + n * local.z;
-    let b_length = length(bent);
-    if (!(b_length > 0.0) || b_length > 1e30) {
+    let b_recip = 1.0 / sqrt(dot(bent, bent));
+    if (!(b_recip > 0.0) || b_recip > 3.0e38) {
         return n;
     }
-    return bent / b_length;
+    return bent * b_recip;
 }
 
 // Metallic and roughness in one f32 of the G-buffer (emission.w), 12 bits

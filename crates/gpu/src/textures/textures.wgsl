@@ -140,20 +140,45 @@ fn sample_texture_footprint(t: u32, uv: vec2<f32>, dx: vec2<f32>, dy: vec2<f32>)
     return mix(sample_level(t, uv, lo), sample_level(t, uv, hi), lod - floor(lod));
 }
 
-// The texture coordinates (xy) at barycentrics b (weights of vertices 1
-// and 2) of BVH primitive `prim` (TexCoords::at), and z = 1; z = 0 where the
-// primitive has none (its textures then leave the factors alone).
-fn primitive_uv(prim: u32, b: vec2<f32>) -> vec3<f32> {
+// The texture coordinates of BVH primitive `prim`'s three corners
+// (TexCoords::triangle); `present` false where it has none.
+struct CornerUvs {
+    present: bool,
+    u0: vec2<f32>,
+    u1: vec2<f32>,
+    u2: vec2<f32>,
+}
+
+fn primitive_corner_uvs(prim: u32) -> CornerUvs {
     let table = texture_data[1];
     if (table == 0u) {
-        return vec3<f32>(0.0);
+        return CornerUvs(false, vec2<f32>(0.0), vec2<f32>(0.0), vec2<f32>(0.0));
     }
     let base = table + 6u * prim;
     if (texture_data[base] == NO_TEXTURE) {
-        return vec3<f32>(0.0);
+        return CornerUvs(false, vec2<f32>(0.0), vec2<f32>(0.0), vec2<f32>(0.0));
     }
     let u0 = vec2<f32>(bitcast<f32>(texture_data[base]), bitcast<f32>(texture_data[base + 1u]));
     let u1 = vec2<f32>(bitcast<f32>(texture_data[base + 2u]), bitcast<f32>(texture_data[base + 3u]));
     let u2 = vec2<f32>(bitcast<f32>(texture_data[base + 4u]), bitcast<f32>(texture_data[base + 5u]));
-    return vec3<f32>(u0 * (1.0 - b.x - b.y) + u1 * b.x + u2 * b.y, 1.0);
+    return CornerUvs(true, u0, u1, u2);
+}
+
+// The texture coordinates (xy) at barycentrics b (weights of vertices 1
+// and 2) of BVH primitive `prim` (TexCoords::at), and z = 1; z = 0 where the
+// primitive has none (its textures then leave the factors alone).
+fn primitive_uv(prim: u32, b: vec2<f32>) -> vec3<f32> {
+    let c = primitive_corner_uvs(prim);
+    if (!c.present) {
+        return vec3<f32>(0.0);
+    }
+    return vec3<f32>(c.u0 * (1.0 - b.x - b.y) + c.u1 * b.x + c.u2 * b.y, 1.0);
+}
+
+// The coordinates' changes along BVH triangle `prim`'s edges (corner 1 −
+// corner 0, corner 2 − corner 0; FlatPrim's b and c), as xy and zw; zero
+// where it has no coordinates.
+fn primitive_uv_edges(prim: u32) -> vec4<f32> {
+    let c = primitive_corner_uvs(prim);
+    return vec4<f32>(c.u1 - c.u0, c.u2 - c.u0);
 }

@@ -476,11 +476,19 @@ fn trace_one(rng: ptr<function, Rng>) {
         let normals = hit_normals(hit.prim, ray.origin, ray.dir, x);
         let s = surfaces.all[prims[hit.prim].surface];
         // The surface here with its textures (Scene::material_at).
-        let point = surface_point(s, primitive_uv(hit.prim, hit.b), vec2<f32>(0.0), vec2<f32>(0.0));
-        // Normals on the side the photon arrives from.
+        let uv = primitive_uv(hit.prim, hit.b);
+        let point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
+        // Normals on the side the photon arrives from; the shading one bent
+        // by a normal texture first (Scene::bent, as the CPU tracer).
         let facing = select(-1.0, 1.0, dot(ray.dir, normals.geometric) < 0.0);
         let ng = normals.geometric * facing;
-        let ns = normals.shading * facing;
+        var shading = normals.shading;
+        let prim = prims[hit.prim];
+        if (TEXTURED && s.normal_texture != NO_TEXTURE && prim.is_sphere == 0u) {
+            let edges = primitive_uv_edges(hit.prim);
+            shading = bent_normal_at_hit(s, uv, edges.xy, edges.zw, prim.b, prim.c, shading);
+        }
+        let ns = shading * facing;
         var next_dir: vec3<f32>;
         if (s.kind == 3u) {
             return;

@@ -22,10 +22,8 @@
 //! transmittance between their ends; volume vertices merge with the light
 //! subpaths' volume vertices within a ball (surface vertices with surface
 //! vertices within a disc), and the weights count the flights' densities
-//! (σ̄ e^−τ̄ to stop at a point, e^−τ̄ to pass).
-//!
-//! Not yet handled: normal textures (shading uses interpolated normals, as
-//! the photon mappers do).
+//! (σ̄ e^−τ̄ to stop at a point, e^−τ̄ to pass). Surfaces shade with
+//! their normal textures' bent normals (`Scene::bent`), as every renderer.
 
 pub mod emitters;
 mod flight;

@@ -147,9 +147,8 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     }
     if normal_mapped > 0 {
         notes.push(format!(
-            "{normal_mapped} material(s) have normal textures: they bend the shading normals of the CPU renderers, \
-             the CPU photon tracer and the GPU's G-buffer; not yet the GPU's specular pass (what mirrors, glass and \
-             glossy reflections show of them) or the GPU photon tracer"
+            "{normal_mapped} material(s) have normal textures: their tangent frames come from the texture \
+             coordinates, a frame per triangle (the file's TANGENT vectors are not read)"
         ));
     }
     if other_sets > 0 {
