@@ -232,55 +232,92 @@ impl MaterialTextures {
     }
 }
 
-/// A run of consecutive primitive indices with texture coordinates.
+/// A run of consecutive primitive indices with per-triangle values.
 #[derive(Clone, Copy, Debug)]
 struct Run {
     first_prim: u32,
     end_prim: u32,
-    first_uv: u32,
+    first_value: u32,
 }
 
-/// Per-triangle texture coordinates (of vertices 0, 1, 2), indexed by the
-/// BVH's primitive index, for the triangles that have them.
-#[derive(Clone, Debug, Default)]
-pub struct TexCoords {
+/// Per-triangle values (one per vertex 0, 1, 2, say), indexed by the BVH's
+/// primitive index, for the triangles that have them: kept in runs of
+/// consecutive primitives, so a scene pays only for the meshes that have
+/// them.
+#[derive(Clone, Debug)]
+pub struct PerTriangle<T> {
     runs: Vec<Run>,
-    uvs: Vec<[Vec2; 3]>,
+    values: Vec<T>,
 }
 
-impl TexCoords {
-    /// Adds the coordinates of primitives `first_prim..first_prim + uvs.len()`;
+impl<T> Default for PerTriangle<T> {
+    fn default() -> Self {
+        PerTriangle { runs: Vec::new(), values: Vec::new() }
+    }
+}
+
+impl<T: Clone> PerTriangle<T> {
+    /// Adds the values of primitives `first_prim..first_prim + values.len()`;
     /// runs must be added in increasing primitive order.
-    pub fn push_run(&mut self, first_prim: u32, uvs: &[[Vec2; 3]]) {
-        if uvs.is_empty() {
+    pub fn push_run(&mut self, first_prim: u32, values: &[T]) {
+        if values.is_empty() {
             return;
         }
         assert!(self.runs.last().is_none_or(|r| r.end_prim <= first_prim), "runs in increasing order");
-        let end_prim = first_prim + uvs.len() as u32;
-        let first_uv = self.uvs.len() as u32;
+        let end_prim = first_prim + values.len() as u32;
+        let first_value = self.values.len() as u32;
         match self.runs.last_mut() {
             Some(r) if r.end_prim == first_prim => r.end_prim = end_prim,
-            _ => self.runs.push(Run { first_prim, end_prim, first_uv }),
+            _ => self.runs.push(Run { first_prim, end_prim, first_value }),
         }
-        self.uvs.extend_from_slice(uvs);
+        self.values.extend_from_slice(values);
     }
 
     pub fn is_empty(&self) -> bool {
-        self.uvs.is_empty()
+        self.values.is_empty()
     }
 
-    pub fn triangle(&self, prim: u32) -> Option<&[Vec2; 3]> {
+    pub fn triangle(&self, prim: u32) -> Option<&T> {
         let i = self.runs.partition_point(|r| r.end_prim <= prim);
         let run = self.runs.get(i).filter(|r| r.first_prim <= prim)?;
-        self.uvs.get((run.first_uv + prim - run.first_prim) as usize)
+        self.values.get((run.first_value + prim - run.first_prim) as usize)
     }
+}
 
+/// Per-triangle texture coordinates (of vertices 0, 1, 2).
+pub type TexCoords = PerTriangle<[Vec2; 3]>;
+
+impl TexCoords {
     /// The coordinates at barycentrics `b` (weights of vertices 1 and 2).
     pub fn at(&self, prim: u32, b: Vec2) -> Option<Vec2> {
         let [a, c1, c2] = *self.triangle(prim)?;
         Some(a * (1.0 - b.x - b.y) + c1 * b.x + c2 * b.y)
     }
 }
+
+/// A vertex's tangent, glTF's `TANGENT`: xyz the unit direction in which
+/// the normal texture's u grows, w (±1) the side of the bitangent, the
+/// image's up, which is w·(normal × tangent). Stored as four signed
+/// normalized 16-bit integers, as the GPU's vertex buffer holds them
+/// (`Snorm16x4`, `unpack2x16snorm`), so every renderer reads the same
+/// numbers: 8 bytes a vertex.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PackedTangent(pub [i16; 4]);
+
+impl PackedTangent {
+    pub fn encode(t: Vec4) -> PackedTangent {
+        PackedTangent(t.to_array().map(|x| (x.clamp(-1.0, 1.0) * 32767.0).round() as i16))
+    }
+
+    /// WebGPU's snorm16 conversion: max(−1, c / 32767).
+    pub fn decode(self) -> Vec4 {
+        Vec4::from_array(self.0.map(|c| (c as f32 / 32767.0).max(-1.0)))
+    }
+}
+
+/// Per-triangle tangents of the meshes that have normal textures (the
+/// file's `TANGENT`, or MikkTSpace's where it has none).
+pub type Tangents = PerTriangle<[PackedTangent; 3]>;
 
 /// Everything a scene's textures need: the images, the texture
 /// coordinates, and per material what it takes from them.
@@ -290,6 +327,9 @@ pub struct Texturing {
     /// Parallel to `Scene::materials`: None for untextured opaque ones.
     pub materials: Vec<Option<MaterialTextures>>,
     pub uvs: TexCoords,
+    /// Where tangents were given or made (normal-textured meshes); the
+    /// others' tangent frames come from their corners' coordinates.
+    pub tangents: Tangents,
     /// Each surface's material (the BVH's alpha test knows surfaces only).
     pub surface_materials: Vec<u32>,
 }
@@ -361,11 +401,13 @@ impl Texturing {
 
     /// The shading normal `ns` (unit, of triangle `corners` with hit
     /// barycentrics `b`) bent by the material's normal texture: the texel
-    /// n_t = (2·rgb − 1)·(scale, scale, 1) in the tangent frame whose
-    /// tangent follows the triangle's u and bitangent its v (one frame per
-    /// triangle, from its corners' coordinates; glTF's TANGENT attribute is
-    /// not read), orthonormalised against `ns`. `ns` itself where there is
-    /// no normal texture, no coordinates or a degenerate frame.
+    /// n_t = (2·rgb − 1)·(scale, scale, 1) in the tangent frame whose x
+    /// follows the image's u and y the image's up (glTF: +Y up; its v
+    /// points down), orthonormalised against `ns`. The frame is the
+    /// triangle's stored tangents interpolated (`Texturing::tangents`),
+    /// else the triangle's own from its corners' coordinates; either turned
+    /// by the texture's transform. `ns` itself where there is no normal
+    /// texture, no coordinates or a degenerate frame.
     pub fn shading_normal(
         &self,
         material: u32,
@@ -383,24 +425,12 @@ impl Texturing {
             (2.0 * texel.y - 1.0) * t.normal_scale,
             2.0 * texel.z - 1.0,
         );
-        let (e1, e2) = (corners[1] - corners[0], corners[2] - corners[0]);
-        // The frame follows the image's axes: the coordinates as the
-        // texture transform moves them.
-        let (d1, d2) =
-            (normal.transform.transform_vector2(uvs[1] - uvs[0]), normal.transform.transform_vector2(uvs[2] - uvs[0]));
-        let det = d1.x * d2.y - d2.x * d1.y;
-        if det.abs() < 1e-20 {
-            return ns;
-        }
-        let tangent = (e1 * d2.y - e2 * d1.y) / det;
-        let bitangent = (e2 * d1.x - e1 * d2.x) / det;
-        // Gram–Schmidt against the shading normal; the bitangent keeps the
-        // side the coordinates give it (mirrored textures).
-        let t_axis = (tangent - ns * ns.dot(tangent)).normalize_or_zero();
-        let handed = if ns.cross(t_axis).dot(bitangent) < 0.0 { -1.0 } else { 1.0 };
-        let b_axis = ns.cross(t_axis) * handed;
-        let bent = (t_axis * local.x + b_axis * local.y + ns * local.z).normalize_or_zero();
-        if t_axis == glam::Vec3::ZERO || bent == glam::Vec3::ZERO || !bent.is_finite() { ns } else { bent }
+        let axes = match self.tangents.triangle(prim) {
+            Some(corner_tangents) => stored_uv_axes(corner_tangents, b, ns),
+            None => triangle_uv_axes(corners, uvs),
+        };
+        let Some(axes) = axes.and_then(|axes| image_axes(normal.transform, axes)) else { return ns };
+        bend(local, axes, ns)
     }
 
     /// Per channel, the emissive texture at the point over its mean (1
@@ -414,9 +444,134 @@ impl Texturing {
     }
 }
 
+/// A surface point's directions of growing u and of the image's up
+/// (−v: glTF's v points down the image), in world space, unnormalised.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvAxes {
+    pub tangent: glam::Vec3,
+    pub up: glam::Vec3,
+}
+
+/// The axes from a triangle's stored tangents at barycentrics `b`: the
+/// tangent interpolated, the up w·(ns × tangent) with the first corner's w
+/// (MikkTSpace gives a triangle one side). None for a zero tangent.
+pub fn stored_uv_axes(corners: &[PackedTangent; 3], b: Vec2, ns: glam::Vec3) -> Option<UvAxes> {
+    let [t0, t1, t2] = corners.map(PackedTangent::decode);
+    let tangent = t0.truncate() * (1.0 - b.x - b.y) + t1.truncate() * b.x + t2.truncate() * b.y;
+    let side = if t0.w < 0.0 { -1.0 } else { 1.0 };
+    (tangent != glam::Vec3::ZERO).then(|| UvAxes { tangent, up: ns.cross(tangent) * side })
+}
+
+/// The axes of a triangle of `corners` and coordinates `uvs` as they
+/// change over it: dp/du and −dp/dv, solved from its edges. None where its
+/// coordinates have no area.
+pub fn triangle_uv_axes(corners: [glam::Vec3; 3], uvs: &[Vec2; 3]) -> Option<UvAxes> {
+    let (e1, e2) = (corners[1] - corners[0], corners[2] - corners[0]);
+    let (d1, d2) = (uvs[1] - uvs[0], uvs[2] - uvs[0]);
+    let det = d1.x * d2.y - d2.x * d1.y;
+    if det.abs() < 1e-20 {
+        return None;
+    }
+    let tangent = (e1 * d2.y - e2 * d1.y) / det;
+    let dp_dv = (e2 * d1.x - e1 * d2.x) / det;
+    Some(UvAxes { tangent, up: -dp_dv })
+}
+
+/// The axes of the image the texture reads, whose coordinates are
+/// `transform` of the surface's (`KHR_texture_transform`: the map's x and
+/// up turn and flip with it): dp/du' = dp/du·∂u/∂u' + dp/dv·∂v/∂u'. None
+/// for a transform that collapses the image.
+pub fn image_axes(transform: glam::Affine2, axes: UvAxes) -> Option<UvAxes> {
+    if transform.matrix2 == glam::Mat2::IDENTITY {
+        return Some(axes);
+    }
+    let det = transform.matrix2.determinant();
+    if det.abs() < 1e-20 || !det.is_finite() {
+        return None;
+    }
+    let inverse = transform.matrix2.inverse();
+    let dp_dv = -axes.up;
+    let along = |column: Vec2| axes.tangent * column.x + dp_dv * column.y;
+    Some(UvAxes { tangent: along(inverse.x_axis), up: -along(inverse.y_axis) })
+}
+
+/// `local` (a normal texture's texel as a direction) in the frame of `ns`
+/// and `axes`: the tangent made orthogonal to `ns` (Gram–Schmidt), the
+/// bitangent ns × tangent on the side of `axes.up` (mirrored textures).
+/// `ns` where the frame or the result is degenerate.
+pub fn bend(local: glam::Vec3, axes: UvAxes, ns: glam::Vec3) -> glam::Vec3 {
+    let t_axis = (axes.tangent - ns * ns.dot(axes.tangent)).normalize_or_zero();
+    let handed = if ns.cross(t_axis).dot(axes.up) < 0.0 { -1.0 } else { 1.0 };
+    let b_axis = ns.cross(t_axis) * handed;
+    let bent = (t_axis * local.x + b_axis * local.y + ns * local.z).normalize_or_zero();
+    if t_axis == glam::Vec3::ZERO || bent == glam::Vec3::ZERO || !bent.is_finite() { ns } else { bent }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A triangle in the xy plane whose u grows along +x and v along −y
+    /// (glTF's v points down the image): the image's up is +y.
+    #[test]
+    fn a_triangles_axes_are_u_and_the_images_up() {
+        let corners = [glam::Vec3::ZERO, glam::Vec3::X, glam::Vec3::Y];
+        let uvs = [Vec2::new(0.0, 1.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 0.0)];
+        let axes = triangle_uv_axes(corners, &uvs).unwrap();
+        assert_eq!(axes, UvAxes { tangent: glam::Vec3::X, up: glam::Vec3::Y });
+        assert_eq!(triangle_uv_axes(corners, &[Vec2::ZERO; 3]), None);
+    }
+
+    /// A transform turning the image a quarter (the extension's rotation
+    /// π/2) turns its axes; one scaling u by −2 flips and shortens its u;
+    /// one that collapses the image has none.
+    #[test]
+    fn a_texture_transform_turns_the_images_axes() {
+        let axes = UvAxes { tangent: glam::Vec3::X, up: glam::Vec3::Y };
+        assert_eq!(image_axes(Affine2::IDENTITY, axes), Some(axes));
+        let quarter =
+            image_axes(uv_transform(Vec2::new(0.3, 0.1), std::f32::consts::FRAC_PI_2, Vec2::ONE), axes).unwrap();
+        // (u, v) → (v, −u): u' grows with the surface's v, along −y; v'
+        // grows with −u, along −x, so the image's up (−v') is +x.
+        assert!((quarter.tangent + glam::Vec3::Y).length() < 1e-6, "{quarter:?}");
+        assert!((quarter.up - glam::Vec3::X).length() < 1e-6, "{quarter:?}");
+        let flipped = image_axes(uv_transform(Vec2::ZERO, 0.0, Vec2::new(-2.0, 1.0)), axes).unwrap();
+        assert!((flipped.tangent + 0.5 * glam::Vec3::X).length() < 1e-6 && flipped.up == glam::Vec3::Y, "{flipped:?}");
+        assert_eq!(image_axes(uv_transform(Vec2::ZERO, 0.0, Vec2::new(0.0, 1.0)), axes), None);
+    }
+
+    /// Stored tangents interpolate; the up is w·(n × t) with the first
+    /// corner's w; a zero tangent is no frame.
+    #[test]
+    fn stored_tangents_give_the_frame() {
+        let n = glam::Vec3::Z;
+        let t = |x: f32, y: f32, w: f32| PackedTangent::encode(Vec4::new(x, y, 0.0, w));
+        let corners = [t(1.0, 0.0, -1.0), t(0.0, 1.0, -1.0), t(1.0, 0.0, -1.0)];
+        let axes = stored_uv_axes(&corners, Vec2::new(0.5, 0.0), n).unwrap();
+        assert!((axes.tangent - glam::Vec3::new(0.5, 0.5, 0.0)).length() < 1e-4, "{axes:?}");
+        assert!((axes.up - glam::Vec3::new(0.5, -0.5, 0.0)).length() < 1e-4, "{axes:?}");
+        assert_eq!(stored_uv_axes(&[PackedTangent::default(); 3], Vec2::ZERO, n), None);
+        // Encoding keeps ±1 and rounds to 1/32767.
+        assert_eq!(
+            PackedTangent::encode(Vec4::new(1.0, -1.0, 0.5, 2.0)).decode(),
+            Vec4::new(1.0, -1.0, 16384.0 / 32767.0, 1.0)
+        );
+    }
+
+    /// The frame bends the normal: +x of the texel toward the tangent, +y
+    /// toward the up, whichever side of n × t it lies.
+    #[test]
+    fn bend_follows_the_tangent_and_the_up() {
+        let n = glam::Vec3::Z;
+        let local = glam::Vec3::new(0.6, 0.0, 0.8);
+        let axes = UvAxes { tangent: glam::Vec3::new(2.0, 0.0, 1.0), up: glam::Vec3::Y };
+        assert!((bend(local, axes, n) - glam::Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6);
+        let up = glam::Vec3::new(0.0, 0.6, 0.8);
+        assert!((bend(up, axes, n) - up).length() < 1e-6);
+        let mirrored = UvAxes { up: -glam::Vec3::Y, ..axes };
+        assert!((bend(up, mirrored, n) - glam::Vec3::new(0.0, -0.6, 0.8)).length() < 1e-6);
+        assert_eq!(bend(local, UvAxes { tangent: n, up: glam::Vec3::Y }, n), n, "a tangent along n is no frame");
+    }
 
     /// A 2×2 image: texel (x, y) = (x, y, 0, 1).
     fn ramp() -> Image {

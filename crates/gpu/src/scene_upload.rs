@@ -21,6 +21,9 @@ pub struct GpuVertex {
     /// texture coordinates.
     pub surface: u32,
     pub uv: [f32; 2],
+    /// The vertex's stored tangent (`hikari_core::texture::PackedTangent`,
+    /// read as `Snorm16x4`); zero where its triangle has none.
+    pub tangent: [i16; 4],
 }
 
 /// `GpuVertex::surface`'s flag: the triangle has texture coordinates.
@@ -151,6 +154,7 @@ pub fn scene_vertices(scene: &Scene) -> (Vec<GpuVertex>, u32) {
 fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
     let mut out = Vec::new();
     let uvs = scene.texturing.as_ref().map(|t| &t.uvs);
+    let tangents = scene.texturing.as_ref().map(|t| &t.tangents);
     for (prim, (tri, surface)) in scene.accel.triangles().enumerate() {
         let ng = tri.geometric_normal().normalize();
         let normals = match tri.normals {
@@ -159,6 +163,7 @@ fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
         };
         let uv = uvs.and_then(|t| t.triangle(prim as u32));
         let surface = if uv.is_some() { surface | HAS_UV } else { surface };
+        let tangent = tangents.and_then(|t| t.triangle(prim as u32));
         for k in 0..3 {
             out.push(GpuVertex {
                 position: tri.v[k].to_array(),
@@ -166,6 +171,7 @@ fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
                 geometric_normal: ng.to_array(),
                 surface,
                 uv: uv.map_or([0.0; 2], |uv| uv[k].to_array()),
+                tangent: tangent.map_or([0; 4], |t| t[k].0),
             });
         }
     }
@@ -202,6 +208,7 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
                 geometric_normal: ng.to_array(),
                 surface,
                 uv: [0.0; 2],
+                tangent: [0; 4],
             });
         }
     };

@@ -404,7 +404,8 @@ fn vertex_attribute_offsets_match_rust_structs() {
             offset_of!(GpuVertex, normal),
             offset_of!(GpuVertex, geometric_normal),
             offset_of!(GpuVertex, surface),
-            offset_of!(GpuVertex, uv)
+            offset_of!(GpuVertex, uv),
+            offset_of!(GpuVertex, tangent)
         ]
     );
 }

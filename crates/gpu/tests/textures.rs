@@ -283,10 +283,13 @@ fn metallic_roughness_textures_reach_the_gbuffer() {
 /// A normal texture on the GPU: the G-buffer's normal is the CPU's bent
 /// normal (`Scene::shading_normal_at`, turned toward the eye) at every
 /// pixel. The quad is a tilted parallelogram whose coordinates run askew,
-/// so the tangent frame (solved from the fragment's derivatives on the
-/// GPU, from the triangle on the CPU) is neither axis-aligned nor
-/// orthogonal; its one texel tilts the normal 45° (no filtering between
-/// texels to differ by); at scale 0 the normal is the flat one.
+/// so the tangent frame is neither axis-aligned nor orthogonal: the
+/// MikkTSpace tangents stored at load (interpolated from the vertices on
+/// both), and without them the frame of the triangle's coordinates (solved
+/// from the fragment's derivatives on the GPU, from the triangle on the
+/// CPU). Its one texel tilts the normal toward both u and the image's up
+/// (no filtering between texels to differ by); at scale 0 the normal is
+/// the flat one.
 #[test]
 fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
     use glam::Vec3;
@@ -296,9 +299,9 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
     use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial, png};
     use hikari_core::test_scenes::gltf_textures::{load, quad};
     let ctx = test_context("a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu");
-    for scale in [1.0, 0.0] {
+    for (scale, stored_tangents) in [(1.0, true), (1.0, false), (0.0, true)] {
         let mut b = GltfBuilder::new();
-        let image = b.image(&png(1, 1, &[218, 128, 218, 255]), "image/png");
+        let image = b.image(&png(1, 1, &[191, 160, 218, 255]), "image/png");
         let repeat = gltf::json::texture::WrappingMode::Repeat;
         let t = b.texture(image, repeat, repeat);
         let m = b.material(&PbrMaterial {
@@ -310,6 +313,11 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
         let (eu, ev) = (Vec3::new(1.0, 0.2, 0.3), Vec3::new(0.4, 1.0, -0.2));
         let node = quad(&mut b, Vec3::new(-0.7, -0.6, 0.0), eu, ev, 1.0, m);
         let mut scene = load(&format!("gpu-normal-map-{scale}"), &b.to_glb(vec![node]));
+        let texturing = std::sync::Arc::make_mut(scene.texturing.as_mut().unwrap());
+        assert!(!texturing.tangents.is_empty(), "MikkTSpace's tangents are stored");
+        if !stored_tangents {
+            texturing.tangents = Default::default();
+        }
         let (width, height) = (48, 48);
         scene.camera = hikari_core::camera::Camera::new(
             Vec3::new(0.2, 0.3, 3.0),
@@ -340,7 +348,10 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
                 seen += 1;
             }
         }
-        eprintln!("scale {scale}: {seen} pixels, worst normal difference {worst:e}, tilt {:.1}°", tilt.to_degrees());
+        eprintln!(
+            "scale {scale}, stored tangents {stored_tangents}: {seen} pixels, worst normal difference {worst:e}, tilt {:.1}°",
+            tilt.to_degrees()
+        );
         assert!(seen > 300, "{seen} pixels see the quad");
         assert!(worst < 2e-3, "scale {scale}: the G-buffer's normal differs from the CPU's by {worst}");
         if scale == 1.0 {

@@ -375,6 +375,9 @@ fn load_gltf_object(
         if let Some(uvs) = &primitive.uvs {
             parts.texturing.uvs.push_run(geo.triangles.len() as u32, uvs);
         }
+        if let Some(tangents) = &primitive.tangents {
+            parts.texturing.tangents.push_run(geo.triangles.len() as u32, tangents);
+        }
         geo.triangles.extend(primitive.triangles.into_iter().map(|t| (t, surface)));
     }
     if geo.counts() == start {

@@ -23,6 +23,9 @@ struct VertexIn {
     @location(2) geometric_normal: vec3<f32>,
     @location(3) surface: u32,
     @location(4) uv: vec2<f32>,
+    // The vertex's stored tangent (scene_upload: Snorm16x4); zero where
+    // its triangle has none.
+    @location(5) tangent: vec4<f32>,
 }
 
 struct VertexOut {
@@ -33,6 +36,9 @@ struct VertexOut {
     @location(2) @interpolate(flat) geometric_normal: vec3<f32>,
     @location(3) @interpolate(flat) surface: u32,
     @location(4) uv: vec2<f32>,
+    @location(5) tangent: vec3<f32>,
+    // The side of the triangle's first corner's tangent, as the CPU takes it.
+    @location(6) @interpolate(flat) tangent_side: f32,
 }
 
 @vertex
@@ -44,6 +50,8 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.geometric_normal = v.geometric_normal;
     out.surface = v.surface;
     out.uv = v.uv;
+    out.tangent = v.tangent.xyz;
+    out.tangent_side = v.tangent.w;
     return out;
 }
 
@@ -100,7 +108,8 @@ fn shade(in: VertexOut) -> GBufferOut {
     var out: GBufferOut;
     out.position = vec4<f32>(in.world, 1.0);
     let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
-    let n = bent_normal(surface, uv, dx, dy, px, py, normalize(in.normal));
+    let tangent = vec4<f32>(in.tangent, in.tangent_side);
+    let n = bent_normal(surface, uv, dx, dy, px, py, tangent, normalize(in.normal));
     out.normal = vec4<f32>(n * side, f32(id));
     out.albedo = vec4<f32>(point.base, f32(surface.kind));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);

@@ -32,12 +32,13 @@ pub fn storage_shader_source() -> String {
 
 /// `GpuVertex` as vertex attributes, offsets written by hand (a test checks
 /// them against the struct).
-pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = [
+pub const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 6] = [
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 12, shader_location: 1 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 24, shader_location: 2 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 36, shader_location: 3 },
     wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 40, shader_location: 4 },
+    wgpu::VertexAttribute { format: wgpu::VertexFormat::Snorm16x4, offset: 48, shader_location: 5 },
 ];
 
 /// The G-buffer's textures, all `width × height`.

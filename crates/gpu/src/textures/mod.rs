@@ -15,7 +15,8 @@
 //!
 //! * `[0]` image count, `[1]` word offset of the texture coordinates (0:
 //!   none), `[2]` word offset of the sky image's sampling block (0: none;
-//!   `sky_block`, in the photon tracer's buffer only), `[3]` unused.
+//!   `sky_block`, in the photon tracer's buffer only), `[3]` word offset of
+//!   the tangents (0: none).
 //! * per texture view (`TextureViews`: each image, then each image with a
 //!   `KHR_texture_transform` a material reads it through), `VIEW_WORDS`
 //!   words from `HEADER_WORDS`: width, height, level count, flags (bit 0:
@@ -26,6 +27,10 @@
 //!   (r in the low byte).
 //! * per BVH primitive (`FlatBvh::prims` order), its three vertices' (u, v)
 //!   as f32 bits; six `NO_TEXTURE` words for primitives without coordinates.
+//! * where some triangle has stored tangents (`Texturing::tangents`), per
+//!   BVH primitive its three vertices' `PackedTangent`s, two words each
+//!   (x | y << 16, z | w << 16, as `unpack2x16snorm` reads them); zeros for
+//!   primitives without.
 
 use hikari_core::geometry::FlatBvh;
 use hikari_core::scene::Scene;
@@ -249,6 +254,18 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
             }
         }
     }
+    if let Some(bvh) = bvh.filter(|_| !texturing.tangents.is_empty()) {
+        words[3] = words.len() as u32;
+        let pair = |a: i16, b: i16| a as u16 as u32 | (b as u16 as u32) << 16;
+        for &source in &bvh.source {
+            match texturing.tangents.triangle(source) {
+                Some(corners) => {
+                    words.extend(corners.iter().flat_map(|t| [pair(t.0[0], t.0[1]), pair(t.0[2], t.0[3])]))
+                }
+                None => words.extend([0; 6]),
+            }
+        }
+    }
     words
 }
 
@@ -277,7 +294,8 @@ fn sky_bytes(scene: &Scene) -> u64 {
 
 /// Bytes of the renderer's texture buffers for `scene`, without building
 /// them (the memory check before upload): the texels and their mip
-/// chains, 24 bytes a primitive for texture coordinates, and the sky image.
+/// chains, 24 bytes a primitive for texture coordinates and 24 for
+/// tangents, and the sky image.
 pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
     let Some(texturing) = &scene.texturing else { return 16 + sky_bytes(scene) };
     let texels: u64 = texturing
@@ -295,8 +313,9 @@ pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
         })
         .sum();
     let uvs = if texturing.uvs.is_empty() { 0 } else { primitives as u64 * 24 };
+    let tangents = if texturing.tangents.is_empty() { 0 } else { primitives as u64 * 24 };
     let views = TextureViews::of(texturing).count();
-    4 * (HEADER_WORDS + VIEW_WORDS * views) as u64 + 4 * texels + uvs + sky_bytes(scene)
+    4 * (HEADER_WORDS + VIEW_WORDS * views) as u64 + 4 * texels + uvs + tangents + sky_bytes(scene)
 }
 
 #[cfg(test)]

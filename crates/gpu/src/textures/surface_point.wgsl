@@ -58,11 +58,12 @@ fn reads_normal_texture(s: Surface, uv: vec3<f32>) -> bool {
 }
 
 // The shading normal `n` bent by the surface's normal texture:
-// hikari_core::texture::Texturing::shading_normal, its tangent frame here
-// solved from the fragment's derivatives (`px`, `py` of the position, `dx`,
-// `dy` of the coordinates): both are affine over a triangle, so dp/du and
-// dp/dv come out as the triangle's own. The coordinates' change is taken
-// through the texture's transform, as the CPU's is.
+// hikari_core::texture::Texturing::shading_normal. Its frame is the
+// fragment's interpolated `tangent` (xyz; w the side of its triangle's
+// first corner) where the triangle has stored tangents, else solved from
+// the fragment's derivatives (`px`, `py` of the position, `dx`, `dy` of the
+// coordinates): both are affine over a triangle, so dp/du and dp/dv come
+// out as the triangle's own.
 fn bent_normal(
     s: Surface,
     uv: vec3<f32>,
@@ -70,22 +71,27 @@ fn bent_normal(
     dy: vec2<f32>,
     px: vec3<f32>,
     py: vec3<f32>,
+    tangent: vec4<f32>,
     n: vec3<f32>,
 ) -> vec3<f32> {
     if (!reads_normal_texture(s, uv)) {
         return n;
     }
-    return bend_by_texel(s, texture_lookup(s.normal_texture, uv, dx, dy).value, dx, dy, px, py, n);
+    var axes = stored_uv_axes(tangent.xyz, tangent.w, n);
+    if (!axes.found) {
+        axes = derived_uv_axes(dx, dy, px, py);
+    }
+    return bend_by_texel(s, texture_lookup(s.normal_texture, uv, dx, dy).value, axes, n);
 }
 
-// `bent_normal` at a ray's hit on a triangle of corner coordinates' deltas
-// `du1`, `du2` along its edges `e1`, `e2` (the same frame: the triangle's
-// own dp/du and dp/dv), the texel read at level 0 as the CPU reads it.
+// `bent_normal` at a ray's hit on BVH primitive `prim` (barycentrics `b`,
+// edges `e1`, `e2`): its stored tangents interpolated, else the frame of
+// its corners' coordinates; the texel read at level 0 as the CPU reads it.
 fn bent_normal_at_hit(
     s: Surface,
     uv: vec3<f32>,
-    du1: vec2<f32>,
-    du2: vec2<f32>,
+    prim: u32,
+    b: vec2<f32>,
     e1: vec3<f32>,
     e2: vec3<f32>,
     n: vec3<f32>,
@@ -93,50 +99,93 @@ fn bent_normal_at_hit(
     if (!reads_normal_texture(s, uv)) {
         return n;
     }
+    let t = primitive_corner_tangents(prim);
+    let tangent = t.t0.xyz * (1.0 - b.x - b.y) + t.t1.xyz * b.x + t.t2.xyz * b.y;
+    var axes = stored_uv_axes(tangent, t.t0.w, n);
+    if (!axes.found) {
+        let edges = primitive_uv_edges(prim);
+        axes = derived_uv_axes(edges.xy, edges.zw, e1, e2);
+    }
     let texel = texture_lookup(s.normal_texture, uv, vec2<f32>(0.0), vec2<f32>(0.0)).value;
-    return bend_by_texel(s, texel, du1, du2, e1, e2, n);
+    return bend_by_texel(s, texel, axes, n);
 }
 
-// `n` bent by the normal texture's `texel`, in the tangent frame whose
-// position changes `px`, `py` go with coordinate changes `dx`, `dy`.
-fn bend_by_texel(
-    s: Surface,
-    texel: vec4<f32>,
-    dx: vec2<f32>,
-    dy: vec2<f32>,
-    px: vec3<f32>,
-    py: vec3<f32>,
-    n: vec3<f32>,
-) -> vec3<f32> {
+// hikari_core::texture::UvAxes: the directions of growing u and of the
+// image's up (−v), unnormalised; `found` false where there is no frame.
+struct UvAxes {
+    tangent: vec3<f32>,
+    up: vec3<f32>,
+    found: bool,
+}
+
+// hikari_core::texture::stored_uv_axes: an interpolated stored tangent and
+// its triangle's side.
+fn stored_uv_axes(tangent: vec3<f32>, side: f32, n: vec3<f32>) -> UvAxes {
+    let sign = select(1.0, -1.0, side < 0.0);
+    return UvAxes(tangent, cross(n, tangent) * sign, any(tangent != vec3<f32>(0.0)));
+}
+
+// hikari_core::texture::triangle_uv_axes: the frame in which position
+// changes `px`, `py` go with coordinate changes `dx`, `dy` (a triangle's
+// edges, or a fragment's derivatives).
+fn derived_uv_axes(dx: vec2<f32>, dy: vec2<f32>, px: vec3<f32>, py: vec3<f32>) -> UvAxes {
+    let det = dx.x * dy.y - dy.x * dx.y;
+    if (abs(det) < 1e-20) {
+        return UvAxes(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    }
+    let tangent = (px * dy.y - py * dx.y) / det;
+    let dp_dv = (py * dx.x - px * dy.x) / det;
+    return UvAxes(tangent, -dp_dv, true);
+}
+
+// hikari_core::texture::image_axes: the axes of the image texture `t`
+// reads, through its transform.
+fn image_axes(t: u32, axes: UvAxes) -> UvAxes {
+    let header = texture_header(t);
+    if ((texture_data[header + 3u] & TEXTURE_TRANSFORMED) == 0u) {
+        return axes;
+    }
+    let m = texture_linear(header);
+    let det = m[0].x * m[1].y - m[1].x * m[0].y;
+    if (!(abs(det) >= 1e-20) || abs(det) > 3.4028235e38) {
+        return UvAxes(vec3<f32>(0.0), vec3<f32>(0.0), false);
+    }
+    // glam's Mat2::inverse, in its order of operations.
+    let inv_det = 1.0 / det;
+    let inverse_x = vec2<f32>(m[1].y * inv_det, m[0].y * -inv_det);
+    let inverse_y = vec2<f32>(m[1].x * -inv_det, m[0].x * inv_det);
+    let dp_dv = -axes.up;
+    let tangent = axes.tangent * inverse_x.x + dp_dv * inverse_x.y;
+    let up = -(axes.tangent * inverse_y.x + dp_dv * inverse_y.y);
+    return UvAxes(tangent, up, true);
+}
+
+// `n` bent by the normal texture's `texel` in the frame `axes` of the
+// surface's coordinates: hikari_core::texture::bend, after image_axes.
+fn bend_by_texel(s: Surface, texel: vec4<f32>, surface_axes: UvAxes, n: vec3<f32>) -> vec3<f32> {
+    if (!surface_axes.found) {
+        return n;
+    }
+    let axes = image_axes(s.normal_texture, surface_axes);
+    if (!axes.found) {
+        return n;
+    }
     let local = vec3<f32>(
         (2.0 * texel.x - 1.0) * s.normal_scale,
         (2.0 * texel.y - 1.0) * s.normal_scale,
         2.0 * texel.z - 1.0,
     );
-    let header = texture_header(s.normal_texture);
-    var linear = mat2x2<f32>(vec2<f32>(1.0, 0.0), vec2<f32>(0.0, 1.0));
-    if ((texture_data[header + 3u] & TEXTURE_TRANSFORMED) != 0u) {
-        linear = texture_linear(header);
-    }
-    let d1 = linear * dx;
-    let d2 = linear * dy;
-    let det = d1.x * d2.y - d2.x * d1.y;
-    if (abs(det) < 1e-20) {
-        return n;
-    }
-    let tangent = (px * d2.y - py * d1.y) / det;
-    let bitangent = (py * d1.x - px * d2.x) / det;
     // Gram–Schmidt against the shading normal; the bitangent keeps the side
-    // the coordinates give it (mirrored textures). Normalised as glam's
+    // of the image's up (mirrored textures). Normalised as glam's
     // normalize_or_zero (× the reciprocal length), so the tracer keeps the
     // CPU tracer's bits.
-    let t_raw = tangent - n * dot(n, tangent);
+    let t_raw = axes.tangent - n * dot(n, axes.tangent);
     let t_recip = 1.0 / sqrt(dot(t_raw, t_raw));
     if (!(t_recip > 0.0) || t_recip > 3.0e38) {
         return n;
     }
     let t_axis = t_raw * t_recip;
-    let handed = select(1.0, -1.0, dot(cross(n, t_axis), bitangent) < 0.0);
+    let handed = select(1.0, -1.0, dot(cross(n, t_axis), axes.up) < 0.0);
     let b_axis = cross(n, t_axis) * handed;
     let bent = t_axis * local.x + b_axis * local.y + n * local.z;
     let b_recip = 1.0 / sqrt(dot(bent, bent));

@@ -164,6 +164,28 @@ fn primitive_corner_uvs(prim: u32) -> CornerUvs {
     return CornerUvs(true, u0, u1, u2);
 }
 
+// hikari_core::texture::Texturing::tangents of BVH primitive `prim`'s
+// corners (PackedTangent::decode is unpack2x16snorm's conversion); zero
+// where it has none (header word 3 gives the table, 0: no table).
+struct CornerTangents {
+    t0: vec4<f32>,
+    t1: vec4<f32>,
+    t2: vec4<f32>,
+}
+
+fn primitive_corner_tangents(prim: u32) -> CornerTangents {
+    let table = texture_data[3];
+    if (table == 0u) {
+        return CornerTangents(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+    }
+    let w = table + 6u * prim;
+    return CornerTangents(
+        vec4<f32>(unpack2x16snorm(texture_data[w]), unpack2x16snorm(texture_data[w + 1u])),
+        vec4<f32>(unpack2x16snorm(texture_data[w + 2u]), unpack2x16snorm(texture_data[w + 3u])),
+        vec4<f32>(unpack2x16snorm(texture_data[w + 4u]), unpack2x16snorm(texture_data[w + 5u])),
+    );
+}
+
 // The texture coordinates (xy) at barycentrics b (weights of vertices 1
 // and 2) of BVH primitive `prim` (TexCoords::at), and z = 1; z = 0 where the
 // primitive has none (its textures then leave the factors alone).

@@ -485,8 +485,7 @@ fn trace_one(rng: ptr<function, Rng>) {
         var shading = normals.shading;
         let prim = prims[hit.prim];
         if (TEXTURED && s.normal_texture != NO_TEXTURE && prim.is_sphere == 0u) {
-            let edges = primitive_uv_edges(hit.prim);
-            shading = bent_normal_at_hit(s, uv, edges.xy, edges.zw, prim.b, prim.c, shading);
+            shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, shading);
         }
         let ns = shading * facing;
         var next_dir: vec3<f32>;

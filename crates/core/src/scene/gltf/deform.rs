@@ -162,7 +162,10 @@ pub fn skin(
         return Err(format!("skinned vertex {i} is not finite: {p}"));
     }
     Ok(Skinned {
-        placed: LocalPrimitive { positions, normals, ..local.clone() },
+        // Tangents are not bent: a skinned mesh's normal texture is read in
+        // each triangle's own frame (`Texturing::shading_normal`), which
+        // follows the pose.
+        placed: LocalPrimitive { positions, normals, tangents: None, ..local.clone() },
         unweighted,
         influences,
         inverse_binds,

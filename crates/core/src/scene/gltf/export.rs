@@ -292,6 +292,19 @@ impl GltfBuilder {
         indices: Option<&[u32]>,
         material: Option<Index<json::Material>>,
     ) -> Index<json::Mesh> {
+        self.tangent_mesh(positions, normals, uvs, None, indices, material)
+    }
+
+    /// [`GltfBuilder::textured_mesh`] with `tangents` (TANGENT, f32 xyzw).
+    pub fn tangent_mesh(
+        &mut self,
+        positions: &[Vec3],
+        normals: Option<&[Vec3]>,
+        uvs: Option<&[Vec2]>,
+        tangents: Option<&[glam::Vec4]>,
+        indices: Option<&[u32]>,
+        material: Option<Index<json::Material>>,
+    ) -> Index<json::Mesh> {
         use json::accessor::{ComponentType, Type};
         let bounds = positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
         let pos = self.accessor(
@@ -310,6 +323,10 @@ impl GltfBuilder {
         if let Some(uv) = uvs {
             let acc = self.accessor(bytemuck::cast_slice(uv), uv.len(), Type::Vec2, ComponentType::F32, None);
             attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), acc);
+        }
+        if let Some(t) = tangents {
+            let acc = self.accessor(bytemuck::cast_slice(t), t.len(), Type::Vec4, ComponentType::F32, None);
+            attributes.insert(Valid(json::mesh::Semantic::Tangents), acc);
         }
         let indices =
             indices.map(|i| self.accessor(bytemuck::cast_slice(i), i.len(), Type::Scalar, ComponentType::U32, None));

@@ -43,7 +43,6 @@ pub struct Converted {
 /// Converts every material, reading its textures from `images`.
 pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -> Converted {
     let mut unread_maps = 0;
-    let mut normal_mapped = 0;
     let mut other_sets = 0;
     let mut approximated = 0;
     let mut blended = 0;
@@ -61,7 +60,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
         .map(|m| {
             let pbr = m.pbr_metallic_roughness();
             unread_maps += m.occlusion_texture().is_some() as usize;
-            normal_mapped += m.normal_texture().is_some() as usize;
             let normal_json =
                 m.index().and_then(|i| doc.as_json().materials.get(i)).and_then(|m| m.normal_texture.as_ref());
             let normal = m.normal_texture().zip(normal_json).and_then(|(n, json)| images.normal(&n, json));
@@ -144,12 +142,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     textures.push(None);
     if unread_maps > 0 {
         notes.push(format!("{unread_maps} material(s) have occlusion textures, which are ignored"));
-    }
-    if normal_mapped > 0 {
-        notes.push(format!(
-            "{normal_mapped} material(s) have normal textures: their tangent frames come from the texture \
-             coordinates, a frame per triangle (the file's TANGENT vectors are not read)"
-        ));
     }
     if other_sets > 0 {
         notes.push(format!(

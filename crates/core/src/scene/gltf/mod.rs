@@ -13,6 +13,7 @@ mod compressed;
 mod deform;
 pub mod export;
 mod materials;
+mod tangents;
 mod textures;
 
 use super::SceneError;
@@ -23,7 +24,7 @@ use crate::light::Light;
 use crate::material::{Material, Rgb};
 use crate::progress::Progress;
 use crate::texture::{Image, MaterialTextures};
-use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3};
+use glam::{Affine3A, Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::accessor::DataType;
 use gltf::mesh::Mode;
 use std::collections::HashMap;
@@ -95,6 +96,9 @@ pub struct Primitive {
     /// Texture coordinates of each triangle's vertices, when its material
     /// reads textures and the primitive has `TEXCOORD_0`.
     pub uvs: Option<Vec<[Vec2; 3]>>,
+    /// Tangents of each triangle's vertices, when its material has a
+    /// normal texture (and the primitive coordinates).
+    pub tangents: Option<Vec<[crate::texture::PackedTangent; 3]>>,
     /// Index into [`Asset::materials`].
     pub material: u32,
     /// Light the surface emits, from its material.
@@ -185,11 +189,13 @@ pub fn asset_from_bytes(
     let materials::Converted { materials, emissions, textures, names: material_names } =
         materials::convert(&gltf.document, &images, &mut notes);
     let textured: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.is_textured())).collect();
+    let normal_mapped: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.normal.is_some())).collect();
     let mut walk = Walk {
         file: &file,
         buffers: &buffers,
         emissions: &emissions,
         textured: &textured,
+        normal_mapped: &normal_mapped,
         camera_name: camera,
         cache: HashMap::new(),
         asset: Asset {
@@ -213,6 +219,7 @@ pub fn asset_from_bytes(
         node_paths: Vec::new(),
         skinned_lights: 0,
         unweighted: 0,
+        skinned_normal_mapped: 0,
         progress,
     };
     let scene = gltf
@@ -252,6 +259,13 @@ pub fn asset_from_bytes(
         walk.asset.notes.push(format!(
             "{} primitive(s) with textured materials have no TEXCOORD_0: their factors are used",
             walk.without_uvs
+        ));
+    }
+    if walk.skinned_normal_mapped > 0 {
+        walk.asset.notes.push(format!(
+            "{} skinned primitive(s) have normal textures: they are read in each triangle's own tangent frame \
+             (from its texture coordinates; the skin does not bend TANGENT or MikkTSpace tangents)",
+            walk.skinned_normal_mapped
         ));
     }
     if walk.skinned_lights > 0 {
@@ -497,6 +511,9 @@ struct LocalPrimitive {
     uvs: Option<Vec<Vec2>>,
     /// Three vertex indices per triangle.
     triangles: Vec<[u32; 3]>,
+    /// Each triangle's corners' tangents (`tangents`), where the material
+    /// has a normal texture and the primitive coordinates.
+    tangents: Option<Vec<[Vec4; 3]>>,
     material: u32,
 }
 
@@ -507,6 +524,9 @@ struct Walk<'a> {
     emissions: &'a [Option<Emission>],
     /// Per material: does it read textures (so its primitives' UVs are kept)?
     textured: &'a [bool],
+    /// Per material: has it a normal texture (so its primitives' tangents
+    /// are read or made)?
+    normal_mapped: &'a [bool],
     camera_name: Option<&'a str>,
     /// (mesh, primitive) → its triangles, read once.
     cache: HashMap<(usize, usize), std::rc::Rc<LocalPrimitive>>,
@@ -526,6 +546,8 @@ struct Walk<'a> {
     skinned_lights: usize,
     /// Skinned vertices without joint weights (placed by their node).
     unweighted: usize,
+    /// Skinned primitives with normal textures (read without tangents).
+    skinned_normal_mapped: usize,
     progress: &'a dyn Progress,
 }
 
@@ -567,7 +589,7 @@ impl Walk<'_> {
                 let local = self.local_primitive(&mesh, &primitive)?;
                 let (local, placement, node_path, joints) =
                     self.deformed(node, &mesh, &primitive, local, world, path)?;
-                let (triangles, uvs, kept) = place_triangles(&local, &placement);
+                let Placed { triangles, uvs, tangents, kept } = place_triangles(&local, &placement);
                 if let Some(v) = triangles.iter().flat_map(|t| t.v).find(|v| v.abs().max_element() > MAX_COORD) {
                     return Err(error(
                         self.file,
@@ -590,6 +612,7 @@ impl Walk<'_> {
                     name: name.clone(),
                     triangles,
                     uvs,
+                    tangents,
                     material,
                     emission,
                     node_path,
@@ -664,6 +687,7 @@ impl Walk<'_> {
         };
         let skinned = deform::skin(&local, primitive, &skin, &self.node_worlds, world, self.buffers).map_err(fail)?;
         self.unweighted += skinned.unweighted;
+        self.skinned_normal_mapped += local.tangents.is_some() as usize;
         // The joints' motions: a skin whose joints the animations move is
         // bent again at each time (`Motion::Deformed`).
         let above = self.asset.world_from_file;
@@ -815,7 +839,7 @@ impl Walk<'_> {
         if let Some((i, v)) = indices.iter().enumerate().find(|&(_, &v)| v as usize >= positions.len()) {
             return Err(fail(".indices", format!("index {i} is {v}, beyond the {} vertices", positions.len())));
         }
-        let triangles = match primitive.mode() {
+        let triangles: Vec<[u32; 3]> = match primitive.mode() {
             Mode::Triangles => indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
             // Strips alternate winding so every triangle faces the same way.
             Mode::TriangleStrip => (2..indices.len())
@@ -836,7 +860,18 @@ impl Walk<'_> {
             None
         };
         self.without_uvs += (self.textured[material as usize] && uvs.is_none()) as usize;
-        let local = std::rc::Rc::new(LocalPrimitive { positions, normals, uvs, triangles, material });
+        let tangents = match &uvs {
+            Some(uvs) if self.normal_mapped[material as usize] => {
+                let given = tangents::read(primitive, self.buffers, positions.len(), self.quantized)
+                    .map_err(|m| fail(".attributes.TANGENT", m))?;
+                Some(match given {
+                    Some(given) => tangents::per_corner(&given, &triangles),
+                    None => tangents::mikktspace(&positions, normals.as_deref(), uvs, &triangles),
+                })
+            }
+            _ => None,
+        };
+        let local = std::rc::Rc::new(LocalPrimitive { positions, normals, uvs, triangles, tangents, material });
         self.cache.insert(key, local.clone());
         Ok(local)
     }
@@ -869,24 +904,28 @@ impl Walk<'_> {
 }
 
 /// A primitive's triangles placed by `world`: normals by its inverse
-/// transpose, and the winding reversed where it mirrors (negative
+/// transpose, tangents by `world` itself (their side turned where it
+/// mirrors), and the winding reversed where it mirrors (negative
 /// determinant), so the front face stays the front face, with their
-/// texture coordinates in the same vertex order. Triangles with no area in
-/// 32-bit floats are dropped.
-fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Option<Vec<[Vec2; 3]>>, Vec<[u32; 3]>) {
+/// texture coordinates and tangents in the same vertex order. Triangles
+/// with no area in 32-bit floats are dropped.
+fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> Placed {
     let linear = Mat3::from_mat4(*world);
     let normal_matrix = linear.inverse().transpose();
     let mirrored = linear.determinant() < 0.0;
+    let side = if mirrored { -1.0 } else { 1.0 };
     let positions: Vec<Vec3> = local.positions.iter().map(|&p| world.transform_point3(p)).collect();
     let normals: Option<Vec<Vec3>> =
         local.normals.as_ref().map(|n| n.iter().map(|&n| (normal_matrix * n).normalize_or_zero()).collect());
     let mut uvs = local.uvs.as_ref().map(|_| Vec::with_capacity(local.triangles.len()));
+    let mut tangents = local.tangents.as_ref().map(|_| Vec::with_capacity(local.triangles.len()));
     let mut kept = Vec::with_capacity(local.triangles.len());
     let triangles = local
         .triangles
         .iter()
-        .filter_map(|&[a, b, c]| {
-            let order = if mirrored { [a, c, b] } else { [a, b, c] };
+        .enumerate()
+        .filter_map(|(t, &[a, b, c])| {
+            let (order, corners) = if mirrored { ([a, c, b], [0, 2, 1]) } else { ([a, b, c], [0, 1, 2]) };
             let v = order.map(|i| positions[i as usize]);
             let normals = normals.as_ref().map(|n| TriangleNormals(order.map(|i| n[i as usize])));
             let tri = Triangle { v, normals };
@@ -894,11 +933,27 @@ fn place_triangles(local: &LocalPrimitive, world: &Mat4) -> (Vec<Triangle>, Opti
             if let (Some(out), Some(uv)) = (uvs.as_mut(), local.uvs.as_ref()) {
                 out.push(order.map(|i| uv[i as usize]));
             }
+            if let (Some(out), Some(given)) = (tangents.as_mut(), local.tangents.as_ref()) {
+                out.push(corners.map(|k| {
+                    let t = given[t][k];
+                    let direction = (linear * t.truncate()).normalize_or_zero();
+                    crate::texture::PackedTangent::encode(direction.extend(if t.w < 0.0 { -side } else { side }))
+                }));
+            }
             kept.push(order);
             Some(tri)
         })
         .collect();
-    (triangles, uvs, kept)
+    Placed { triangles, uvs, tangents, kept }
+}
+
+/// What `place_triangles` gives: the triangles kept, their corners'
+/// coordinates and tangents, and their vertex indices.
+struct Placed {
+    triangles: Vec<Triangle>,
+    uvs: Option<Vec<[Vec2; 3]>>,
+    tangents: Option<Vec<[crate::texture::PackedTangent; 3]>>,
+    kept: Vec<[u32; 3]>,
 }
 
 #[cfg(test)]
@@ -958,12 +1013,16 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
         lights.push(light);
     }
     let mut uvs = crate::texture::TexCoords::default();
+    let mut tangents = crate::texture::Tangents::default();
     for (primitive, motion) in asset.primitives.drain(..).zip(primitive_motions) {
         if primitive.triangles.is_empty() {
             continue;
         }
         if let Some(tri_uvs) = &primitive.uvs {
             uvs.push_run(triangles.len() as u32, tri_uvs);
+        }
+        if let Some(tri_tangents) = &primitive.tangents {
+            tangents.push_run(triangles.len() as u32, tri_tangents);
         }
         let surface = surfaces.len() as u32;
         let emitter = primitive.emitted_light().map(|light| {
@@ -1000,6 +1059,7 @@ fn scene_from_asset(mut asset: Asset, file: String, progress: &dyn Progress) -> 
             images: std::mem::take(&mut asset.images),
             materials: std::mem::take(&mut asset.material_textures),
             uvs,
+            tangents,
             surface_materials: surfaces.iter().map(|s| s.material).collect(),
         })
     });

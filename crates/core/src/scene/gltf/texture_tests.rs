@@ -288,17 +288,17 @@ fn a_normal_texture_bends_every_cpu_renderers_normals() {
     // ρ/π·E·cos 45° on the flat floor.
     let flat = 0.5 / PI * 2.0 * std::f32::consts::FRAC_1_SQRT_2;
     // Direct light only along one sample: the sun is a delta light, and the
-    // floor alone reflects no indirect light. The bent normal (x, z, −y) of
-    // the texel (u along +X, v along −Z) against the sun's (1, 1, 0)/√2.
+    // floor alone reflects no indirect light. The bent normal (x, z, y) of
+    // the texel (u along +X, v along −Z: the image's up, −v, is +Z)
+    // against the sun's (1, 1, 0)/√2.
     let bent = path_radiance(&floor_with(1.0, "normal-1"), look, &settings, &mut rng).x;
-    let n = Vec3::new(decoded.x, decoded.z, -decoded.y).normalize();
+    let n = Vec3::new(decoded.x, decoded.z, decoded.y).normalize();
     let want = 0.5 / PI * 2.0 * n.dot(Vec3::new(1.0, 1.0, 0.0).normalize());
     assert!(want > 1.3 * flat, "the texel faces the sun");
     assert!((bent - want).abs() < 1e-4 * want, "bent: {bent} vs {want}");
     let unbent = path_radiance(&floor_with(0.0, "normal-0"), look, &settings, &mut rng).x;
     assert!((unbent - flat).abs() < 1e-4 * flat, "scale 0: {unbent} vs {flat}");
     let scene = floor_with(1.0, "normal-photon");
-    assert!(scene.notes.iter().any(|n| n.contains("normal textures")), "{:?}", scene.notes);
     let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
     let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
     let photon = renderer.radiance(&look, 0, &mut rng).x;
@@ -318,6 +318,67 @@ fn a_normal_texture_bends_every_cpu_renderers_normals() {
         .sum::<f32>()
         / passes as f32;
     assert!((mean - want).abs() < 0.03 * want, "vcm: {mean} vs {want} (flat {flat})");
+}
+
+/// The frame a normal texture is read in, on a floor (normal +Y; u along
+/// +X, v along −Z, so the image's up, −v, is +Z) under a sun from
+/// (1, 2, 0.5): without `TANGENT` MikkTSpace's, tangent +X and up +Z; with
+/// the file's `TANGENT` (0, 0, 1, ±1) the tangent +Z and the up
+/// ±(+Y × +Z) = ±X, which the path tracer's light must follow. The texel
+/// tilts both ways, so a wrong tangent, side or up changes the light.
+#[test]
+fn the_files_tangents_set_the_normal_textures_frame() {
+    use crate::render::path::radiance as path_radiance;
+    let texel = [191u8, 160, 218, 255];
+    let d = glam::Vec3::new(191.0, 160.0, 218.0) / 255.0 * 2.0 - 1.0;
+    let sun = Vec3::new(1.0, 2.0, 0.5).normalize();
+    let floor_with = |tangent: Option<glam::Vec4>, tag: &str| {
+        let mut b = GltfBuilder::new();
+        let image = b.image(&png(1, 1, &texel), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let m = b.material(&PbrMaterial {
+            base_color: Vec3::splat(0.5),
+            specular: 0.0,
+            normal_texture: Some((t, 1.0)),
+            ..Default::default()
+        });
+        let origin = Vec3::new(-2.0, 0.0, 2.0);
+        let positions =
+            [origin, origin + 4.0 * Vec3::X, origin + 4.0 * Vec3::X - 4.0 * Vec3::Z, origin - 4.0 * Vec3::Z];
+        let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+        let tangents = tangent.map(|t| [t; 4]);
+        let normals = [Vec3::Y; 4];
+        let mesh = b.tangent_mesh(
+            &positions,
+            Some(&normals),
+            Some(&uvs),
+            tangents.as_ref().map(|t| &t[..]),
+            Some(&[0, 1, 2, 0, 2, 3]),
+            Some(m),
+        );
+        let floor = b.node(gltf::json::Node { mesh: Some(mesh), ..Default::default() });
+        use gltf::json::extensions::scene::khr_lights_punctual::Type;
+        let light = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+        let light = b.node(GltfBuilder::light_node(light, Vec3::ZERO, looking(-sun, Vec3::Z)));
+        load(tag, &b.to_glb(vec![floor, light]))
+    };
+    let look = Ray::new(Vec3::new(0.3, 1.0, 0.2), -Vec3::Y);
+    let settings = PathSettings { spp: 1, ..Default::default() };
+    let mut rng = Rng::for_item(2, 0);
+    let cases = [
+        (None, Vec3::new(d.x, d.z, d.y)),
+        (Some(glam::Vec4::new(0.0, 0.0, 1.0, 1.0)), Vec3::new(d.y, d.z, d.x)),
+        (Some(glam::Vec4::new(0.0, 0.0, 1.0, -1.0)), Vec3::new(-d.y, d.z, d.x)),
+    ];
+    let mut seen = Vec::new();
+    for (i, (tangent, n)) in cases.into_iter().enumerate() {
+        let got = path_radiance(&floor_with(tangent, &format!("tangent-{i}")), look, &settings, &mut rng).x;
+        let want = 0.5 / PI * 2.0 * n.normalize().dot(sun);
+        assert!((got - want).abs() < 2e-3 * want, "case {i}: {got} vs {want}");
+        seen.push(want);
+    }
+    // The three frames light the floor differently (the test can tell them apart).
+    assert!((seen[0] - seen[1]).abs() > 0.05 * seen[0] && (seen[1] - seen[2]).abs() > 0.05 * seen[1], "{seen:?}");
 }
 
 /// `EXT_texture_webp` as gltfpack `-tw` writes it: required, the texture's
