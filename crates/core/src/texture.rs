@@ -507,6 +507,39 @@ pub fn bend(local: glam::Vec3, axes: UvAxes, ns: glam::Vec3) -> glam::Vec3 {
     if t_axis == glam::Vec3::ZERO || bent == glam::Vec3::ZERO || !bent.is_finite() { ns } else { bent }
 }
 
+/// A bent normal `n` turned toward the geometric normal `ng` just enough
+/// that the mirror reflection of `wo` about it leaves the surface at least
+/// as steeply as min(0.9·(wo·ng), 0.01): Cycles' correction of bump- and
+/// normal-mapped normals (`ensure_valid_specular_reflection`), so that a
+/// normal texture tilting away from the eye near a silhouette shades as in
+/// Blender instead of black (lobes need wo above the shading normal). `ng`
+/// on the side of `wo`; all unit. `n` itself where its reflection is high
+/// enough. The new normal lies between `n` and `ng`.
+pub fn valid_reflection_normal(ng: glam::Vec3, wo: glam::Vec3, n: glam::Vec3) -> glam::Vec3 {
+    let reflected = 2.0 * n.dot(wo) * n - wo;
+    let iz = wo.dot(ng);
+    let threshold = (0.9 * iz).min(0.01);
+    if reflected.dot(ng) >= threshold {
+        return n;
+    }
+    // A frame with ng as z and n in the x–z plane: the normal sought,
+    // (√(1 − z²), 0, z), reflects wo to height `threshold`:
+    // 4a z⁴ − 2b z² + c = 0, of which the root below keeps the reflection
+    // above the surface (the other gives −threshold).
+    let x = (n - n.dot(ng) * ng).try_normalize().unwrap_or(n);
+    let ix = wo.dot(x);
+    let a = ix * ix + iz * iz;
+    if !(a > 0.0) {
+        return ng;
+    }
+    let b = 2.0 * (a + iz * threshold);
+    let c = (threshold + iz) * (threshold + iz);
+    let root = (b * b - 4.0 * a * c).max(0.0).sqrt();
+    let z2 = if ix < 0.0 { 0.25 * (b + root) / a } else { 0.25 * (b - root) / a };
+    let corrected = x * (1.0 - z2).max(0.0).sqrt() + ng * z2.max(0.0).sqrt();
+    if corrected.is_finite() { corrected } else { ng }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -571,6 +604,53 @@ mod tests {
         let mirrored = UvAxes { up: -glam::Vec3::Y, ..axes };
         assert!((bend(up, mirrored, n) - glam::Vec3::new(0.0, -0.6, 0.8)).length() < 1e-6);
         assert_eq!(bend(local, UvAxes { tangent: n, up: glam::Vec3::Y }, n), n, "a tangent along n is no frame");
+    }
+
+    /// Normals whose mirror reflection of wo dips below the surface are
+    /// lifted to reflect it at the threshold, staying between themselves
+    /// and the geometric normal; the others are kept.
+    #[test]
+    fn valid_reflection_lifts_only_normals_that_reflect_below() {
+        let mut rng = crate::sampling::Rng::for_item(5, 0);
+        let mut unit = || {
+            let u = glam::Vec2::new(rng.next_f32(), rng.next_f32());
+            let z = 1.0 - 2.0 * u.x;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = 2.0 * std::f32::consts::PI * u.y;
+            glam::Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        let (mut lifted, mut kept) = (0, 0);
+        for _ in 0..20_000 {
+            let ng = unit();
+            let wo = unit();
+            let wo = if wo.dot(ng) < 0.0 { -wo } else { wo };
+            let mut n = unit();
+            if n.dot(ng) < 0.0 {
+                n = -n;
+            }
+            let iz = wo.dot(ng);
+            if iz < 1e-3 {
+                continue;
+            }
+            let threshold = (0.9 * iz).min(0.01);
+            let out = valid_reflection_normal(ng, wo, n);
+            assert!((out.length() - 1.0).abs() < 1e-4, "{out}");
+            let height = (2.0 * out.dot(wo) * out - wo).dot(ng);
+            if out == n {
+                kept += 1;
+                assert!(height >= threshold);
+            } else {
+                lifted += 1;
+                assert!(
+                    (height - threshold).abs() < 2e-3,
+                    "reflection at {height}, want {threshold} (ng {ng}, wo {wo}, n {n})"
+                );
+                assert!(out.dot(wo) > 0.0, "faces the eye");
+                // Between n and ng: in their plane, nearer ng than n is.
+                assert!(out.dot(n.cross(ng)).abs() < 1e-3 && out.dot(ng) >= n.dot(ng) - 1e-4, "{out} vs {n}");
+            }
+        }
+        assert!(lifted > 1000 && kept > 1000, "{lifted} lifted, {kept} kept");
     }
 
     /// A 2×2 image: texel (x, y) = (x, y, 0, 1).

@@ -289,7 +289,9 @@ fn metallic_roughness_textures_reach_the_gbuffer() {
 /// from the fragment's derivatives on the GPU, from the triangle on the
 /// CPU). Its one texel tilts the normal toward both u and the image's up
 /// (no filtering between texels to differ by); at scale 0 the normal is
-/// the flat one.
+/// the flat one. Seen at a grazing angle from the side the texel tilts
+/// away from, normals that would reflect the eye below the quad are
+/// lifted (`valid_reflection_normal`) on both alike.
 #[test]
 fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
     use glam::Vec3;
@@ -299,7 +301,9 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
     use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial, png};
     use hikari_core::test_scenes::gltf_textures::{load, quad};
     let ctx = test_context("a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu");
-    for (scale, stored_tangents) in [(1.0, true), (1.0, false), (0.0, true)] {
+    for (scale, stored_tangents, grazing) in
+        [(1.0, true, false), (1.0, false, false), (0.0, true, false), (1.0, true, true)]
+    {
         let mut b = GltfBuilder::new();
         let image = b.image(&png(1, 1, &[191, 160, 218, 255]), "image/png");
         let repeat = gltf::json::texture::WrappingMode::Repeat;
@@ -319,9 +323,16 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
             texturing.tangents = Default::default();
         }
         let (width, height) = (48, 48);
+        let centre = Vec3::new(-0.7, -0.6, 0.0) + 0.5 * (eu + ev);
+        let normal = eu.cross(ev).normalize();
+        let eye = if grazing {
+            centre + 2.5 * (0.15 * normal - 0.99 * eu.normalize()).normalize()
+        } else {
+            Vec3::new(0.2, 0.3, 3.0)
+        };
         scene.camera = hikari_core::camera::Camera::new(
-            Vec3::new(0.2, 0.3, 3.0),
-            Vec3::new(0.0, 0.0, 0.0),
+            eye,
+            if grazing { centre } else { Vec3::ZERO },
             Vec3::Y,
             40.0,
             width,
@@ -335,13 +346,17 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
                 .expect("GPU renderer");
         gpu.render().unwrap();
         let normals = gpu.read(&gpu.targets.gbuffer.normal).unwrap();
-        let (mut seen, mut worst, mut tilt) = (0, 0.0f32, 0.0f32);
+        let (mut seen, mut worst, mut tilt, mut lifted) = (0, 0.0f32, 0.0f32, 0);
         for y in 0..height {
             for x in 0..width {
                 let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 let Some(hit) = scene.accel.intersect(&ray) else { continue };
                 let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
-                let want = scene.shading_normal_at(&hit) * facing;
+                let want = scene.shading_normal_at(&hit, ray.dir) * facing;
+                let texturing = scene.texturing.as_ref().unwrap();
+                let corners = scene.accel.triangle(hit.prim).unwrap().v;
+                let unlifted = texturing.shading_normal(0, hit.prim, hit.barycentrics, corners, hit.shading_normal);
+                lifted += ((unlifted * facing).dot(want) < 0.9999) as u32;
                 let got = normals[(y * width + x) as usize].truncate();
                 worst = worst.max((got - want).length());
                 tilt = tilt.max(want.angle_between(hit.geometric_normal * facing));
@@ -349,12 +364,19 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
             }
         }
         eprintln!(
-            "scale {scale}, stored tangents {stored_tangents}: {seen} pixels, worst normal difference {worst:e}, tilt {:.1}°",
+            "scale {scale}, stored tangents {stored_tangents}, grazing {grazing}: {seen} pixels ({lifted} lifted), worst normal difference {worst:e}, tilt {:.1}°",
             tilt.to_degrees()
         );
-        assert!(seen > 300, "{seen} pixels see the quad");
+        assert!(seen > if grazing { 100 } else { 300 }, "{seen} pixels see the quad");
         assert!(worst < 2e-3, "scale {scale}: the G-buffer's normal differs from the CPU's by {worst}");
-        if scale == 1.0 {
+        if grazing {
+            assert!(lifted > 20, "{lifted} pixels' normals are lifted");
+        } else {
+            assert_eq!(lifted, 0);
+        }
+        if grazing {
+            // Lifted toward the geometric normal: less tilted.
+        } else if scale == 1.0 {
             assert!(tilt > 0.5, "the texture tilts the normal ({tilt} rad)");
         } else {
             assert!(tilt < 1e-3, "scale 0 leaves it flat ({tilt} rad)");

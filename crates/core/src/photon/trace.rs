@@ -184,7 +184,7 @@ impl PathTracer<'_> {
                 }
             }
             let Some(hit) = hit else { return };
-            let hit = self.scene.bent(hit);
+            let hit = self.scene.bent(hit, ray.dir);
             let material = &*self.scene.material_at(&hit);
             // Normals on the side the photon arrives from.
             let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };

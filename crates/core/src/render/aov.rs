@@ -73,7 +73,7 @@ fn see(scene: &Scene, mut ray: Ray) -> Option<Seen> {
     for _ in 0..=MAX_SPECULAR {
         let hit = scene.accel.intersect(&ray)?;
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
-        let normal = scene.shading_normal_at(&hit) * facing;
+        let normal = scene.shading_normal_at(&hit, ray.dir) * facing;
         let next = match scene.material_at(&hit).into_owned() {
             Material::Diffuse { albedo, specular } => return Some(Seen { albedo: albedo + specular, normal }),
             Material::Pbr(bsdf) => return Some(Seen { albedo: bsdf.base_color, normal }),

@@ -10,9 +10,18 @@ use std::f32::consts::PI;
 
 /// Reflected radiance albedo/π · ∫ L_i cos θ dω from all lights, each delta
 /// light (point, spot, sun) by one shadow ray, each area light and the sky
-/// by `area_samples` samples. `normal` faces the viewer.
-pub fn direct_diffuse(scene: &Scene, x: Vec3, normal: Vec3, albedo: Rgb, area_samples: u32, rng: &mut Rng) -> Rgb {
-    direct_reflected(scene, x, normal, |_| albedo / PI, area_samples, rng)
+/// by `area_samples` samples. `normal` (shading) and `geometric` face the
+/// viewer.
+pub fn direct_diffuse(
+    scene: &Scene,
+    x: Vec3,
+    normal: Vec3,
+    geometric: Vec3,
+    albedo: Rgb,
+    area_samples: u32,
+    rng: &mut Rng,
+) -> Rgb {
+    direct_reflected(scene, x, normal, geometric, |_| albedo / PI, area_samples, rng)
 }
 
 /// Which lights a surface point's light sampling reaches.
@@ -46,16 +55,22 @@ impl LitSides {
 
 /// Reflected radiance ∫ f_r(ω_i) L_i cos θ dω from all lights, sampled as
 /// [`direct_diffuse`] does; `brdf` is f_r for the world direction ω_i
-/// toward the light (the viewer's direction fixed by the caller).
+/// toward the light (the viewer's direction fixed by the caller), from
+/// above the geometric normal `geometric` (facing the viewer) only.
 pub fn direct_reflected(
     scene: &Scene,
     x: Vec3,
     normal: Vec3,
+    geometric: Vec3,
     brdf: impl Fn(Vec3) -> Rgb,
     area_samples: u32,
     rng: &mut Rng,
 ) -> Rgb {
-    direct_scattered(scene, x, normal, LitSides::Front, brdf, area_samples, rng)
+    // No light from below the geometric surface, whatever the shading
+    // normal (a bent or smooth one): it would come through the surface
+    // (the path tracer's `next_event` and vcm's `Scatter::evaluate` agree).
+    let above = |wi: Vec3| if wi.dot(geometric) > 0.0 { brdf(wi) } else { Rgb::ZERO };
+    direct_scattered(scene, x, normal, LitSides::Front, above, area_samples, rng)
 }
 
 /// [`direct_reflected`] from the lights on `sides` of `normal`: with

@@ -235,10 +235,10 @@ impl<'a> PhotonCpuRenderer<'a> {
         depth: u32,
         rng: &mut Rng,
     ) -> Rgb {
-        let hit = self.scene.bent(*hit);
+        let hit = self.scene.bent(*hit, ray.dir);
         let can_recurse = depth < self.settings.max_specular_depth;
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
-        let ns = hit.shading_normal * facing;
+        let (ns, ng) = (hit.shading_normal * facing, hit.geometric_normal * facing);
         match material {
             Material::Glass(glass) => {
                 if glass.is_smooth() {
@@ -267,7 +267,6 @@ impl<'a> PhotonCpuRenderer<'a> {
                 let wo = frame.to_local(-ray.dir);
                 let mut l = Rgb::ZERO;
                 if self.settings.components.direct {
-                    let ng = hit.geometric_normal * facing;
                     let f = |wi: glam::Vec3| glass.f(wo, frame.to_local(wi), Transport::Radiance);
                     let samples = self.settings.area_light_samples;
                     l += direct_scattered(self.scene, hit.point, ng, LitSides::FrontAndDeltaBehind, f, samples, rng);
@@ -292,7 +291,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                 if self.settings.components.direct {
                     // Direct light through every non-delta lobe, by shadow rays.
                     let f = |wi: glam::Vec3| bsdf.f(wo, frame.to_local(wi));
-                    l += direct_reflected(self.scene, hit.point, ns, f, self.settings.area_light_samples, rng);
+                    l += direct_reflected(self.scene, hit.point, ns, ng, f, self.settings.area_light_samples, rng);
                 }
                 l += self.photon_radiance_brdf(hit.point, &frame, part);
                 // A lobe smoother than the gather threshold is followed, one
@@ -312,7 +311,15 @@ impl<'a> PhotonCpuRenderer<'a> {
                 let albedo = material.diffuse_albedo();
                 if albedo.max_element() > 0.0 {
                     if self.settings.components.direct {
-                        l += direct_diffuse(self.scene, hit.point, ns, albedo, self.settings.area_light_samples, rng);
+                        l += direct_diffuse(
+                            self.scene,
+                            hit.point,
+                            ns,
+                            ng,
+                            albedo,
+                            self.settings.area_light_samples,
+                            rng,
+                        );
                     }
                     l += self.photon_radiance(hit.point, ns, albedo);
                 }

@@ -161,21 +161,29 @@ impl Scene {
         }
     }
 
-    /// The shading normal at `hit`, bent by its material's normal texture
-    /// (`Texturing::shading_normal`).
-    pub fn shading_normal_at(&self, hit: &Hit) -> glam::Vec3 {
+    /// The shading normal at `hit` (reached travelling along `dir`), bent
+    /// by its material's normal texture (`Texturing::shading_normal`) and
+    /// then, as Cycles does, lifted where the eye would see it reflect
+    /// below the surface (`texture::valid_reflection_normal`).
+    pub fn shading_normal_at(&self, hit: &Hit, dir: glam::Vec3) -> glam::Vec3 {
         let (Some(t), Some(triangle)) = (&self.texturing, self.accel.triangle(hit.prim)) else {
             return hit.shading_normal;
         };
         let material = self.surfaces[hit.surface as usize].material;
-        t.shading_normal(material, hit.prim, hit.barycentrics, triangle.v, hit.shading_normal)
+        let bent = t.shading_normal(material, hit.prim, hit.barycentrics, triangle.v, hit.shading_normal);
+        if bent == hit.shading_normal {
+            return bent;
+        }
+        let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+        crate::texture::valid_reflection_normal(hit.geometric_normal * facing, -dir, bent * facing) * facing
     }
 
-    /// `hit` with its shading normal bent by its material's normal texture
-    /// (`shading_normal_at`): what every renderer and the photon tracer
-    /// shade with, so a normal-mapped surface looks the same in each.
-    pub fn bent(&self, hit: Hit) -> Hit {
-        Hit { shading_normal: self.shading_normal_at(&hit), ..hit }
+    /// `hit` (reached along `dir`) with its shading normal bent by its
+    /// material's normal texture (`shading_normal_at`): what every renderer
+    /// and the photon tracer shade with, so a normal-mapped surface looks
+    /// the same in each.
+    pub fn bent(&self, hit: Hit, dir: glam::Vec3) -> Hit {
+        Hit { shading_normal: self.shading_normal_at(&hit, dir), ..hit }
     }
 
     pub fn emitter(&self, hit: &Hit) -> Option<&Light> {

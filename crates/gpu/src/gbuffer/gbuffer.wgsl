@@ -109,7 +109,7 @@ fn shade(in: VertexOut) -> GBufferOut {
     out.position = vec4<f32>(in.world, 1.0);
     let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
     let tangent = vec4<f32>(in.tangent, in.tangent_side);
-    let n = bent_normal(surface, uv, dx, dy, px, py, tangent, normalize(in.normal));
+    let n = bent_normal(surface, uv, dx, dy, px, py, tangent, normalize(in.normal), in.geometric_normal, normalize(view));
     out.normal = vec4<f32>(n * side, f32(id));
     out.albedo = vec4<f32>(point.base, f32(surface.kind));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);

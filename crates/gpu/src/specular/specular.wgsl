@@ -428,7 +428,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         // Scene::shading_normal_at and the G-buffer bend it.
         var shading = normals.shading;
         if (TEXTURED && s.normal_texture != NO_TEXTURE && p.is_sphere == 0u) {
-            shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, p.b, p.c, shading);
+            shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, p.b, p.c, shading, ng, b.dir);
         }
         let ns = select(-shading, shading, front);
         let can_bounce = b.depth < params.max_depth;

@@ -57,8 +57,9 @@ fn reads_normal_texture(s: Surface, uv: vec3<f32>) -> bool {
     return TEXTURED && s.normal_texture != NO_TEXTURE && uv.z != 0.0;
 }
 
-// The shading normal `n` bent by the surface's normal texture:
-// hikari_core::texture::Texturing::shading_normal. Its frame is the
+// The shading normal `n` bent by the surface's normal texture, seen along
+// `dir` on a surface of geometric normal `ng`: hikari_core::scene::Scene::
+// shading_normal_at. Its frame is the
 // fragment's interpolated `tangent` (xyz; w the side of its triangle's
 // first corner) where the triangle has stored tangents, else solved from
 // the fragment's derivatives (`px`, `py` of the position, `dx`, `dy` of the
@@ -73,6 +74,8 @@ fn bent_normal(
     py: vec3<f32>,
     tangent: vec4<f32>,
     n: vec3<f32>,
+    ng: vec3<f32>,
+    dir: vec3<f32>,
 ) -> vec3<f32> {
     if (!reads_normal_texture(s, uv)) {
         return n;
@@ -81,12 +84,53 @@ fn bent_normal(
     if (!axes.found) {
         axes = derived_uv_axes(dx, dy, px, py);
     }
-    return bend_by_texel(s, texture_lookup(s.normal_texture, uv, dx, dy).value, axes, n);
+    let bent = bend_by_texel(s, texture_lookup(s.normal_texture, uv, dx, dy).value, axes, n);
+    return lifted_for_view(bent, n, ng, dir);
 }
 
-// `bent_normal` at a ray's hit on BVH primitive `prim` (barycentrics `b`,
-// edges `e1`, `e2`): its stored tangents interpolated, else the frame of
-// its corners' coordinates; the texel read at level 0 as the CPU reads it.
+// Scene::shading_normal_at's last step: the bent normal lifted where the
+// eye, looking along `dir`, would see it reflect below the surface of
+// geometric normal `ng`; `n` (unbent) where the texture did not bend it.
+fn lifted_for_view(bent: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, dir: vec3<f32>) -> vec3<f32> {
+    if (all(bent == n)) {
+        return bent;
+    }
+    let facing = select(-1.0, 1.0, dot(dir, ng) < 0.0);
+    return valid_reflection_normal(ng * facing, -dir, bent * facing) * facing;
+}
+
+// hikari_core::texture::valid_reflection_normal (Cycles'
+// ensure_valid_specular_reflection).
+fn valid_reflection_normal(ng: vec3<f32>, wo: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let reflected = 2.0 * dot(n, wo) * n - wo;
+    let iz = dot(wo, ng);
+    let threshold = min(0.9 * iz, 0.01);
+    if (dot(reflected, ng) >= threshold) {
+        return n;
+    }
+    // glam's try_normalize, else n.
+    let x_raw = n - dot(n, ng) * ng;
+    let recip = 1.0 / sqrt(dot(x_raw, x_raw));
+    var x = n;
+    if (recip > 0.0 && recip <= 3.4028235e38) {
+        x = x_raw * recip;
+    }
+    let ix = dot(wo, x);
+    let a = ix * ix + iz * iz;
+    if (!(a > 0.0)) {
+        return ng;
+    }
+    let b = 2.0 * (a + iz * threshold);
+    let c = (threshold + iz) * (threshold + iz);
+    let root = sqrt(max(b * b - 4.0 * a * c, 0.0));
+    let z2 = select(0.25 * (b - root) / a, 0.25 * (b + root) / a, ix < 0.0);
+    return x * sqrt(max(1.0 - z2, 0.0)) + ng * sqrt(max(z2, 0.0));
+}
+
+// `bent_normal` at a ray's hit (travelling along `dir`) on BVH primitive
+// `prim` (barycentrics `b`, edges `e1`, `e2`, geometric normal `ng`): its
+// stored tangents interpolated, else the frame of its corners'
+// coordinates; the texel read at level 0 as the CPU reads it.
 fn bent_normal_at_hit(
     s: Surface,
     uv: vec3<f32>,
@@ -95,6 +139,8 @@ fn bent_normal_at_hit(
     e1: vec3<f32>,
     e2: vec3<f32>,
     n: vec3<f32>,
+    ng: vec3<f32>,
+    dir: vec3<f32>,
 ) -> vec3<f32> {
     if (!reads_normal_texture(s, uv)) {
         return n;
@@ -107,7 +153,7 @@ fn bent_normal_at_hit(
         axes = derived_uv_axes(edges.xy, edges.zw, e1, e2);
     }
     let texel = texture_lookup(s.normal_texture, uv, vec2<f32>(0.0), vec2<f32>(0.0)).value;
-    return bend_by_texel(s, texel, axes, n);
+    return lifted_for_view(bend_by_texel(s, texel, axes, n), n, ng, dir);
 }
 
 // hikari_core::texture::UvAxes: the directions of growing u and of the

@@ -485,7 +485,7 @@ fn trace_one(rng: ptr<function, Rng>) {
         var shading = normals.shading;
         let prim = prims[hit.prim];
         if (TEXTURED && s.normal_texture != NO_TEXTURE && prim.is_sphere == 0u) {
-            shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, shading);
+            shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, shading, normals.geometric, ray.dir);
         }
         let ns = shading * facing;
         var next_dir: vec3<f32>;

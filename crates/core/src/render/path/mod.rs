@@ -158,7 +158,7 @@ fn advance(
     }
     let facing = if path.ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
     // Normal textures bend the shading normal here (only the path tracer reads them).
-    let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(hit) * facing);
+    let (ng, ns) = (hit.geometric_normal * facing, scene.shading_normal_at(hit, path.ray.dir) * facing);
     let next_dir = match material {
         Material::Emitter => return false,
         Material::Glass(glass) => {
@@ -173,7 +173,7 @@ fn advance(
                 // as MIS expects).
                 let f = |wi: Vec3| glass.f(wo, frame.to_local(wi), Transport::Radiance);
                 let pdf = |wi: Vec3| glass.pdf(wo, frame.to_local(wi));
-                path.l += path.beta * next_event(scene, hit.point, ng, LitSides::Both, f, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ng, ng, LitSides::Both, f, pdf, sampler);
             }
             let u_lobe = sampler.next_f32();
             let u = if glass.is_smooth() { Vec2::ZERO } else { sampler.next_2d() };
@@ -194,7 +194,7 @@ fn advance(
             if bsdf.has_non_delta_lobe() {
                 let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
                 let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
-                path.l += path.beta * next_event(scene, hit.point, ns, LitSides::Front, brdf, pdf, sampler);
+                path.l += path.beta * next_event(scene, hit.point, ns, ng, LitSides::Front, brdf, pdf, sampler);
             }
             let Some(s) = bsdf.sample(wo, sampler.next_f32(), sampler.next_2d()) else { return false };
             path.beta *= s.weight;
@@ -215,7 +215,8 @@ fn advance(
             let p_diffuse = p_d / (p_d + p_s);
             if p_d > 0.0 {
                 let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
-                path.l += path.beta * next_event(scene, hit.point, ns, LitSides::Front, |_| albedo / PI, pdf, sampler);
+                path.l +=
+                    path.beta * next_event(scene, hit.point, ns, ng, LitSides::Front, |_| albedo / PI, pdf, sampler);
             }
             if p_s == 0.0 || sampler.next_f32() < p_diffuse {
                 path.beta *= albedo / p_diffuse;
@@ -344,11 +345,16 @@ fn sky(scene: &Scene, ray: &Ray, previous: Previous) -> Rgb {
 /// Direct light at a vertex from the lights on `sides` of `n`: one sample
 /// per light, MIS-weighted against the vertex's own sampling. `brdf` and
 /// `pdf` are f and the density with which the vertex samples the world
-/// direction ω_i toward the light.
+/// direction ω_i toward the light. A surface that only reflects takes no
+/// light from below its geometric normal `ng` (on the side the path came
+/// from), whatever its shading normal: it would come through the surface,
+/// and the vertex's own sampling ends paths there too (as Cycles and pbrt
+/// do).
 fn next_event(
     scene: &Scene,
     x: Vec3,
     n: Vec3,
+    ng: Vec3,
     sides: LitSides,
     brdf: impl Fn(Vec3) -> Rgb,
     pdf: impl Fn(Vec3) -> f32,
@@ -362,7 +368,7 @@ fn next_event(
             continue;
         };
         let cos = sides.cos(s.wi, n, s.is_delta);
-        if cos <= 0.0 || s.pdf <= 0.0 {
+        if cos <= 0.0 || s.pdf <= 0.0 || (sides == LitSides::Front && s.wi.dot(ng) <= 0.0) {
             continue;
         }
         let mut shadow = Ray::new(x, s.wi);

@@ -35,7 +35,7 @@ pub struct Step {
 
 pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
     // Surfaces shade with their normal textures' normals.
-    let hit = scene.accel.intersect(ray).map(|hit| scene.bent(hit));
+    let hit = scene.accel.intersect(ray).map(|hit| scene.bent(hit, ray.dir));
     let media = &scene.media;
     if media.is_empty() {
         return match hit {

@@ -253,6 +253,19 @@ fn an_emissive_texture_varies_the_radiance_seen() {
     }
 }
 
+/// A matte grey material (base 0.5, no specular lobe) whose normal
+/// texture is one `texel`, at `scale`.
+fn grey_normal_mapped(b: &mut GltfBuilder, texel: [u8; 4], scale: f32) -> gltf::json::Index<gltf::json::Material> {
+    let image = b.image(&png(1, 1, &texel), "image/png");
+    let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+    b.material(&PbrMaterial {
+        base_color: Vec3::splat(0.5),
+        specular: 0.0,
+        normal_texture: Some((t, scale)),
+        ..Default::default()
+    })
+}
+
 /// A normal texture tilting the normal 45° toward +u (world +X) on a floor
 /// under a sun 45° from the zenith toward +X: the path tracer shades with
 /// the bent normal, which faces the sun (1/cos 45° more light than flat; a
@@ -267,14 +280,7 @@ fn a_normal_texture_bends_every_cpu_renderers_normals() {
     let decoded = glam::Vec3::new(218.0, 128.0, 218.0) / 255.0 * 2.0 - 1.0;
     let floor_with = |scale: f32, tag: &str| {
         let mut b = GltfBuilder::new();
-        let image = b.image(&png(1, 1, &texel), "image/png");
-        let t = b.texture(image, gltf::json::texture::WrappingMode::Repeat, gltf::json::texture::WrappingMode::Repeat);
-        let m = b.material(&PbrMaterial {
-            base_color: Vec3::splat(0.5),
-            specular: 0.0,
-            normal_texture: Some((t, scale)),
-            ..Default::default()
-        });
+        let m = grey_normal_mapped(&mut b, texel, scale);
         let floor = quad(&mut b, Vec3::new(-2.0, 0.0, 2.0), 4.0 * Vec3::X, -4.0 * Vec3::Z, 1.0, m);
         use gltf::json::extensions::scene::khr_lights_punctual::Type;
         let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
@@ -334,14 +340,7 @@ fn the_files_tangents_set_the_normal_textures_frame() {
     let sun = Vec3::new(1.0, 2.0, 0.5).normalize();
     let floor_with = |tangent: Option<glam::Vec4>, tag: &str| {
         let mut b = GltfBuilder::new();
-        let image = b.image(&png(1, 1, &texel), "image/png");
-        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
-        let m = b.material(&PbrMaterial {
-            base_color: Vec3::splat(0.5),
-            specular: 0.0,
-            normal_texture: Some((t, 1.0)),
-            ..Default::default()
-        });
+        let m = grey_normal_mapped(&mut b, texel, 1.0);
         let origin = Vec3::new(-2.0, 0.0, 2.0);
         let positions =
             [origin, origin + 4.0 * Vec3::X, origin + 4.0 * Vec3::X - 4.0 * Vec3::Z, origin - 4.0 * Vec3::Z];
@@ -379,6 +378,45 @@ fn the_files_tangents_set_the_normal_textures_frame() {
     }
     // The three frames light the floor differently (the test can tell them apart).
     assert!((seen[0] - seen[1]).abs() > 0.05 * seen[0] && (seen[1] - seen[2]).abs() > 0.05 * seen[1], "{seen:?}");
+}
+
+/// A floor (normal +Y) whose normal texture tilts its normals 60° toward
+/// +X, lit by a sun from +X: from 10° above the floor it lights it in
+/// every CPU renderer; from 10° below (still in front of the bent normal)
+/// its light would come through the floor, and none arrives (path's and
+/// photon-cpu's direct light and vcm alike, as in Cycles).
+#[test]
+fn no_light_comes_through_a_normal_mapped_surface() {
+    use crate::render::path::radiance as path_radiance;
+    use gltf::json::extensions::scene::khr_lights_punctual::Type;
+    let floor_lit_from = |elevation_degrees: f32, tag: &str| {
+        let mut b = GltfBuilder::new();
+        let m = grey_normal_mapped(&mut b, [238, 128, 191, 255], 1.0);
+        let floor = quad(&mut b, Vec3::new(-2.0, 0.0, 2.0), 4.0 * Vec3::X, -4.0 * Vec3::Z, 1.0, m);
+        let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+        let e = elevation_degrees.to_radians();
+        let toward = -Vec3::new(e.cos(), e.sin(), 0.0);
+        let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(toward, Vec3::Z)));
+        let mut scene = load(tag, &b.to_glb(vec![floor, sun]));
+        scene.camera = crate::camera::Camera::new(Vec3::new(0.0, 1.0, 0.0), Vec3::ZERO, -Vec3::Z, 60.0, 8, 8).unwrap();
+        scene
+    };
+    let look = Ray::new(Vec3::new(0.3, 1.0, 0.2), -Vec3::Y);
+    let mut rng = Rng::for_item(3, 0);
+    for (elevation, lit) in [(10.0, true), (-10.0, false)] {
+        let scene = floor_lit_from(elevation, &format!("through-{lit}"));
+        let path = path_radiance(&scene, look, &PathSettings { spp: 1, ..Default::default() }, &mut rng).x;
+        let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+        let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default());
+        let photon = renderer.radiance(&look, 0, &mut rng).x;
+        let vcm = crate::render::vcm::render_pass(&scene, &crate::render::vcm::VcmSettings::default(), 1).unwrap().0;
+        let vcm = vcm.pixels.iter().map(|p| p.x).sum::<f32>();
+        if lit {
+            assert!(path > 0.01 && photon > 0.01 && vcm > 0.01, "lit from above: {path}, {photon}, {vcm}");
+        } else {
+            assert_eq!((path, photon, vcm), (0.0, 0.0, 0.0), "lit from below the floor");
+        }
+    }
 }
 
 /// `EXT_texture_webp` as gltfpack `-tw` writes it: required, the texture's
