@@ -112,7 +112,7 @@ fn valid_reflection_normal(ng: vec3<f32>, wo: vec3<f32>, n: vec3<f32>) -> vec3<f
     let x_raw = n - dot(n, ng) * ng;
     let recip = 1.0 / sqrt(dot(x_raw, x_raw));
     var x = n;
-    if (recip > 0.0 && recip <= 3.4028235e38) {
+    if (recip > 0.0 && recip <= F32_MAX) {
         x = x_raw * recip;
     }
     let ix = dot(wo, x);
@@ -156,6 +156,12 @@ fn bent_normal_at_hit(
     return lifted_for_view(bend_by_texel(s, texel, axes, n), n, ng, dir);
 }
 
+// The largest finite f32 (f32::MAX): `x <= F32_MAX` is Rust's is_finite for
+// a number. Written 3.4028234e38, which rounds to it: Chromium's WGSL
+// compiler refuses f32::MAX's own shortest decimal, 3.4028235e38, as
+// beyond f32 (naga takes both).
+const F32_MAX: f32 = 3.4028234e38;
+
 // hikari_core::texture::UvAxes: the directions of growing u and of the
 // image's up (−v), unnormalised; `found` false where there is no frame.
 struct UvAxes {
@@ -193,7 +199,7 @@ fn image_axes(t: u32, axes: UvAxes) -> UvAxes {
     }
     let m = texture_linear(header);
     let det = m[0].x * m[1].y - m[1].x * m[0].y;
-    if (!(abs(det) >= 1e-20) || abs(det) > 3.4028235e38) {
+    if (!(abs(det) >= 1e-20) || abs(det) > F32_MAX) {
         return UvAxes(vec3<f32>(0.0), vec3<f32>(0.0), false);
     }
     // glam's Mat2::inverse, in its order of operations.
