@@ -32,8 +32,14 @@ def balls_before_a_wall(scene, floor_material, balls):
     for x, mat in balls:
         bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=0.8, location=(x, 0, 0.8))
         o = bpy.context.object; bpy.ops.object.shade_smooth(); o.data.materials.append(mat)
-    bpy.ops.object.light_add(type="POINT", location=(1.5, -2.5, 3.5))
-    light = bpy.context.object; light.data.energy = 800.0; light.data.shadow_soft_size = 0.0
+    point_light_and_camera(scene, (1.5, -2.5, 3.5), 800.0)
+
+
+def point_light_and_camera(scene, location, energy):
+    """A point light of radius 0 at `location` and the camera the
+    comparisons share (7 m before the origin, 1.8 m up)."""
+    bpy.ops.object.light_add(type="POINT", location=location)
+    light = bpy.context.object; light.data.energy = energy; light.data.shadow_soft_size = 0.0
     bpy.ops.object.camera_add(location=(0, -7, 1.8)); cam = bpy.context.object
     cam.rotation_euler = (math.radians(83), 0, 0); cam.data.lens = 30
     scene.camera = cam

@@ -16,7 +16,7 @@
 import bpy, sys, os, math
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import box, constant_sky, export_and_render, principled_material
+from common import box, constant_sky, export_and_render, point_light_and_camera, principled_material
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
@@ -79,11 +79,7 @@ bpy.ops.mesh.primitive_uv_sphere_add(segments=96, ring_count=48, radius=0.8, loc
 o = bpy.context.object; bpy.ops.object.shade_smooth()
 o.data.materials.append(normal_mapped("bumpy ball", bumps, (0.6, 0.45, 0.3)))
 
-bpy.ops.object.light_add(type="POINT", location=(-1.5, -3.0, 3.5))
-light = bpy.context.object; light.data.energy = 300.0; light.data.shadow_soft_size = 0.0
-bpy.ops.object.camera_add(location=(0, -7, 1.8)); cam = bpy.context.object
-cam.rotation_euler = (math.radians(83), 0, 0); cam.data.lens = 30
-scene.camera = cam
+point_light_and_camera(scene, (-1.5, -3.0, 3.5), 300.0)
 constant_sky(scene, out, (0.3, 0.33, 0.36))
 scene.render.resolution_x, scene.render.resolution_y = 240, 160
 bpy.ops.export_scene.gltf(filepath=os.path.join(out, "normal_map_tangents.glb"), export_format="GLB",

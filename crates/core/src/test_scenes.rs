@@ -478,7 +478,7 @@ pub mod gltf_textures {
         let cutout = b.material(&PbrMaterial {
             base_color: Vec3::ZERO,
             specular: 0.0,
-            alpha_cutoff: Some(0.5),
+            alpha_mode: crate::texture::AlphaMode::Mask(0.5),
             base_color_texture: Some(t),
             ..Default::default()
         });
@@ -487,6 +487,49 @@ pub mod gltf_textures {
         let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
         let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(-Vec3::Y, Vec3::Z)));
         b.to_glb(vec![floor, cutout, sun])
+    }
+
+    /// Of the photons on the floor (y = 0) of `cutout_glb` and `blend_glb`:
+    /// how many lie under the quad (|x|, |z| < ½), how many beside it (out
+    /// to 1½, 8 times the area), and the density under over the density
+    /// beside: the fraction of the sun's light the quad lets through.
+    pub fn density_under_the_quad(photons: &[crate::photon::Photon]) -> (usize, usize, f32) {
+        let (mut under, mut beside) = (0usize, 0usize);
+        for p in photons {
+            let [x, y, z] = p.position;
+            if y.abs() > 1e-3 {
+                continue;
+            }
+            let r = x.abs().max(z.abs());
+            if r < 0.5 {
+                under += 1;
+            } else if r < 1.5 {
+                beside += 1;
+            }
+        }
+        (under, beside, under as f32 * 8.0 / beside as f32)
+    }
+
+    /// `cutout_glb`'s scene with the quad `alphaMode` BLEND of alpha
+    /// `alpha` (the base colour factor's; no texture): it stops a fraction
+    /// alpha of the sun's light and of the eye's rays, so from above the
+    /// floor under it shows (1 − alpha)² of the lit floor's radiance.
+    pub fn blend_glb(alpha: f32) -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let floor = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() });
+        let floor = quad(&mut b, Vec3::new(-2.0, 0.0, -2.0), 4.0 * Vec3::X, 4.0 * Vec3::Z, 1.0, floor);
+        let pane = b.material(&PbrMaterial {
+            base_color: Vec3::ZERO,
+            specular: 0.0,
+            alpha,
+            alpha_mode: crate::texture::AlphaMode::Blend,
+            ..Default::default()
+        });
+        let pane = quad(&mut b, Vec3::new(-0.5, 1.0, -0.5), Vec3::X, Vec3::Z, 1.0, pane);
+        use json::extensions::scene::khr_lights_punctual::Type;
+        let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+        let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(-Vec3::Y, Vec3::Z)));
+        b.to_glb(vec![floor, pane, sun])
     }
 }
 

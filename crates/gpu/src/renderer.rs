@@ -173,6 +173,10 @@ pub struct GpuRenderer {
     volume_pass: VolumePass,
     volume_lod: LodOutput,
     has_media: bool,
+    /// The scene has `alphaMode` BLEND surfaces: the shadow views are
+    /// redrawn every pass (`resample_lights`), the last for pass `blend_pass`.
+    has_blend: bool,
+    blend_pass: std::cell::Cell<u32>,
     scene: SceneBuffers,
     lod_pass: LodPass,
     global_lod: LodOutput,
@@ -433,6 +437,8 @@ impl GpuRenderer {
                 .create_output(device, &PhotonBuffer::upload(device, &traced.caustic, "caustic photons")),
             volume_lod: lod_pass.create_output(device, &PhotonBuffer::upload(device, &traced.volume, "volume photons")),
             has_media: !scene.media.is_empty(),
+            has_blend: scene.texturing.as_ref().is_some_and(|t| t.has_blend()),
+            blend_pass: std::cell::Cell::new(0),
             media,
             volume_pass,
             lod_pass,
@@ -539,6 +545,8 @@ impl GpuRenderer {
         let lights = GpuLights::new(scene, self.settings.area_light_samples);
         self.light_source = LightSource::of(scene);
         self.light_pass.set(1);
+        self.has_blend = scene.texturing.as_ref().is_some_and(|t| t.has_blend());
+        self.blend_pass.set(0);
         self.shadows_drawn.set(false);
         if !self.targets.shadow_maps.update(queue, &lights, self.bounds) {
             self.targets.shadow_maps =
@@ -826,21 +834,28 @@ impl GpuRenderer {
     /// pass to pass (skies, area lights, emissive meshes), so that the
     /// progressive mean of their shadows converges (`GpuLights::sampled`):
     /// new shadow views, redrawn, and the direct and specular passes' sample
-    /// tables rewritten. Nothing is redone while the pass stays the same (a
-    /// moving camera, the viewer without converging).
+    /// tables rewritten; and, in a scene with BLEND surfaces, redraws the
+    /// views with this pass's choice of their fragments. Nothing is redone
+    /// while the pass stays the same (a moving camera, the viewer without
+    /// converging).
     fn resample_lights(&self) {
         let (pass, n) = (self.settings.pass.max(1), self.settings.area_light_samples);
-        if pass == self.light_pass.get() || !self.light_source.varies_per_pass(n) {
-            return;
+        if pass != self.light_pass.get() && self.light_source.varies_per_pass(n) {
+            let lights = GpuLights::sampled(&self.light_source, n, pass);
+            let queue = &self.ctx.queue;
+            // The same lights: the same number of views, so the maps are rewritten in place.
+            if self.targets.shadow_maps.update(queue, &lights, self.bounds) {
+                self.direct_pass.set_samples(queue, &self.direct_binding, &lights);
+                self.specular_pass.set_light_samples(queue, &lights);
+                self.shadows_drawn.set(false);
+                self.light_pass.set(pass);
+                // `update` wrote the views' seeds too.
+                self.blend_pass.set(0);
+            }
         }
-        let lights = GpuLights::sampled(&self.light_source, n, pass);
-        let queue = &self.ctx.queue;
-        // The same lights: the same number of views, so the maps are rewritten in place.
-        if self.targets.shadow_maps.update(queue, &lights, self.bounds) {
-            self.direct_pass.set_samples(queue, &self.direct_binding, &lights);
-            self.specular_pass.set_light_samples(queue, &lights);
+        if self.has_blend && pass != self.blend_pass.replace(pass) {
+            self.targets.shadow_maps.set_blend_seed(&self.ctx.queue, pass);
             self.shadows_drawn.set(false);
-            self.light_pass.set(pass);
         }
     }
 
@@ -870,7 +885,7 @@ impl GpuRenderer {
                 let params = GBufferParams {
                     clip_from_world: self.clip_from_world.to_cols_array_2d(),
                     camera_position: self.camera_position.to_array(),
-                    _pad: 0.0,
+                    blend_seed: self.settings.pass,
                 };
                 let t = &self.targets;
                 self.gbuffer_pass.record(queue, encoder, &self.scene, &self.gbuffer_binding, &params, &t.gbuffer);

@@ -6,6 +6,11 @@ use glam::Vec3;
 use hikari_core::geometry::FlatBvh;
 use hikari_core::material::Material;
 use hikari_core::scene::Scene;
+use hikari_core::texture::AlphaMode;
+
+/// `GpuSurface::alpha_cutoff` of an `alphaMode` BLEND surface: beyond any
+/// cut-off, so surface_point.wgsl's `is_there` knows it (its `ALPHA_BLEND`).
+pub const ALPHA_BLEND: f32 = 2.0;
 use wgpu::util::DeviceExt;
 
 /// One rasterized vertex. Mirrors `VertexIn` in gbuffer.wgsl.
@@ -65,7 +70,7 @@ pub struct GpuSurface {
     /// What textures make of the surface (`hikari_core::texture::Texturing`):
     /// `emission` per unit of the emissive texture (the emitter's uniform
     /// radiance over the texture's mean), and `alphaMode` MASK's cut-off
-    /// (negative: opaque).
+    /// (negative: opaque; `ALPHA_BLEND`: BLEND).
     pub emission_per_texel: [f32; 3],
     pub alpha_cutoff: f32,
     /// `textures::texture_ref`s (`textures::NO_TEXTURE` for none).
@@ -276,11 +281,15 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 specular_factor: glossy.map_or(0.0, |b| b.specular),
                 glossy: glossy.is_some() as u32,
                 emission_per_texel: per_texel.to_array(),
-                alpha_cutoff: textures.alpha_cutoff.unwrap_or(-1.0),
+                alpha_cutoff: match textures.alpha_mode {
+                    AlphaMode::Opaque => -1.0,
+                    AlphaMode::Mask(cutoff) => cutoff,
+                    AlphaMode::Blend => ALPHA_BLEND,
+                },
                 base_color_texture: views.reference(textures.base_color),
                 metallic_roughness_texture: views.reference(textures.metallic_roughness),
                 emissive_texture: views.reference(textures.emissive),
-                alpha_factor: if textures.alpha_cutoff.is_some() { textures.alpha_factor } else { 1.0 },
+                alpha_factor: if textures.alpha_mode == AlphaMode::Opaque { 1.0 } else { textures.alpha_factor },
                 normal_texture: views.reference(textures.normal),
                 normal_scale: textures.normal_scale,
                 clearcoat: glossy.map_or(0.0, |b| b.clearcoat),

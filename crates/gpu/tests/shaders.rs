@@ -85,7 +85,7 @@ macro_rules! assert_layout {
 #[test]
 fn shared_structs_match_wgsl_layouts() {
     let gbuffer = hikari_gpu::gbuffer::shader_source();
-    assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, _pad]);
+    assert_layout!(gbuffer, "GBufferParams", GBufferParams, [clip_from_world, camera_position, blend_seed]);
     assert_layout!(
         gbuffer,
         "Surface",
@@ -128,10 +128,10 @@ fn shared_structs_match_wgsl_layouts() {
         [clip_from_world, radius, power_unit, normal_test, _pad, camera_position, _pad1]
     );
     let shadow = hikari_gpu::shadow::shader_source();
-    assert_layout!(shadow, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
+    assert_layout!(shadow, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction, blend_seed]);
     let direct = hikari_gpu::direct::shader_source();
     assert_layout!(direct, "DirectParams", DirectParams, [light_count, shadow_size, bias, pass_index]);
-    assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction]);
+    assert_layout!(direct, "ShadowView", ShadowViewParams, [clip_from_world, light_position, direction, blend_seed]);
     assert_layout!(
         direct,
         "Light",
@@ -201,7 +201,7 @@ fn shared_structs_match_wgsl_layouts() {
         ]
     );
     assert_layout!(specular, "FlatNode", hikari_core::geometry::FlatNode, [min, prim_count, max, first]);
-    assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, _pad]);
+    assert_layout!(specular, "FlatPrim", hikari_core::geometry::FlatPrim, [a, is_sphere, b, surface, c, source]);
     assert_layout!(
         specular,
         "SliceParams",

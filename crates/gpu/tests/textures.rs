@@ -174,7 +174,7 @@ fn a_cutout_lets_light_through_on_the_gpu() {
     use hikari_core::photon::{TraceSettings, trace_photons};
     use hikari_core::progress::Silent;
     use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
-    use hikari_core::test_scenes::gltf_textures::{cutout_glb, load};
+    use hikari_core::test_scenes::gltf_textures::{cutout_glb, density_under_the_quad, load};
     let mut scene = load("gpu-cutout", &cutout_glb());
     let size = 64;
     scene.camera =
@@ -205,22 +205,87 @@ fn a_cutout_lets_light_through_on_the_gpu() {
     // the density beside it, as the CPU's.
     let mut tracer = hikari_gpu::trace::GpuTracer::new(&ctx, &scene).expect("GPU tracer");
     let (photons, _) = tracer.trace(&ctx, &TraceSettings { photons: 200_000, ..Default::default() }).expect("photons");
-    let (mut under, mut beside) = (0usize, 0usize);
-    for p in &photons.global {
-        let [x, y, z] = p.position;
-        if y.abs() > 1e-3 {
-            continue;
-        }
-        let r = x.abs().max(z.abs());
-        if r < 0.5 {
-            under += 1;
-        } else if r < 1.5 {
-            beside += 1;
-        }
-    }
-    let ratio = under as f32 * 8.0 / beside as f32;
+    let (under, beside, ratio) = density_under_the_quad(&photons.global);
     eprintln!("GPU photons under the cut-out {under}, beside {beside}: density ratio {ratio}");
     assert!((ratio - 0.5).abs() < 0.05, "{ratio}");
+}
+
+/// `alphaMode` BLEND on the GPU: a black pane of alpha 0.4 over a lit
+/// floor. The G-buffer keeps 0.4 of its fragments and the shadow maps cast
+/// from 0.4 of theirs, chosen afresh each pass, so the mean of passes over
+/// the pane is (1 − 0.4)² of the lit floor, as on the CPU; the GPU tracer
+/// decides by the same hash of each photon's ray as the CPU tracer, so it
+/// stores the same photons under the pane.
+#[test]
+fn a_blend_surface_converges_over_passes_on_the_gpu() {
+    use glam::Vec3;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::test_scenes::gltf_textures::{blend_glb, load};
+    let alpha = 0.4;
+    let mut scene = load("gpu-blend", &blend_glb(alpha));
+    let size = 64;
+    // 2 units above the floor, 20°: the middle 49×49 pixels see the pane.
+    scene.camera =
+        hikari_core::camera::Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 20.0, size, size).unwrap();
+    let ctx = test_context("a_blend_surface_converges_over_passes_on_the_gpu");
+    let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let settings = hikari_gpu::GpuSettings { shadow_map_size: 1024, ..hikari_gpu::GpuSettings::new(global, caustic) };
+    let mut gpu = hikari_gpu::GpuRenderer::new(ctx.clone(), &scene, &traced, settings).expect("GPU renderer");
+    let lit = 0.5 / std::f32::consts::PI * 2.0;
+    let passes = 24;
+    let middle = |i: usize| {
+        let (x, y) = ((i % size as usize) as i32 - 32, (i / size as usize) as i32 - 32);
+        x.abs() < 20 && y.abs() < 20
+    };
+    let mut sum = 0.0f64;
+    let mut per_pixel = vec![0.0f64; (size * size) as usize];
+    for pass in 1..=passes {
+        gpu.settings.pass = pass;
+        gpu.render().unwrap();
+        let image = gpu.read(gpu.resolved()).unwrap();
+        for (p, v) in per_pixel.iter_mut().zip(&image) {
+            *p += v.x as f64 / passes as f64 / lit as f64;
+        }
+        let over: Vec<f32> = image.iter().enumerate().filter(|&(i, _)| middle(i)).map(|(_, v)| v.x).collect();
+        let mean = over.iter().sum::<f32>() as f64 / over.len() as f64;
+        // Each pixel shows the floor (lit or shadowed) or the black pane.
+        let shown = over.iter().filter(|&&v| v > 0.5 * lit).count() as f64 / over.len() as f64;
+        eprintln!(
+            "pass {pass}: mean over the pane {:.4} of lit, lit floor in {shown:.3} of its pixels",
+            mean / lit as f64
+        );
+        sum += mean;
+    }
+    let mean = sum / passes as f64 / lit as f64;
+    let expected = ((1.0 - alpha) * (1.0 - alpha)) as f64;
+    eprintln!("BLEND on the GPU: mean of {passes} passes {mean:.4} of lit, expected {expected}");
+    assert!((mean / expected - 1.0).abs() < 0.03, "{mean} against {expected}");
+    // Every pixel converges, not only their mean: each pass decides afresh
+    // for the eye and for the light (frozen shadow maps would leave each
+    // floor point lit or not: a spread of about 0.3).
+    let deviations: Vec<f64> =
+        per_pixel.iter().enumerate().filter(|&(i, _)| middle(i)).map(|(_, p)| (p - expected).powi(2)).collect();
+    let spread = (deviations.iter().sum::<f64>() / deviations.len() as f64).sqrt();
+    let independent = (expected * (1.0 - expected) / passes as f64).sqrt();
+    eprintln!("per-pixel means' spread {spread:.4} (independent passes: {independent:.4})");
+    assert!(spread < 1.3 * independent, "{spread} against {independent}");
+    // The GPU tracer's photons: under the pane the CPU tracer's, but for rounding.
+    let settings = TraceSettings { photons: 200_000, ..Default::default() };
+    let mut tracer = hikari_gpu::trace::GpuTracer::new(&ctx, &scene).expect("GPU tracer");
+    let (photons, _) = tracer.trace(&ctx, &settings).expect("photons");
+    let cpu = trace_photons(&scene, &settings, &Silent);
+    let under = |t: &hikari_core::photon::TracedPhotons| {
+        t.global
+            .iter()
+            .filter(|p| p.position[1].abs() < 1e-3 && p.position[0].abs().max(p.position[2].abs()) < 0.5)
+            .count()
+    };
+    let (g, c) = (under(&photons), under(&cpu));
+    eprintln!("photons under the BLEND pane: GPU {g}, CPU {c} (of {} and {})", photons.global.len(), cpu.global.len());
+    assert!(g.abs_diff(c) <= 3, "GPU {g} against CPU {c}");
 }
 
 /// A metallic–roughness texture (B metallic, G roughness, times their

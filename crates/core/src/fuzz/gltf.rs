@@ -67,8 +67,11 @@ fn textured() -> Vec<u8> {
     let image = b.image(&png(4, 4, &rgba), "image/png");
     let repeat = b.texture(image, Repeat, Repeat);
     let clamp = b.texture(image, ClampToEdge, Repeat);
-    let cutout =
-        b.material(&PbrMaterial { base_color_texture: Some(repeat), alpha_cutoff: Some(0.5), ..Default::default() });
+    let cutout = b.material(&PbrMaterial {
+        base_color_texture: Some(repeat),
+        alpha_mode: crate::texture::AlphaMode::Mask(0.5),
+        ..Default::default()
+    });
     let floor =
         b.material(&PbrMaterial { metallic: 1.0, metallic_roughness_texture: Some(clamp), ..Default::default() });
     let uvs = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].map(|uv| uv * 3.0);

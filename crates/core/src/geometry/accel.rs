@@ -45,14 +45,15 @@ pub(super) struct PackedPrim {
     pub b: Vec3,
     pub c: Vec3,
     /// Index in the joint primitive space; `SPHERE_BIT` marks spheres,
-    /// `MASKED_BIT` triangles of `alphaMode` MASK cut-outs.
+    /// `MASKED_BIT` triangles of `alphaMode` MASK cut-outs and BLEND.
     pub prim: u32,
 }
 
 pub(super) const SPHERE_BIT: u32 = 1 << 31;
-/// The triangle is a cut-out: a hit counts only where its alpha reaches
-/// the cutoff (`Texturing::opaque_at`). Only flagged primitives pay for the
-/// test, so scenes without cut-outs cost nothing more.
+/// The triangle is a cut-out or BLEND: a hit counts only where its alpha
+/// says the surface is there (`Texturing::opaque_at`; BLEND by the ray's
+/// `blend_threshold`). Only flagged primitives pay for the test, so scenes
+/// without them cost nothing more.
 pub(super) const MASKED_BIT: u32 = 1 << 30;
 pub(super) const INDEX_BITS: u32 = MASKED_BIT - 1;
 
@@ -213,7 +214,8 @@ impl Accel {
     }
 
     /// Makes the triangles of `texturing`'s MASK cut-out surfaces
-    /// transparent where their alpha is below the cutoff, for closest-hit
+    /// transparent where their alpha is below the cutoff, and those of its
+    /// BLEND surfaces where it is below each ray's threshold, for closest-hit
     /// and occlusion queries alike (None, or a texturing without cut-outs:
     /// every primitive is opaque).
     pub fn set_alpha_mask(&mut self, texturing: Option<Arc<Texturing>>) {
@@ -239,12 +241,15 @@ impl Accel {
     /// Whether a candidate hit on packed primitive `prim` (with its bits)
     /// counts: always, unless it is a cut-out transparent there.
     #[inline(always)]
-    fn counts(&self, prim: u32, b1: f32, b2: f32) -> bool {
+    fn counts(&self, prim: u32, b1: f32, b2: f32, ray: &Ray) -> bool {
         if prim & MASKED_BIT == 0 {
             return true;
         }
         let i = prim & INDEX_BITS;
-        self.alpha.as_ref().is_none_or(|t| t.opaque_at(self.info[i as usize].surface, i, Vec2::new(b1, b2)))
+        self.alpha.as_ref().is_none_or(|t| {
+            let u = || crate::texture::blend_threshold(ray.origin, ray.dir, i);
+            t.opaque_at(self.info[i as usize].surface, i, Vec2::new(b1, b2), u)
+        })
     }
 
     /// Primitive `p`'s hit (t, b1, b2) in (epsilon, ray.t_max) where it
@@ -253,7 +258,7 @@ impl Accel {
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     fn counted_hit(&self, p: &PackedPrim, ray: &Ray) -> Option<(f32, f32, f32)> {
         let (t, b1, b2) = p.intersect(ray, self.epsilon);
-        (t < ray.t_max && self.counts(p.prim, b1, b2)).then_some((t, b1, b2))
+        (t < ray.t_max && self.counts(p.prim, b1, b2, ray)).then_some((t, b1, b2))
     }
 
     pub fn bounds(&self) -> (Vec3, Vec3) {
@@ -319,7 +324,7 @@ impl Accel {
         obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_test_ray, state.oct_inv4), {
             let packed = &packed[state.primitive_id as usize];
             let (t, b1, b2) = packed.intersect(&prim_ray, eps);
-            if t < prim_ray.t_max && self.counts(packed.prim, b1, b2) {
+            if t < prim_ray.t_max && self.counts(packed.prim, b1, b2, ray) {
                 best = (packed.prim & INDEX_BITS, b1, b2);
                 prim_ray.t_max = t;
                 node_test_ray.tmax = t;
@@ -466,7 +471,7 @@ impl Accel {
             obvhs::traverse!(bvh, node, state, node.intersect_ray(&node_ray, state.oct_inv4), {
                 let packed = &packed[state.primitive_id as usize];
                 let (t, b1, b2) = packed.intersect(ray, eps);
-                if t < ray.t_max && self.counts(packed.prim, b1, b2) {
+                if t < ray.t_max && self.counts(packed.prim, b1, b2, ray) {
                     blocked = true;
                     break 'search;
                 }

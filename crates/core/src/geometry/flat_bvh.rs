@@ -28,7 +28,9 @@ pub struct FlatPrim {
     pub b: [f32; 3],
     pub surface: u32,
     pub c: [f32; 3],
-    pub _pad: u32,
+    /// Its index in `Accel`'s joint primitive space (`FlatBvh::source`),
+    /// which a BLEND surface's threshold hashes (`texture::blend_threshold`).
+    pub source: u32,
 }
 
 /// What a hit on a primitive needs beyond its distance, in the same order as
@@ -68,13 +70,14 @@ impl FlatBvh {
     pub fn new(accel: &Accel) -> Self {
         let mut prims: Vec<FlatPrim> = accel
             .triangles()
-            .map(|(t, surface)| FlatPrim {
+            .enumerate()
+            .map(|(i, (t, surface))| FlatPrim {
                 a: t.v[0].to_array(),
                 is_sphere: 0,
                 b: (t.v[1] - t.v[0]).to_array(),
                 surface,
                 c: (t.v[2] - t.v[0]).to_array(),
-                _pad: 0,
+                source: i as u32,
             })
             .collect();
         let mut shading: Vec<FlatShading> = accel
@@ -89,13 +92,14 @@ impl FlatBvh {
             })
             .collect();
         shading.extend(accel.spheres().map(|_| FlatShading::zeroed()));
-        prims.extend(accel.spheres().map(|(s, surface)| FlatPrim {
+        let first_sphere = prims.len() as u32;
+        prims.extend(accel.spheres().enumerate().map(|(i, (s, surface))| FlatPrim {
             a: s.center.to_array(),
             is_sphere: 1,
             b: [s.radius, 0.0, 0.0],
             surface,
             c: [0.0; 3],
-            _pad: 0,
+            source: first_sphere + i as u32,
         }));
         if prims.is_empty() {
             return FlatBvh { nodes: Vec::new(), prims, shading, source: Vec::new(), epsilon: accel.epsilon };

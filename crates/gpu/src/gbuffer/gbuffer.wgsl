@@ -1,12 +1,14 @@
 // G-buffer: world position, normal facing the eye, albedo and material kind,
 // emitted radiance. One fragment per pixel centre, like a primary ray. The
 // surface's textures are applied here (surface_point.wgsl, mip-mapped by
-// the pixel's footprint); MASK cut-outs discard their fragments.
+// the pixel's footprint); MASK cut-outs discard their fragments, and BLEND
+// surfaces with probability 1 − alpha, afresh each pass.
 
 struct GBufferParams {
     clip_from_world: mat4x4<f32>,
     camera_position: vec3<f32>,
-    _pad: f32,
+    // Changes from pass to pass: BLEND fragments' `fragment_blend_threshold`.
+    blend_seed: u32,
 }
 
 
@@ -97,11 +99,11 @@ fn shade(in: VertexOut) -> GBufferOut {
         dy = dpdy(in.uv);
     }
     let point = fragment_point(in);
-    if (CUT_OUTS && !point.opaque) {
-        discard;
-    }
     let id = in.surface & ~HAS_UV;
     let surface = surfaces.all[id];
+    if (CUT_OUTS && !is_there_for_fragment(surface, point.alpha, in.clip, params.blend_seed)) {
+        discard;
+    }
     let view = in.world - params.camera_position;
     let front = dot(in.geometric_normal, view) < 0.0;
     let side = select(-1.0, 1.0, front);
@@ -117,10 +119,12 @@ fn shade(in: VertexOut) -> GBufferOut {
     return out;
 }
 
-// The depth-only draw of the storage path: cut-outs leave no depth.
+// The depth-only draw of the storage path: cut-outs leave no depth, and
+// a BLEND fragment decides as `shade` does.
 @fragment
 fn fs_depth(in: VertexOut) {
-    if (CUT_OUTS && !fragment_point(in).opaque) {
+    let surface = surfaces.all[in.surface & ~HAS_UV];
+    if (CUT_OUTS && !is_there_for_fragment(surface, fragment_point(in).alpha, in.clip, params.blend_seed)) {
         discard;
     }
 }

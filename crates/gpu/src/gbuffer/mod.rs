@@ -10,7 +10,9 @@ use bytemuck::{Pod, Zeroable};
 pub struct GBufferParams {
     pub clip_from_world: [[f32; 4]; 4],
     pub camera_position: [f32; 3],
-    pub _pad: f32,
+    /// Changes from pass to pass: which fragments of BLEND surfaces are
+    /// there (gbuffer.wgsl's `fragment_blend_threshold`).
+    pub blend_seed: u32,
 }
 
 pub const TARGET_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;

@@ -49,6 +49,10 @@ pub struct ShadowViewParams {
     /// Orthographic views: the unit direction light travels and the view's
     /// width; zero for perspective views.
     pub direction: [f32; 4],
+    /// x: which fragments of BLEND surfaces cast shadow in this drawing
+    /// (shadow.wgsl, `fragment_blend_threshold`); changes from pass to pass
+    /// (`ShadowMaps::set_blend_seed`). yzw unused.
+    pub blend_seed: [u32; 4],
 }
 
 impl ShadowViewParams {
@@ -69,6 +73,7 @@ impl ShadowViewParams {
             clip_from_world: v.clip_from_world.to_cols_array_2d(),
             light_position: v.light_position.extend(range).to_array(),
             direction,
+            blend_seed: [0; 4],
         }
     }
 }
@@ -121,6 +126,17 @@ impl ShadowMaps {
             queue.write_buffer(buffer, 0, bytemuck::cast_slice(&lights.occluders.vertices));
         }
         true
+    }
+}
+
+impl ShadowMaps {
+    /// Sets the seed with which the next drawing of the views decides which
+    /// fragments of BLEND surfaces cast shadow.
+    pub fn set_blend_seed(&self, queue: &wgpu::Queue, seed: u32) {
+        let offset = std::mem::offset_of!(ShadowViewParams, blend_seed) as u64;
+        for buffer in &self.view_buffers {
+            queue.write_buffer(buffer, offset, bytemuck::bytes_of(&seed));
+        }
     }
 }
 

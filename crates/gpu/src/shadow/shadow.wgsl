@@ -1,7 +1,9 @@
 // Shadow views: each layer of the shadow-map array stores, per texel, the
 // depth of the nearest surface seen through it (shadow_view.wgsl's
 // `shadow_depth`), divided by the view's range so it fits in [0, 1].
-// Cut-outs (alphaMode MASK) cast no shadow where they are cut.
+// Cut-outs (alphaMode MASK) cast no shadow where they are cut; BLEND
+// surfaces cast it from a fraction alpha of their fragments, chosen afresh
+// each pass (the renderer redraws the views every pass of a scene with one).
 
 @group(0) @binding(0) var<uniform> view: ShadowView;
 @group(1) @binding(0) var<storage, read> surfaces: Surfaces;
@@ -36,7 +38,8 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     let id = in.surface & ~HAS_UV;
     if (CUT_OUTS && id != NO_SURFACE) {
         let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
-        if (!surface_point(surfaces.all[id], uv, dx, dy).opaque) {
+        let s = surfaces.all[id];
+        if (!is_there_for_fragment(s, surface_point(s, uv, dx, dy).alpha, in.clip, view.blend_seed.x)) {
             discard;
         }
     }

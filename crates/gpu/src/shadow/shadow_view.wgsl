@@ -12,6 +12,8 @@ struct ShadowView {
     // Orthographic views: xyz the unit direction light travels, w the
     // view's width (> 0). Perspective views: w = 0.
     direction: vec4<f32>,
+    // x: the seed of this drawing's BLEND fragments (ShadowViewParams).
+    blend_seed: vec4<u32>,
 }
 
 // What view `v` stores for a surface at p, before dividing by its range.

@@ -117,9 +117,10 @@ fn light_sample(i: u32) -> LightSample {
 }
 
 fn shadow_view(i: u32) -> ShadowView {
-    let at = params.view_table + i * 24u;
+    // ShadowViewParams: 28 words (the BLEND seed, unused here, last).
+    let at = params.view_table + i * 28u;
     let clip_from_world = mat4x4<f32>(table_vec4(at), table_vec4(at + 4u), table_vec4(at + 8u), table_vec4(at + 12u));
-    return ShadowView(clip_from_world, table_vec4(at + 16u), table_vec4(at + 20u));
+    return ShadowView(clip_from_world, table_vec4(at + 16u), table_vec4(at + 20u), vec4<u32>(0u));
 }
 
 fn region_triangle(i: u32) -> RegionTriangle {

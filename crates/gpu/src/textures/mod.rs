@@ -45,7 +45,7 @@ pub static TEXTURES: crate::wgsl::Module =
 pub static SURFACE_POINT: crate::wgsl::Module = crate::wgsl::Module {
     name: "surface_point.wgsl",
     source: include_str!("surface_point.wgsl"),
-    requires: &[&TEXTURES, &crate::wgsl::SURFACE, &crate::wgsl::BSDF],
+    requires: &[&TEXTURES, &crate::wgsl::SURFACE, &crate::wgsl::BSDF, &crate::wgsl::RANDOM],
 };
 
 /// A surface without this texture (`GpuSurface`'s texture fields).

@@ -1,5 +1,6 @@
 // A surface at one point, its textures applied: hikari_core::texture::
-// Texturing::apply (base colour, metallic, roughness), opaque_at (MASK)
+// Texturing::apply (base colour, metallic, roughness), the alpha opaque_at
+// reads (`is_there` decides with it)
 // and emission_scale (the emissive texture), in one lookup of each texture.
 // `uv` is the point's texture coordinates (xy) and z = 1 where the
 // primitive has them (z = 0: the factors alone, as on the CPU); `dx` and
@@ -10,7 +11,8 @@ struct SurfacePoint {
     metallic: f32,
     emission: vec3<f32>,
     roughness: f32,
-    opaque: bool,
+    // The base colour's alpha (factor × texture), for `is_there`.
+    alpha: f32,
 }
 
 struct TextureLookup {
@@ -30,16 +32,13 @@ fn texture_lookup(t: u32, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Textur
 
 // TEXTURED and CUT_OUTS (features.wgsl) leave out what no surface has.
 fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> SurfacePoint {
-    var p = SurfacePoint(s.albedo, s.metallic, s.emission, s.roughness, true);
+    var p = SurfacePoint(s.albedo, s.metallic, s.emission, s.roughness, s.alpha_factor);
     if (!TEXTURED) {
-        p.opaque = !CUT_OUTS || s.alpha_cutoff < 0.0 || s.alpha_factor >= s.alpha_cutoff;
         return p;
     }
     let base = texture_lookup(s.base_color_texture, uv, dx, dy);
     p.base *= base.value.rgb;
-    if (CUT_OUTS && s.alpha_cutoff >= 0.0) {
-        p.opaque = s.alpha_factor * base.value.a >= s.alpha_cutoff;
-    }
+    p.alpha *= base.value.a;
     let mr = texture_lookup(s.metallic_roughness_texture, uv, dx, dy);
     if (mr.found) {
         p.metallic = clamp(p.metallic * mr.value.b, 0.0, 1.0);
@@ -50,6 +49,68 @@ fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Sur
         p.emission = s.emission_per_texel * emission.value.rgb;
     }
     return p;
+}
+
+// scene_upload::ALPHA_BLEND: the cut-off of an alphaMode BLEND surface.
+const ALPHA_BLEND: f32 = 2.0;
+
+// hikari_core::texture::AlphaMode::is_there: whether surface `s` of alpha
+// `alpha` is there for a ray (or fragment) of BLEND threshold `u`: always
+// where opaque (a negative cut-off), where alpha reaches a MASK's cut-off,
+// with probability alpha for BLEND.
+fn is_there(s: Surface, alpha: f32, u: f32) -> bool {
+    if (!CUT_OUTS || s.alpha_cutoff < 0.0) {
+        return true;
+    }
+    if (s.alpha_cutoff == ALPHA_BLEND) {
+        return alpha > u;
+    }
+    return alpha >= s.alpha_cutoff;
+}
+
+// hikari_core::texture::blend_threshold: a BLEND surface's threshold for
+// the ray from `o` along `d` at primitive `prim`, a hash of the ray's bits.
+fn blend_threshold(o: vec3<f32>, d: vec3<f32>, prim: u32) -> f32 {
+    var h = hash_u32(prim ^ 0x2545f491u);
+    h = hash_u32(h ^ bitcast<u32>(o.x));
+    h = hash_u32(h ^ bitcast<u32>(o.y));
+    h = hash_u32(h ^ bitcast<u32>(o.z));
+    h = hash_u32(h ^ bitcast<u32>(d.x));
+    h = hash_u32(h ^ bitcast<u32>(d.y));
+    h = hash_u32(h ^ bitcast<u32>(d.z));
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// `is_there` for the ray from `o` along `d` at BVH primitive `source`
+// (its index in Accel's joint primitive space), hashing the ray only for
+// BLEND surfaces.
+fn is_there_for_ray(s: Surface, alpha: f32, o: vec3<f32>, d: vec3<f32>, source: u32) -> bool {
+    if (CUT_OUTS && s.alpha_cutoff == ALPHA_BLEND) {
+        return alpha > blend_threshold(o, d, source);
+    }
+    return is_there(s, alpha, 0.0);
+}
+
+// `is_there` for a rasterized fragment at `position` (its
+// `@builtin(position)`) in a drawing of BLEND seed `seed`.
+fn is_there_for_fragment(s: Surface, alpha: f32, position: vec4<f32>, seed: u32) -> bool {
+    if (CUT_OUTS && s.alpha_cutoff == ALPHA_BLEND) {
+        return alpha > fragment_blend_threshold(position, seed);
+    }
+    return is_there(s, alpha, 0.0);
+}
+
+// A rasterized fragment's BLEND threshold: a hash of its window position
+// and depth (`@builtin(position)`, the same in every draw of it) and a
+// seed that changes from pass to pass, so each pass decides afresh and
+// layers behind one another independently. No CPU twin: the CPU decides
+// by the eye ray (`blend_threshold`); both are uniform.
+fn fragment_blend_threshold(position: vec4<f32>, seed: u32) -> f32 {
+    var h = hash_u32(seed ^ 0x68e31da4u);
+    h = hash_u32(h ^ bitcast<u32>(position.x));
+    h = hash_u32(h ^ bitcast<u32>(position.y));
+    h = hash_u32(h ^ bitcast<u32>(position.z));
+    return f32(h >> 8u) * (1.0 / 16777216.0);
 }
 
 // The surface has a normal texture and the point coordinates to read it at.

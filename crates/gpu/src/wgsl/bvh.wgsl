@@ -2,8 +2,9 @@
 // step for step as its CPU `intersect`: the specular pass and the photon
 // tracer share this one copy. The includer declares the storage arrays
 // `nodes` and `prims`, `loop_iteration()` (its loop accounting) and
-// `prim_is_there(prim, barycentrics)`: false where a cut-out (alphaMode
-// MASK) is cut, so the ray goes on (Accel's alpha test; CUT_OUTS).
+// `prim_is_there(prim, barycentrics, origin, direction)`: false where a
+// cut-out (alphaMode MASK) is cut or a BLEND surface absent for this ray,
+// so the ray goes on (Accel's alpha test; CUT_OUTS).
 
 struct FlatNode {
     min: vec3<f32>,
@@ -18,7 +19,8 @@ struct FlatPrim {
     b: vec3<f32>,
     surface: u32,
     c: vec3<f32>,
-    _pad: u32,
+    // Its index in Accel's joint primitive space (a BLEND threshold's hash).
+    source: u32,
 }
 
 const NO_HIT: f32 = 3.0e38;
@@ -133,7 +135,7 @@ fn trace_bvh(o: vec3<f32>, d: vec3<f32>, eps: f32) -> Hit {
                 break;
             }
             let r = intersect_prim(prims[i], o, d, hit.t, eps);
-            if (r.x < hit.t && prim_is_there(i, r.yz)) {
+            if (r.x < hit.t && prim_is_there(i, r.yz, o, d)) {
                 hit = Hit(r.x, i, r.yz);
             }
         }

@@ -85,17 +85,19 @@ pub static HIT_NORMALS: Module =
     Module { name: "hit_normals.wgsl", source: include_str!("hit_normals.wgsl"), requires: &[&BVH, &OPTICS] };
 
 /// `prim_is_there` for bvh.wgsl: the alpha test of cut-outs (alphaMode
-/// MASK) at a candidate hit, as `Accel` tests it. The includer declares
-/// `prims`, `surfaces` and `texture_data`.
+/// MASK) and BLEND surfaces at a candidate hit of the ray from `o` along
+/// `d`, as `Accel` tests it. The includer declares `prims`, `surfaces` and
+/// `texture_data`.
 pub static CUT_OUTS: Module = Module {
     name: "cut_outs",
-    source: "fn prim_is_there(prim: u32, b: vec2<f32>) -> bool {\n\
+    source: "fn prim_is_there(prim: u32, b: vec2<f32>, o: vec3<f32>, d: vec3<f32>) -> bool {\n\
              if (!CUT_OUTS) { return true; }\n\
              let p = prims[prim];\n\
              if (p.is_sphere != 0u) { return true; }\n\
              let s = surfaces.all[p.surface];\n\
              if (s.alpha_cutoff < 0.0) { return true; }\n\
-             return surface_point(s, primitive_uv(prim, b), vec2<f32>(0.0), vec2<f32>(0.0)).opaque;\n\
+             let alpha = surface_point(s, primitive_uv(prim, b), vec2<f32>(0.0), vec2<f32>(0.0)).alpha;\n\
+             return is_there_for_ray(s, alpha, o, d, p.source);\n\
              }\n",
     requires: &[&crate::textures::SURFACE_POINT],
 };

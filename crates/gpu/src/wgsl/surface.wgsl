@@ -20,7 +20,8 @@ struct Surface {
     specular_factor: f32,
     glossy: u32,
     // Textures (textures.wgsl's `surface_point`): `emission` per unit of
-    // the emissive texture, MASK's cut-off (negative: opaque), texture
+    // the emissive texture, MASK's cut-off (negative: opaque; ALPHA_BLEND:
+    // BLEND, surface_point.wgsl's `is_there`), texture
     // references (0xffffffff: none) and the base colour factor's alpha.
     emission_per_texel: vec3<f32>,
     alpha_cutoff: f32,

@@ -8,6 +8,7 @@ use super::materials::{CLEARCOAT, SHEEN};
 use crate::light::Light;
 use crate::material::{Material, Rgb};
 use crate::scene::Scene;
+use crate::texture::AlphaMode;
 use glam::{Mat3, Quat, Vec2, Vec3};
 /// The wrap modes `GltfBuilder::texture` takes, for writers outside this crate.
 pub use gltf::json::texture::WrappingMode;
@@ -42,8 +43,8 @@ pub struct PbrMaterial {
     pub double_sided: bool,
     /// `baseColorFactor`'s alpha.
     pub alpha: f32,
-    /// `alphaMode` MASK with this `alphaCutoff` (None: OPAQUE).
-    pub alpha_cutoff: Option<f32>,
+    /// `alphaMode` (MASK with its `alphaCutoff`).
+    pub alpha_mode: AlphaMode,
     /// Textures (from [`GltfBuilder::texture`]), read through TEXCOORD_0.
     pub base_color_texture: Option<Index<json::Texture>>,
     pub metallic_roughness_texture: Option<Index<json::Texture>>,
@@ -70,7 +71,7 @@ impl Default for PbrMaterial {
             sheen_roughness: 0.0,
             double_sided: true,
             alpha: 1.0,
-            alpha_cutoff: None,
+            alpha_mode: AlphaMode::Opaque,
             base_color_texture: None,
             metallic_roughness_texture: None,
             emissive_texture: None,
@@ -260,12 +261,15 @@ impl GltfBuilder {
                 extensions: None,
                 extras: Default::default(),
             }),
-            alpha_mode: Valid(if m.alpha_cutoff.is_some() {
-                json::material::AlphaMode::Mask
-            } else {
-                json::material::AlphaMode::Opaque
+            alpha_mode: Valid(match m.alpha_mode {
+                AlphaMode::Opaque => json::material::AlphaMode::Opaque,
+                AlphaMode::Mask(_) => json::material::AlphaMode::Mask,
+                AlphaMode::Blend => json::material::AlphaMode::Blend,
             }),
-            alpha_cutoff: m.alpha_cutoff.map(json::material::AlphaCutoff),
+            alpha_cutoff: match m.alpha_mode {
+                AlphaMode::Mask(cutoff) => Some(json::material::AlphaCutoff(cutoff)),
+                _ => None,
+            },
             extensions: Some(extensions),
             ..Default::default()
         })

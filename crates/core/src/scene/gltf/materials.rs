@@ -10,13 +10,14 @@
 //! metallic–roughness, emissive and normal textures are read
 //! (`crate::texture`; normal maps bend the CPU renderers' shading normals);
 //! occlusion textures are not. `alphaMode` MASK makes cut-outs,
-//! BLEND is drawn opaque. Each approximation made is reported in one note.
+//! BLEND stochastic transparency (`crate::texture::AlphaMode`). Each
+//! approximation made is reported in one note.
 
 use super::textures::Images;
 use crate::bsdf::Bsdf;
 use crate::bsdf::dielectric::Dielectric;
 use crate::material::{Material, Rgb};
-use crate::texture::{ColorSpace, MaterialTextures};
+use crate::texture::{AlphaMode, ColorSpace, MaterialTextures};
 use glam::{Vec3, Vec4Swizzles};
 
 /// Light a surface emits: `emissiveFactor` × `KHR_materials_emissive_strength`,
@@ -45,7 +46,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut unread_maps = 0;
     let mut other_sets = 0;
     let mut approximated = 0;
-    let mut blended = 0;
     let mut specular_textures = 0;
     let mut transmission_textures = 0;
     let mut coat_textures = 0;
@@ -72,9 +72,11 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 m.normal_texture().zip(normal_json).map_or(0, |(n, json)| super::textures::normal_tex_coord(&n, json));
             other_sets += (read.iter().flatten().any(|(set, _)| *set != 0) || normal_set != 0) as usize;
             let [base_color, metallic_roughness, emissive] = read.map(|r| r.and_then(|(_, t)| t));
-            blended += (m.alpha_mode() == gltf::material::AlphaMode::Blend) as usize;
-            let alpha_cutoff =
-                (m.alpha_mode() == gltf::material::AlphaMode::Mask).then(|| m.alpha_cutoff().unwrap_or(0.5));
+            let alpha_mode = match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            };
             let [r, g, b, alpha] = pbr.base_color_factor();
             let base = sane(Vec3::new(r, g, b), 1.0);
             let metallic = sane(Vec3::splat(pbr.metallic_factor()), 1.0).x;
@@ -126,11 +128,11 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 emissive,
                 emissive_mean,
                 alpha_factor: sane(Vec3::splat(alpha), 1.0).x,
-                alpha_cutoff,
+                alpha_mode,
                 normal: normal.map(|(t, _)| t),
                 normal_scale: normal.map_or(1.0, |(_, scale)| if scale.is_finite() { scale } else { 1.0 }),
             };
-            textures.push((t.is_textured() || alpha_cutoff.is_some()).then_some(t));
+            textures.push((t.is_textured() || alpha_mode != AlphaMode::Opaque).then_some(t));
             (material, emission)
         })
         .unzip();
@@ -193,9 +195,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     }
     if sheened_glass > 0 {
         notes.push(format!("{sheened_glass} transmissive material(s) have a sheen, which is ignored on glass"));
-    }
-    if blended > 0 {
-        notes.push(format!("{blended} material(s) with alphaMode BLEND are rendered opaque"));
     }
     Converted { materials, emissions, textures, names }
 }

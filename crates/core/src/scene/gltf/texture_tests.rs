@@ -14,7 +14,9 @@ use crate::texture::srgb_to_linear;
 use gltf::json::texture::WrappingMode;
 use std::f32::consts::PI;
 
-use crate::test_scenes::gltf_textures::{GREYS, checker_glb, cutout_glb, folder, grey_checker, load, quad};
+use crate::test_scenes::gltf_textures::{
+    GREYS, checker_glb, cutout_glb, density_under_the_quad, folder, grey_checker, load, quad,
+};
 
 fn checker_scene(tag: &str) -> Scene {
     load(tag, &checker_glb())
@@ -183,22 +185,86 @@ fn a_cutout_lets_light_through_where_alpha_is_below_the_cutoff() {
     let (path, photon) = (path_sum / (n * n) as f32 / lit, photon_sum / (n * n) as f32 / lit);
     assert!((path - 0.5).abs() < 1e-4 && (photon - 0.5).abs() < 1e-4, "lit fraction: path {path}, photon-cpu {photon}");
     // Photons: the density on the floor under the quad is half that beside it.
-    let (mut under, mut beside) = (0usize, 0usize);
-    for p in &traced.global {
-        let [x, y, z] = p.position;
-        if y.abs() > 1e-3 {
-            continue;
-        }
-        let r = x.abs().max(z.abs());
-        if r < 0.5 {
-            under += 1;
-        } else if r < 1.5 {
-            beside += 1; // 8 times the area
-        }
-    }
-    let ratio = under as f32 * 8.0 / beside as f32;
+    let (under, beside, ratio) = density_under_the_quad(&traced.global);
     eprintln!("photons under the cut-out {under}, beside {beside}: density ratio {ratio}");
     assert!((ratio - 0.5).abs() < 0.05, "{ratio}");
+}
+
+/// `alphaMode` BLEND is stochastic transparency: a black pane of alpha 0.4
+/// over a lit floor stops 40% of the sun's light (shadow rays, photons) and
+/// of the eye's rays, so from above the floor under it shows (1 − 0.4)² of
+/// the lit floor in path, photon-cpu and vcm; the packet traversals decide
+/// as single rays do, to the bit.
+#[test]
+fn a_blend_surface_lets_through_one_minus_alpha_of_light_and_eye() {
+    use crate::test_scenes::gltf_textures::blend_glb;
+    let alpha = 0.4;
+    let scene = load("blend", &blend_glb(alpha));
+    assert!(scene.notes.iter().all(|n| !n.contains("BLEND")), "{:?}", scene.notes);
+    let lit = 0.5 / PI * 2.0;
+    let mut rng = Rng::for_item(11, 0);
+    let under = |rng: &mut Rng| {
+        let p = rng.next_2d() - 0.5;
+        (p.x, p.y)
+    };
+    // Shadow rays from the floor under the pane toward the sun, single and packed.
+    let n = 20_000;
+    let mut blocked = 0;
+    for _ in 0..n / 8 {
+        let rays: [Ray; 8] = std::array::from_fn(|_| {
+            let (x, z) = under(&mut rng);
+            Ray::new(Vec3::new(x, 0.0, z), Vec3::Y)
+        });
+        let lanes = crate::geometry::packet::RayLanes::gather(&rays.map(Some));
+        let packed = scene.accel.occluded_packet(&lanes);
+        let single = (0..8).fold(0u32, |bits, l| bits | (scene.accel.occluded(&rays[l]) as u32) << l);
+        assert_eq!(packed, single);
+        let mut hits = [None; 8];
+        scene.accel.intersect_packet(&rays.map(Some), &mut hits);
+        for (hit, ray) in hits.iter().zip(&rays) {
+            assert_eq!(hit.map(|h| h.t.to_bits()), scene.accel.intersect(ray).map(|h| h.t.to_bits()));
+        }
+        blocked += single.count_ones();
+    }
+    let blocked = blocked as f64 / n as f64;
+    eprintln!("BLEND alpha {alpha}: {blocked} of shadow rays blocked");
+    assert!((blocked - alpha as f64).abs() < 0.015, "{blocked}");
+    // From above: each renderer's mean over the pane.
+    let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, ..Default::default() }, &Silent);
+    let renderer = PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings { spp: 1, ..Default::default() });
+    let settings = PathSettings { spp: 1, ..Default::default() };
+    let look = |rng: &mut Rng| {
+        let (x, z) = under(rng);
+        Ray::new(Vec3::new(x, 2.0, z), -Vec3::Y)
+    };
+    let expected = (1.0 - alpha) * (1.0 - alpha) * lit;
+    let m = 20_000;
+    let mean = |f: &mut dyn FnMut(&mut Rng) -> f32, rng: &mut Rng| (0..m).map(|_| f(rng)).sum::<f32>() / m as f32;
+    let path = mean(&mut |rng| path_radiance(&scene, look(rng), &settings, rng).x, &mut rng);
+    let photon = mean(&mut |rng| renderer.radiance(&look(rng), 0, rng).x, &mut rng);
+    // vcm: 16×16 pixels looking down at the pane's middle, all under it.
+    let mut above = scene.clone();
+    above.camera = crate::camera::Camera::new(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO, Vec3::Z, 20.0, 16, 16).unwrap();
+    let vcm = (1..=16)
+        .map(|pass| {
+            let image = crate::render::vcm::render_pass(&above, &Default::default(), pass).unwrap().0;
+            image.pixels.iter().map(|p| p.x).sum::<f32>() / image.pixels.len() as f32
+        })
+        .sum::<f32>()
+        / 16.0;
+    eprintln!(
+        "BLEND from above over (1 − α)² lit: path {}, photon-cpu {}, vcm {}",
+        path / expected,
+        photon / expected,
+        vcm / expected
+    );
+    for (name, l) in [("path", path), ("photon-cpu", photon), ("vcm", vcm)] {
+        assert!((l / expected - 1.0).abs() < 0.03, "{name}: {l} against {expected}");
+    }
+    // Photons: the density under the pane is 1 − α of that beside it.
+    let (below, beside, ratio) = density_under_the_quad(&traced.global);
+    eprintln!("photons under the BLEND pane {below}, beside {beside}: density ratio {ratio}");
+    assert!((ratio - (1.0 - alpha)).abs() < 0.03, "{ratio}");
 }
 
 /// A texture that reads an image file that is not there, or bytes that
