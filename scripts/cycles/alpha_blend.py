@@ -12,17 +12,16 @@
 #   hikari render OUT/alpha_blend.glb --environment OUT/sky.exr --renderer path \
 #       --resolution 240x160 --spp 512 -o path.exr
 #   python shared/relerr.py path.exr OUT/cycles.exr
-import bpy, sys, os, math, json, struct
+import bpy, sys, os, math
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import box, constant_sky, export_and_render, point_light_and_camera, principled_material
+from common import (box, constant_sky, export_and_render, exported_materials, grey_floor_and_wall,
+                    point_light_and_camera, principled_material, smooth_ball)
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
 
-grey = principled_material("grey", {"Base Color": (0.6, 0.6, 0.6, 1), "Roughness": 1.0, "Specular IOR Level": 0.0})
-box((0, 0, -0.05), (10, 6, 0.1), grey)
-box((0, 2.0, 1.5), (10, 0.2, 3), grey)
+grey_floor_and_wall()
 
 
 def pane(x, material):
@@ -50,15 +49,12 @@ links.new(tex.outputs["Alpha"], nodes["Principled BSDF"].inputs["Alpha"])
 pane(1.2, fade)
 
 ball = principled_material("orange", {"Base Color": (0.8, 0.4, 0.1, 1), "Roughness": 0.5})
-bpy.ops.mesh.primitive_uv_sphere_add(segments=96, ring_count=48, radius=0.7, location=(0, 0.6, 0.7))
-o = bpy.context.object; bpy.ops.object.shade_smooth(); o.data.materials.append(ball)
+smooth_ball((0, 0.6, 0.7), 0.7, ball)
 
 point_light_and_camera(scene, (-1.5, -3.0, 3.5), 300.0)
 constant_sky(scene, out, (0.3, 0.33, 0.36))
 export_and_render(scene, out, "alpha_blend")
 
 # What the exporter wrote: both panes must be BLEND for the comparison to mean anything.
-with open(os.path.join(out, "alpha_blend.glb"), "rb") as f:
-    f.seek(12); n, _ = struct.unpack("<II", f.read(8)); doc = json.loads(f.read(n))
-for m in doc["materials"]:
+for m in exported_materials(out, "alpha_blend"):
     print(m["name"], m.get("alphaMode", "OPAQUE"), m.get("pbrMetallicRoughness", {}).get("baseColorFactor"))

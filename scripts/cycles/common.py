@@ -35,6 +35,27 @@ def balls_before_a_wall(scene, floor_material, balls):
     point_light_and_camera(scene, (1.5, -2.5, 3.5), 800.0)
 
 
+def grey_floor_and_wall():
+    """The comparisons' stage: a matte grey floor and back wall (no
+    specular reflection), 10 m wide."""
+    grey = principled_material("grey", {"Base Color": (0.6, 0.6, 0.6, 1), "Roughness": 1.0, "Specular IOR Level": 0.0})
+    box((0, 0, -0.05), (10, 6, 0.1), grey)
+    box((0, 2.0, 1.5), (10, 0.2, 3), grey)
+
+
+def smooth_ball(location, radius, material):
+    """A smooth-shaded UV sphere (96 × 48) of `material`."""
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=96, ring_count=48, radius=radius, location=location)
+    o = bpy.context.object; bpy.ops.object.shade_smooth(); o.data.materials.append(material)
+
+
+def exported_materials(out, name):
+    """The materials Blender's exporter wrote to OUT/NAME.glb (its JSON)."""
+    import json, struct
+    with open(os.path.join(out, name + ".glb"), "rb") as f:
+        f.seek(12); n, _ = struct.unpack("<II", f.read(8)); return json.loads(f.read(n))["materials"]
+
+
 def point_light_and_camera(scene, location, energy):
     """A point light of radius 0 at `location` and the camera the
     comparisons share (7 m before the origin, 1.8 m up)."""

@@ -16,7 +16,7 @@
 import bpy, sys, os, math
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import box, constant_sky, export_and_render, point_light_and_camera, principled_material
+from common import box, constant_sky, export_and_render, grey_floor_and_wall, point_light_and_camera, principled_material
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
@@ -57,9 +57,7 @@ bump = np.stack([-dhdu, -dhdv, np.ones_like(u)], axis=2)
 bump /= np.linalg.norm(bump, axis=2, keepdims=True)
 bumps = normal_image("bumps", bump)
 
-grey = principled_material("grey", {"Base Color": (0.6, 0.6, 0.6, 1), "Roughness": 1.0, "Specular IOR Level": 0.0})
-box((0, 0, -0.05), (10, 6, 0.1), grey)
-box((0, 2.0, 1.5), (10, 0.2, 3), grey)
+grey_floor_and_wall()
 
 
 def tile(x, uv_map):

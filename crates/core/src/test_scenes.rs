@@ -510,6 +510,34 @@ pub mod gltf_textures {
         (under, beside, under as f32 * 8.0 / beside as f32)
     }
 
+    /// A smooth glass slab (index 1.5) 2 wide and 1 thick, y from 0.5 to
+    /// 1.5, whose inside keeps `color` of the light over its thickness
+    /// (`KHR_materials_volume`: absorption −ln(color) per unit). With
+    /// `floor_and_sun`, over a white floor (albedo 0.5, 8 wide) under a sun
+    /// straight down (E = 2 W/m²); without, alone under the uniform white
+    /// sky the loader gives a file without lights.
+    pub fn absorbing_slab_glb(color: Vec3, floor_and_sun: bool) -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let glass = b.material(&PbrMaterial {
+            glass_ior: Some(1.5),
+            roughness: 0.0,
+            glass_absorption: -color.ln(),
+            ..Default::default()
+        });
+        let slab = crate::medium::region::box_triangles(Vec3::new(-1.0, 0.5, -1.0), Vec3::new(1.0, 1.5, 1.0));
+        let positions: Vec<Vec3> = slab.into_iter().flatten().collect();
+        let mesh = b.mesh(&positions, None, None, Some(glass));
+        let mut nodes = vec![b.node(json::Node { mesh: Some(mesh), ..Default::default() })];
+        if floor_and_sun {
+            let floor = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() });
+            nodes.push(quad(&mut b, Vec3::new(-4.0, 0.0, -4.0), 8.0 * Vec3::Z, 8.0 * Vec3::X, 1.0, floor));
+            use json::extensions::scene::khr_lights_punctual::Type;
+            let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+            nodes.push(b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(-Vec3::Y, Vec3::Z))));
+        }
+        b.to_glb(nodes)
+    }
+
     /// `cutout_glb`'s scene with the quad `alphaMode` BLEND of alpha
     /// `alpha` (the base colour factor's; no texture): it stops a fraction
     /// alpha of the sun's light and of the eye's rays, so from above the

@@ -97,7 +97,11 @@ pub struct GpuSurface {
     pub sheen_color: [f32; 3],
     pub _pad2: u32,
     /// The glTF BRDF's specular colour (`Bsdf::specular_color`, white:
-    /// glTF's default).
+    /// glTF's default); for glass (kind 2), which has no such colour, its
+    /// inside's absorption per scene unit (`Dielectric::absorption`,
+    /// KHR_materials_volume; surface.wgsl's `glass_absorption`). Shared
+    /// rather than a field of its own: 16 more bytes a surface cost every
+    /// pass that reads surfaces (the splat passes 5–7% on llvmpipe).
     pub specular_color: [f32; 3],
     pub _pad3: u32,
 }
@@ -299,7 +303,10 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 _pad: [0; 2],
                 sheen_color: glossy.map_or([0.0; 3], |b| b.sheen_color.to_array()),
                 _pad2: 0,
-                specular_color: glossy.map_or([1.0; 3], |b| b.specular_color.to_array()),
+                specular_color: match material {
+                    Material::Glass(glass) => glass.absorption.to_array(),
+                    _ => glossy.map_or([1.0; 3], |b| b.specular_color.to_array()),
+                },
                 _pad3: 0,
             }
         })

@@ -204,6 +204,7 @@ fn wgsl_glass_matches_the_cpu() {
             ior: [1.5, 1.33, 2.4][(rng.next_f32() * 3.0) as usize % 3],
             roughness: 0.05 + 0.95 * rng.next_f32(),
             tint: Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()),
+            absorption: Vec3::ZERO,
         };
         let (wo, wi) = (uniform_sphere(rng.next_2d()), uniform_sphere(rng.next_2d()));
         let (u_lobe, u) = (rng.next_f32(), rng.next_2d());

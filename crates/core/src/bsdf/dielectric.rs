@@ -57,13 +57,19 @@ pub enum Transport {
 }
 
 /// A glass surface: index of refraction, perceptual roughness (GGX α =
-/// roughness²) and the colour seen through a solid piece of it (each
-/// crossing tints by its square root).
+/// roughness²), the colour seen through a solid piece of it (each
+/// crossing tints by its square root) and what its inside absorbs.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dielectric {
     pub ior: f32,
     pub roughness: f32,
     pub tint: Rgb,
+    /// Absorption coefficient of the glass's inside, per scene unit
+    /// (`KHR_materials_volume`: −ln(attenuationColor) / attenuationDistance;
+    /// zero: clear): light crossing a length d of it keeps e^(−σ·d)
+    /// ([`Dielectric::interior_transmittance`]), coloured glass as thick
+    /// parts look darker.
+    pub absorption: Rgb,
 }
 
 /// A direction drawn by [`Dielectric::sample`].
@@ -88,7 +94,21 @@ pub struct GlassSample {
 impl Dielectric {
     /// Clear smooth glass of index `ior`.
     pub fn clear(ior: f32) -> Self {
-        Dielectric { ior, roughness: 0.0, tint: Rgb::ONE }
+        Dielectric { ior, roughness: 0.0, tint: Rgb::ONE, absorption: Rgb::ZERO }
+    }
+
+    /// What reaches a hit on this glass of geometric normal `ng` at
+    /// distance `t` along `dir` of what left the ray's origin: e^(−σ·t)
+    /// where the ray arrives from inside (along `ng`, which points out),
+    /// having crossed t of the glass (Beer–Lambert); 1 from outside. Every
+    /// renderer applies it on arriving at glass (the WGSL twin is
+    /// dielectric.wgsl's `glass_interior_transmittance`), so a closed glass
+    /// mesh absorbs along each segment inside it.
+    pub fn interior_transmittance(&self, dir: Vec3, ng: Vec3, t: f32) -> Rgb {
+        if dir.dot(ng) <= 0.0 || self.absorption == Rgb::ZERO {
+            return Rgb::ONE;
+        }
+        (-self.absorption * t).exp()
     }
 
     /// Both lobes are deltas.

@@ -193,6 +193,8 @@ impl PathTracer<'_> {
             let next_dir = match material {
                 Material::Emitter => return,
                 Material::Glass(glass) => {
+                    // Arriving from inside: what the glass absorbed on the way.
+                    power *= glass.interior_transmittance(ray.dir, hit.geometric_normal, hit.t);
                     // Power crosses unchanged (importance); a rough or
                     // tinted boundary's weight is below 1, and Russian
                     // roulette on it keeps photons near constant power.

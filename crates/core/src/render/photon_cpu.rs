@@ -241,6 +241,8 @@ impl<'a> PhotonCpuRenderer<'a> {
         let (ns, ng) = (hit.shading_normal * facing, hit.geometric_normal * facing);
         match material {
             Material::Glass(glass) => {
+                // Arriving from inside: what the glass absorbed on the way.
+                let absorbed = glass.interior_transmittance(ray.dir, hit.geometric_normal, hit.t);
                 if glass.is_smooth() {
                     if !can_recurse {
                         return Rgb::ZERO;
@@ -253,7 +255,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                             l += weight * self.radiance(&Ray::new(hit.point, wi), depth + 1, rng);
                         }
                     }
-                    return l;
+                    return absorbed * l;
                 }
                 // Rough glass: lights on this side by shadow rays through
                 // the reflection, and point, spot and sun lights beyond by
@@ -278,7 +280,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                         l += s.weight * self.radiance_seen(&next, depth + 1, s.transmitted, rng);
                     }
                 }
-                l
+                absorbed * l
             }
             Material::Emitter => Rgb::ZERO,
             Material::Pbr(bsdf) => {

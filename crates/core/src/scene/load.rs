@@ -495,6 +495,7 @@ fn load_material(m: &MaterialDesc, p: &Place) -> Result<Material, SceneError> {
                 ior: p.in_range("ior", m.ior.unwrap_or(1.5), limits::IOR)?,
                 roughness: p.in_range("roughness", m.roughness.unwrap_or(0.0), (0.0, 1.0))?,
                 tint: p.color("base_color", m.base_color.unwrap_or([1.0; 3]), 1.0)?,
+                absorption: crate::material::Rgb::ZERO,
             }))
         }
         "pbr" => {

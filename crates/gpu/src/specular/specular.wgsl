@@ -420,6 +420,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         let normals = hit_normals(hit.prim, b.origin, b.dir, x);
         let ng = normals.geometric;
         let s = surfaces.all[p.surface];
+        if (s.kind == 2u) {
+            // Arriving from inside: what the glass absorbed on the way.
+            weight *= glass_interior_transmittance(glass_absorption(s), b.dir, ng, hit.t);
+        }
         // The surface here with its textures (level 0, as the CPU reads).
         let uv = primitive_uv(hit.prim, hit.b);
         let point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));

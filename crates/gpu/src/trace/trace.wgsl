@@ -488,6 +488,10 @@ fn trace_one(rng: ptr<function, Rng>) {
             shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, shading, normals.geometric, ray.dir);
         }
         let ns = shading * facing;
+        if (s.kind == 2u) {
+            // Arriving from inside: what the glass absorbed on the way.
+            power *= glass_interior_transmittance(glass_absorption(s), ray.dir, normals.geometric, hit.t);
+        }
         var next_dir: vec3<f32>;
         if (s.kind == 3u) {
             return;

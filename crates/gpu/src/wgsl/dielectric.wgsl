@@ -34,6 +34,17 @@ fn glass_eta_across(g: Dielectric, wo_z: f32) -> f32 {
     return select(1.0 / g.ior, g.ior, wo_z > 0.0);
 }
 
+// Dielectric::interior_transmittance: e^(−σ·t) for a ray along `dir`
+// arriving at glass of outward geometric normal `ng` from inside, having
+// crossed t of it (Beer–Lambert, KHR_materials_volume's absorption σ);
+// 1 from outside.
+fn glass_interior_transmittance(absorption: vec3<f32>, dir: vec3<f32>, ng: vec3<f32>, t: f32) -> vec3<f32> {
+    if (dot(dir, ng) <= 0.0 || all(absorption == vec3<f32>(0.0))) {
+        return vec3<f32>(1.0);
+    }
+    return exp(-absorption * t);
+}
+
 // √tint per crossing: a solid piece shows the tint.
 fn glass_transmission_factor(g: Dielectric, eta: f32, radiance: bool) -> vec3<f32> {
     let tint = sqrt(g.tint);

@@ -42,9 +42,16 @@ struct Surface {
     _pad: array<u32, 2>,
     sheen_color: vec3<f32>,
     _pad2: u32,
-    // KHR_materials_specular's colour, scaling the dielectric's F0.
+    // KHR_materials_specular's colour, scaling the dielectric's F0; for
+    // glass, its inside's absorption (`glass_absorption`).
     specular_color: vec3<f32>,
     _pad3: u32,
+}
+
+// A glass surface's inside absorption per scene unit (kind 2 keeps it in
+// `specular_color`, which glass has no use for: scene_upload::GpuSurface).
+fn glass_absorption(s: Surface) -> vec3<f32> {
+    return s.specular_color;
 }
 
 // The surfaces buffer (scene_upload::surfaces_contents): the sheen's albedo

@@ -7,7 +7,7 @@ use crate::sampling::chi2::assert_direction_distribution;
 use std::cell::RefCell;
 
 fn glass(roughness: f32) -> Dielectric {
-    Dielectric { ior: 1.5, roughness, tint: Rgb::ONE }
+    Dielectric { ior: 1.5, roughness, tint: Rgb::ONE, absorption: Rgb::ZERO }
 }
 
 /// `wo` at `deg` from the normal, outside (`outside`) or mirrored inside.
@@ -43,7 +43,7 @@ fn albedo_by_sampling(g: &Dielectric, wo: Vec3, mode: Transport, n: usize) -> (f
 
 #[test]
 fn smooth_glass_splits_by_fresnel_with_tinted_transmission() {
-    let g = Dielectric { ior: 1.5, roughness: 0.0, tint: Rgb::new(0.9, 0.5, 0.2) };
+    let g = Dielectric { ior: 1.5, roughness: 0.0, tint: Rgb::new(0.9, 0.5, 0.2), absorption: Rgb::ZERO };
     let wo = Vec3::Z;
     // Normal incidence from outside: R = ((1.5 − 1)/(1.5 + 1))² = 0.04.
     let r = g.sample(wo, 0.0, Vec2::ZERO, Transport::Importance).unwrap();
@@ -139,7 +139,7 @@ fn sampled_albedo_matches_quadrature() {
 /// near total internal reflection 1 − F is steep in f32's cosines).
 #[test]
 fn radiance_is_the_adjoint_of_importance() {
-    let g = Dielectric { ior: 1.33, roughness: 0.45, tint: Rgb::new(0.8, 0.6, 1.0) };
+    let g = Dielectric { ior: 1.33, roughness: 0.45, tint: Rgb::new(0.8, 0.6, 1.0), absorption: Rgb::ZERO };
     let mut rng = Rng::for_item(0xD1E3, 0);
     let mut checked = 0;
     for _ in 0..2000 {
@@ -186,7 +186,7 @@ fn rough_glass_tends_to_smooth_glass() {
 /// stay white.
 fn tint_colours_transmission_only() {
     let tint = Rgb::new(1.0, 0.25, 0.0625);
-    let g = Dielectric { ior: 1.5, roughness: 0.4, tint };
+    let g = Dielectric { ior: 1.5, roughness: 0.4, tint, absorption: Rgb::ZERO };
     let wo = view(30.0, true);
     let mut rng = Rng::for_item(0xD1E5, 0);
     let (mut seen_r, mut seen_t) = (false, false);
@@ -213,7 +213,7 @@ fn tint_colours_transmission_only() {
 
 #[test]
 fn smooth_branches_are_the_samples_weighted_by_their_probability() {
-    let g = Dielectric { ior: 1.4, roughness: 0.0, tint: Rgb::new(0.7, 0.8, 0.9) };
+    let g = Dielectric { ior: 1.4, roughness: 0.0, tint: Rgb::new(0.7, 0.8, 0.9), absorption: Rgb::ZERO };
     for (deg, outside) in [(0.0, true), (35.0, true), (80.0, true), (25.0, false), (60.0, false)] {
         let wo = view(deg, outside);
         let ((r_dir, r_weight), refracted) = g.smooth_branches(-wo, Vec3::Z, Transport::Radiance);
@@ -228,4 +228,17 @@ fn smooth_branches_are_the_samples_weighted_by_their_probability() {
             None => assert!(!t.transmitted && r.pdf == 1.0, "{deg}° {outside}"),
         }
     }
+}
+
+/// Beer–Lambert inside: a ray arriving from inside (along the outward
+/// normal) keeps e^(−σ·t); one arriving from outside, or clear glass,
+/// keeps everything.
+#[test]
+fn the_inside_absorbs_only_along_paths_inside() {
+    let g = Dielectric { absorption: Rgb::new(0.5, 1.0, 0.0), ..glass(0.0) };
+    let up = Vec3::Z;
+    let kept = g.interior_transmittance(Vec3::new(0.0, 0.6, 0.8), up, 2.0);
+    assert!((kept - Rgb::new((-1.0f32).exp(), (-2.0f32).exp(), 1.0)).abs().max_element() < 1e-6, "{kept}");
+    assert_eq!(g.interior_transmittance(-up, up, 2.0), Rgb::ONE);
+    assert_eq!(glass(0.0).interior_transmittance(up, up, 2.0), Rgb::ONE);
 }

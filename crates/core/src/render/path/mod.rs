@@ -162,6 +162,8 @@ fn advance(
     let next_dir = match material {
         Material::Emitter => return false,
         Material::Glass(glass) => {
+            // Arriving from inside: what the glass absorbed on the way.
+            path.beta *= glass.interior_transmittance(path.ray.dir, hit.geometric_normal, hit.t);
             if !glass.is_smooth() {
                 // The boundary's own frame: +z its outward (geometric) normal.
                 let frame = ShadingFrame::new(hit.geometric_normal);

@@ -36,10 +36,16 @@ pub struct Step {
 pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
     // Surfaces shade with their normal textures' normals.
     let hit = scene.accel.intersect(ray).map(|hit| scene.bent(hit, ray.dir));
+    // Arriving at glass from inside: what it absorbed on the way (a
+    // deterministic factor: no density changes).
+    let absorbed = hit.as_ref().map_or(Rgb::ONE, |h| match scene.material(h) {
+        crate::material::Material::Glass(glass) => glass.interior_transmittance(ray.dir, h.geometric_normal, h.t),
+        _ => Rgb::ONE,
+    });
     let media = &scene.media;
     if media.is_empty() {
         return match hit {
-            Some(hit) => Step { distance: hit.t, event: Event::Surface(hit), weight: Rgb::ONE, passes: 1.0 },
+            Some(hit) => Step { distance: hit.t, event: Event::Surface(hit), weight: absorbed, passes: 1.0 },
             None => Step { event: Event::Escaped, distance: f32::INFINITY, weight: Rgb::ONE, passes: 1.0 },
         };
     }
@@ -60,7 +66,7 @@ pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
         Flight::Passed { weight, tau_bar } => Step {
             event: hit.map_or(Event::Escaped, Event::Surface),
             distance: t_max,
-            weight,
+            weight: weight * absorbed,
             passes: (-tau_bar).exp(),
         },
     }

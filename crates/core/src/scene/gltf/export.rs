@@ -26,6 +26,9 @@ pub struct PbrMaterial {
     pub emission: Rgb,
     /// Smooth glass with this index of refraction (`KHR_materials_transmission`).
     pub glass_ior: Option<f32>,
+    /// The glass's inside absorption per unit length (`KHR_materials_volume`,
+    /// written as the colour e^−σ at distance 1; zero: none written).
+    pub glass_absorption: Rgb,
     /// `KHR_materials_specular`'s factor: 1 is glTF's default dielectric
     /// (F0 = 0.04), 0 a pure Lambertian.
     pub specular: f32,
@@ -62,6 +65,7 @@ impl Default for PbrMaterial {
             roughness: 1.0,
             emission: Rgb::ZERO,
             glass_ior: None,
+            glass_absorption: Rgb::ZERO,
             specular: 1.0,
             specular_color: Rgb::ONE,
             ior: 1.5,
@@ -239,6 +243,17 @@ impl GltfBuilder {
                 ior: json::extensions::material::IndexOfRefraction(ior),
                 extras: Default::default(),
             });
+            if m.glass_absorption != Rgb::ZERO {
+                extensions.volume = Some(json::extensions::material::Volume {
+                    thickness_factor: json::extensions::material::ThicknessFactor(1.0),
+                    thickness_texture: None,
+                    attenuation_distance: json::extensions::material::AttenuationDistance(1.0),
+                    attenuation_color: json::extensions::material::AttenuationColor(
+                        (-m.glass_absorption).exp().to_array(),
+                    ),
+                    extras: Default::default(),
+                });
+            }
         }
         let [r, g, b] = m.base_color.to_array();
         self.root.push(json::Material {
@@ -496,6 +511,7 @@ impl GltfBuilder {
                 (ext.is_some_and(|e| e.ior.is_some()), "KHR_materials_ior"),
                 (ext.is_some_and(|e| e.emissive_strength.is_some()), "KHR_materials_emissive_strength"),
                 (ext.is_some_and(|e| e.specular.is_some()), "KHR_materials_specular"),
+                (ext.is_some_and(|e| e.volume.is_some()), "KHR_materials_volume"),
                 (ext.is_some_and(|e| e.others.contains_key(CLEARCOAT)), CLEARCOAT),
                 (ext.is_some_and(|e| e.others.contains_key(SHEEN)), SHEEN),
             ] {
@@ -586,6 +602,7 @@ pub fn scene_to_glb(scene: &Scene) -> Result<Vec<u8>, String> {
                 base_color: glass.tint,
                 roughness: glass.roughness,
                 glass_ior: Some(glass.ior),
+                glass_absorption: glass.absorption,
                 ..Default::default()
             },
             (other, _) => return Err(format!("material {other:?} has no glTF form")),

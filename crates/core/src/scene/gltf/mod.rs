@@ -44,6 +44,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_specular",
+    "KHR_materials_volume",
     materials::CLEARCOAT,
     materials::SHEEN,
     "KHR_texture_transform",

@@ -519,8 +519,104 @@ fn transmission_is_rough_tinted_glass() {
     let path = write(&dir, "t.glb", &b.to_glb(vec![node]));
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
     assert!(!scene.notes.iter().any(|n| n.contains("approximated")), "{:?}", scene.notes);
-    let want = crate::bsdf::dielectric::Dielectric { ior: 1.33, roughness: 0.4, tint };
+    let want = crate::bsdf::dielectric::Dielectric { ior: 1.33, roughness: 0.4, tint, absorption: Rgb::ZERO };
     assert_eq!(scene.materials[0], Material::Glass(want));
+}
+
+/// Light through a slab of thickness 1 whose inside keeps c per unit, at
+/// normal incidence, Fresnel F at each face and every inner reflection
+/// summed: T = (1 − F)² c / (1 − F²c²) through, R = F + (1 − F)² F c² /
+/// (1 − F²c²) back.
+fn slab_transmission_and_reflection(c: Vec3) -> (Vec3, Vec3) {
+    let f = 0.04; // ((1.5 − 1) / (1.5 + 1))²
+    let bounce = Vec3::ONE - f * f * c * c;
+    ((1.0 - f) * (1.0 - f) * c / bounce, f + (1.0 - f) * (1.0 - f) * f * c * c / bounce)
+}
+
+/// `KHR_materials_volume`: glass whose inside absorbs (Beer–Lambert). The
+/// file's attenuation colour and distance become σ = −ln(c)/d; under the
+/// white sky a ray straight down through the slab sees T + R of the hand
+/// computation in path, photon-cpu (whose smooth glass branches exactly)
+/// and vcm; from a sun straight down, the photons on the floor under the
+/// slab carry T of the power of those beside it (within 3%: the floor's
+/// light the slab's underside sends back down adds under 1%).
+#[test]
+fn an_absorbing_glass_slab_keeps_beer_lamberts_share() {
+    use crate::photon::{TraceSettings, trace_photons};
+    use crate::progress::Silent;
+    use crate::render::path::{PathSettings, radiance};
+    use crate::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+    use crate::test_scenes::gltf_textures::{absorbing_slab_glb, load};
+    let c = Vec3::new(0.5, 0.8, 1.0);
+    let scene = load("volume-slab", &absorbing_slab_glb(c, false));
+    assert!(!scene.notes.iter().any(|n| n.contains("KHR_materials_volume")), "{:?}", scene.notes);
+    let Material::Glass(glass) = scene.materials[0] else { panic!("{:?}", scene.materials[0]) };
+    assert!((glass.absorption - (-c.ln())).abs().max_element() < 1e-5, "{}", glass.absorption);
+    let (t, r) = slab_transmission_and_reflection(c);
+    let want = t + r;
+    let down = |x: f32, z: f32| crate::geometry::Ray::new(Vec3::new(x, 3.0, z), -Vec3::Y);
+    let mut rng = crate::sampling::Rng::for_item(5, 0);
+    let n = 20_000;
+    let settings = PathSettings { spp: 1, ..Default::default() };
+    let path =
+        (0..n).map(|i| radiance(&scene, down(0.3 * (i % 7) as f32 / 7.0, 0.1), &settings, &mut rng)).sum::<Vec3>()
+            / n as f32;
+    let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+    let photon =
+        PhotonCpuRenderer::new(&scene, &traced, &PhotonCpuSettings::default()).radiance(&down(0.2, 0.1), 0, &mut rng);
+    let mut above = scene.clone();
+    above.camera = crate::camera::Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 20.0, 16, 16).unwrap();
+    let vcm = (1..=8)
+        .map(|pass| {
+            let image = crate::render::vcm::render_pass(&above, &Default::default(), pass).unwrap().0;
+            image.pixels.iter().sum::<Vec3>() / image.pixels.len() as f32
+        })
+        .sum::<Vec3>()
+        / 8.0;
+    eprintln!("through an absorbing slab: hand {want}, path {path}, photon-cpu {photon}, vcm {vcm}");
+    for (name, l, tolerance) in [("path", path, 0.01), ("photon-cpu", photon, 2e-3), ("vcm", vcm, 0.02)] {
+        assert!(((l - want) / want).abs().max_element() < tolerance, "{name}: {l} against {want}");
+    }
+    // Photons from a sun through the slab onto a floor.
+    let scene = load("volume-slab-floor", &absorbing_slab_glb(c, true));
+    let traced = trace_photons(&scene, &TraceSettings { photons: 200_000, ..Default::default() }, &Silent);
+    let power_in = |inner: f32, outer: f32| {
+        // The global map holds every photon stored (the caustic map
+        // repeats the caustic ones).
+        let on_floor = traced.global.iter().filter(|p| p.position[1].abs() < 1e-3);
+        let r = |p: &&crate::photon::Photon| p.position[0].abs().max(p.position[2].abs());
+        let inside = on_floor.filter(|p| (inner..outer).contains(&r(p)));
+        inside.map(|p| p.power_in_units()).sum::<Vec3>() / (4.0 * (outer * outer - inner * inner))
+    };
+    let ratio = power_in(0.0, 0.75) / power_in(1.5, 3.0);
+    eprintln!("photon power under the slab over beside it: {ratio} (T = {t})");
+    assert!(((ratio - t) / t).abs().max_element() < 0.03, "{ratio} against {t}");
+}
+
+/// A file Blender wrote reads its attenuation as Blender's Volume
+/// Absorption node, which it was written from: σ = (1 − c) / d, as Cycles
+/// draws it (with a note); any other file as the extension says, −ln(c) / d.
+#[test]
+fn blenders_volume_absorption_reads_as_cycles_draws_it() {
+    let c = Vec3::new(0.9, 0.5, 0.2);
+    let absorption_of = |generator: &str, tag: &str| {
+        let mut b = GltfBuilder::new();
+        let glass = b.material(&PbrMaterial { glass_ior: Some(1.5), glass_absorption: -c.ln(), ..Default::default() });
+        let mesh = b.mesh(&TRIANGLE, None, None, Some(glass));
+        let node = b.node(json::Node { mesh: Some(mesh), ..Default::default() });
+        let (mut root, bin) = b.finish(vec![node]);
+        root.asset.generator = Some(generator.into());
+        let path = write(&folder(tag), "t.glb", &glb(&root, bin));
+        let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
+        let Material::Glass(glass) = scene.materials[0] else { panic!("{:?}", scene.materials[0]) };
+        (glass.absorption, scene.notes)
+    };
+    let (blender, notes) = absorption_of("Khronos glTF Blender I/O v5.3.43", "volume-blender");
+    assert!((blender - (Vec3::ONE - c)).abs().max_element() < 1e-5, "{blender}");
+    assert!(notes.iter().any(|n| n.contains("Blender's Volume Absorption")), "{notes:?}");
+    let (other, notes) = absorption_of("three.js", "volume-three");
+    assert!((other - (-c.ln())).abs().max_element() < 1e-5, "{other}");
+    assert!(!notes.iter().any(|n| n.contains("KHR_materials_volume")), "{notes:?}");
 }
 
 /// A glTF animation moves what it animates: a parent's rotation carries a
