@@ -231,7 +231,7 @@ impl AlphaMode {
 /// for the ray from `origin` along `dir` at primitive `prim`: a hash of the
 /// ray's bits, so each ray decides afresh (and any traversal of the same ray
 /// the same way), with no random stream to thread through the BVH.
-/// The WGSL twin is `blend_threshold` in cut_outs (hikari-gpu).
+/// The WGSL twin is `blend_threshold` in hikari-gpu's surface_point.wgsl.
 pub fn blend_threshold(origin: glam::Vec3, dir: glam::Vec3, prim: u32) -> f32 {
     let mut h = hash_u32(prim ^ 0x2545_f491);
     for bits in [origin.x, origin.y, origin.z, dir.x, dir.y, dir.z].map(f32::to_bits) {
