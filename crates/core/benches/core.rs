@@ -203,6 +203,32 @@ fn skinning(c: &mut Criterion) {
     group.bench_function("sheet_100k_triangles_2_joints", |b| {
         b.iter(|| black_box(mesh.triangles_at(black_box(0.5), &Affine3A::IDENTITY)).len())
     });
+    // What a new pose costs the CPU before photons are traced: the skinning
+    // above, the acceleration structure and its BVHs (`Accel::build_bvhs`:
+    // the binary BVH the GPU's flat BVH is laid out from, and the wide one).
+    group.bench_function("sheet_100k_triangles_skinned_and_bvh_built", |b| {
+        b.iter(|| {
+            let triangles = mesh.triangles_at(black_box(0.5), &Affine3A::IDENTITY);
+            let surfaces = vec![0; triangles.len()];
+            let accel = hikari_core::geometry::Accel::build(triangles, surfaces, Vec::new(), Vec::new());
+            accel.build_bvhs();
+            black_box(accel.bounds())
+        })
+    });
+    // The same through `Accel::build_moved`, as the viewers pose a frame:
+    // the rest pose's binary BVH refitted, the wide BVH laid out from it.
+    let at_rest = mesh.triangles_at(0.0, &Affine3A::IDENTITY);
+    let rest = hikari_core::geometry::Accel::build(at_rest.clone(), vec![0; at_rest.len()], Vec::new(), Vec::new());
+    rest.build_bvhs();
+    group.bench_function("sheet_100k_triangles_skinned_and_bvh_refitted", |b| {
+        b.iter(|| {
+            let triangles = mesh.triangles_at(black_box(0.5), &Affine3A::IDENTITY);
+            let surfaces = vec![0; triangles.len()];
+            let accel = hikari_core::geometry::Accel::build_moved(triangles, surfaces, Vec::new(), Vec::new(), &rest);
+            accel.build_bvhs();
+            black_box(accel.bounds())
+        })
+    });
     group.finish();
 }
 

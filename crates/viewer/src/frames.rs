@@ -48,6 +48,17 @@ pub struct Update {
     /// its photon count and why. The last set stays on screen; the front
     /// end asks for smaller ones.
     pub refused: Option<(u64, String)>,
+    /// Seconds the new set's upload took on this thread, and whether it
+    /// came in a new pose (`GpuRenderer::set_scene`: the posed scene and
+    /// the photons) or the one shown (`set_photons`: the photons alone).
+    pub upload: Option<(f64, Posed)>,
+}
+
+/// Whether a photon set's pose was on screen before ([`Update::upload`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Posed {
+    Before,
+    Anew,
 }
 
 /// What a viewer's frames keep between them.
@@ -158,11 +169,14 @@ impl Frames {
             // (docs/progressive.md).
             let pass = if same_scene { mean.count() + 1 } else { 1 };
             set_pass(renderer, controls, pass)?;
+            let start = web_time::Instant::now();
             let result = if same_scene {
                 renderer.set_photons(&set.scene, &set.traced)
             } else {
                 renderer.set_scene(&set.scene, &set.traced)
             };
+            let posed = if same_scene { Posed::Before } else { Posed::Anew };
+            update.upload = Some((start.elapsed().as_secs_f64(), posed));
             match result {
                 Ok(()) => {
                     if !same_scene {

@@ -21,5 +21,9 @@ pub struct PhotonSet {
     pub traced: TracedPhotons,
     /// Seconds spent posing and tracing, and the photon paths traced.
     pub seconds: f64,
+    /// Of `seconds`, those spent posing the scene (`Scene::posed`: moving
+    /// and deforming meshes, rebuilding the BVH); 0 where the pose was
+    /// traced before.
+    pub pose_seconds: f64,
     pub photons: u64,
 }

@@ -90,7 +90,8 @@ impl Tracing {
         let Some((mut tracer, traced_pose, traced_scene)) = self.tracer.take().filter(|_| self.gpu_failed.is_none())
         else {
             job.photons = job.photons.min(CPU_PHOTONS);
-            let scene = Arc::new(self.base.posed(&job.pose));
+            let scene = Arc::new(self.base.posed_for_frame(&job.pose));
+            let pose_seconds = started.elapsed().as_secs_f64();
             let settings = TraceSettings { photons: job.photons, seed: job.seed, ..Default::default() };
             let traced = trace_photons(&scene, &settings, &Silent);
             let set = PhotonSet {
@@ -99,6 +100,7 @@ impl Tracing {
                 scene,
                 traced,
                 seconds: started.elapsed().as_secs_f64(),
+                pose_seconds,
                 photons: job.photons,
             };
             *self.finished.borrow_mut() = Some((Ok(set), None));
@@ -109,7 +111,8 @@ impl Tracing {
         let (ctx, base, finished) = (self.ctx.clone(), self.base.clone(), self.finished.clone());
         wasm_bindgen_futures::spawn_local(async move {
             let moved = traced_pose != job.pose;
-            let scene = if moved { Arc::new(base.posed(&job.pose)) } else { traced_scene };
+            let scene = if moved { Arc::new(base.posed_for_frame(&job.pose)) } else { traced_scene };
+            let pose_seconds = if moved { started.elapsed().as_secs_f64() } else { 0.0 };
             let settings = TraceSettings { photons: job.photons, seed: job.seed, ..Default::default() };
             let outcome = async {
                 if moved {
@@ -127,6 +130,7 @@ impl Tracing {
                         scene: scene.clone(),
                         traced,
                         seconds,
+                        pose_seconds,
                         photons: job.photons,
                     };
                     (Ok(set), Some((tracer, job.pose, scene)))

@@ -50,6 +50,7 @@ use hikari_gpu::GpuContext;
 use hikari_gpu::present::PresentPass;
 use hikari_viewer::clock::AnimationClock;
 use hikari_viewer::frame_stats::FrameStats;
+use hikari_viewer::frames::Posed;
 use hikari_viewer::frames::{Frames, wants_photons};
 use hikari_viewer::orbit::Orbit;
 use hikari_viewer::panel::{Controls, Panel, Readouts};
@@ -171,6 +172,11 @@ struct Viewer {
     sets_used: u64,
     trace_seconds: f64,
     first_trace_seconds: f64,
+    /// Seconds each new pose took to make (`PhotonSet::pose_seconds`), and
+    /// each set to upload in a new pose and in the pose shown
+    /// (`Update::upload`).
+    pose_seconds: Vec<f64>,
+    upload_seconds: [Vec<f64>; 2],
     session: Option<Session>,
     error: Option<anyhow::Error>,
     stats: FrameStats,
@@ -225,6 +231,8 @@ impl Viewer {
             sets_used: 0,
             trace_seconds: 0.0,
             first_trace_seconds: 0.0,
+            pose_seconds: Vec::new(),
+            upload_seconds: [Vec::new(), Vec::new()],
             session: None,
             error: None,
             stats: FrameStats::default(),
@@ -310,6 +318,9 @@ impl Viewer {
     fn received(&mut self, set: &PhotonSet) {
         self.budget.traced(set.photons, set.seconds);
         self.trace_seconds += set.seconds;
+        if set.pose_seconds > 0.0 {
+            self.pose_seconds.push(set.pose_seconds);
+        }
         self.readouts.trace_ms = set.seconds * 1e3;
         self.readouts.photons_per_set = set.photons;
         self.readouts.stored = [set.traced.indirect().len(), set.traced.caustic.len(), set.traced.volume.len()];
@@ -454,6 +465,9 @@ impl Viewer {
         if update.drew_new_set {
             self.sets_used += 1;
         }
+        if let Some((seconds, posed)) = update.upload {
+            self.upload_seconds[(posed == Posed::Anew) as usize].push(seconds);
+        }
         // A set the adapter cannot hold: the last one stays and sets get smaller.
         if let Some((photons, why)) = update.refused {
             let cap = (photons * 3 / 4).max(1);
@@ -584,6 +598,28 @@ impl Viewer {
             latency("scene edit", &self.pose_latencies, "no scene edits"),
             latency("camera move", &self.camera_latencies, "no camera moves"),
         );
+        // What a moving scene costs per new pose, besides tracing.
+        let uploads = |posed: Posed, what: &str| {
+            let seconds = &self.upload_seconds[(posed == Posed::Anew) as usize];
+            mean(seconds).map(|m| format!("{what} {:.1} ms mean over {}", m * 1e3, seconds.len()))
+        };
+        let parts: Vec<String> = [
+            mean(&self.pose_seconds).map(|m| {
+                format!(
+                    "posing the scene (animations, deformed meshes, the BVH) {:.1} ms mean over {}",
+                    m * 1e3,
+                    self.pose_seconds.len()
+                )
+            }),
+            uploads(Posed::Anew, "uploading a set in a new pose"),
+            uploads(Posed::Before, "in the pose shown"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        if !parts.is_empty() {
+            println!("view: {}", parts.join(", "));
+        }
     }
 
     /// The camera moved: the next presented frame shows it.

@@ -47,10 +47,12 @@ impl PhotonSets {
                     }
                     let (id, Job { pose, photons, seed }) = job;
                     let start = Instant::now();
+                    let mut pose_seconds = 0.0;
                     let scene = match &posed {
                         Some((p, s)) if *p == pose => s.clone(),
                         _ => {
-                            let s = Arc::new(scene.posed(&pose));
+                            let s = Arc::new(scene.posed_for_frame(&pose));
+                            pose_seconds = start.elapsed().as_secs_f64();
                             posed = Some((pose.clone(), s.clone()));
                             tracer.set_scene(&s);
                             s
@@ -59,7 +61,7 @@ impl PhotonSets {
                     let settings = TraceSettings { photons, seed, ..Default::default() };
                     let traced = tracer.trace(&scene, &settings, &hikari_core::progress::Silent);
                     let seconds = start.elapsed().as_secs_f64();
-                    let set = PhotonSet { id, pose, scene, traced, seconds, photons };
+                    let set = PhotonSet { id, pose, scene, traced, seconds, pose_seconds, photons };
                     if sender.send(set).is_err() {
                         return; // the window closed, or the scene was reloaded
                     }

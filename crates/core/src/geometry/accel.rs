@@ -11,7 +11,7 @@ use super::wide::WideBvh;
 use super::{Ray, Sphere, Triangle};
 use crate::texture::Texturing;
 use glam::{UVec2, Vec2, Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, cwbvh::CwBvh};
+use obvhs::{Boundable, BvhBuildParams, aabb::Aabb, bvh2::Bvh2, cwbvh::CwBvh};
 use std::borrow::Borrow;
 use std::sync::{Arc, OnceLock};
 
@@ -50,6 +50,13 @@ pub(super) struct PackedPrim {
 }
 
 pub(super) const SPHERE_BIT: u32 = 1 << 31;
+
+/// How much more a refitted BVH may cost traversals (`relative_cost`) than
+/// the tree it was refitted from before a moved scene builds its own
+/// (`Accel::build_moved`): a refit costs a linear pass, a build of 100,000
+/// triangles ~25 ms on one core, and the tracing of one photon set or
+/// frame pays the difference in cost.
+const REFIT_COST_LIMIT: f32 = 1.5;
 /// The triangle is a cut-out or BLEND: a hit counts only where its alpha
 /// says the surface is there (`Texturing::opaque_at`; BLEND by the ray's
 /// `blend_threshold`). Only flagged primitives pay for the test, so scenes
@@ -98,13 +105,8 @@ impl PackedPrim {
 /// The bounds of every primitive, in the joint index space (triangles,
 /// then spheres): what both BVHs are built over.
 fn prim_bounds(triangles: &[Triangle], spheres: &[Sphere]) -> Vec<PrimBounds> {
-    let mut bounds: Vec<PrimBounds> = triangles
-        .iter()
-        .map(|t| {
-            let pts: Vec<Vec3A> = t.v.iter().map(|&v| v.into()).collect();
-            PrimBounds(Aabb::from_points(&pts))
-        })
-        .collect();
+    let mut bounds: Vec<PrimBounds> =
+        triangles.iter().map(|t| PrimBounds(Aabb::from_points(&t.v.map(Vec3A::from)))).collect();
     bounds.extend(spheres.iter().map(|s| {
         let r = Vec3A::splat(s.radius);
         let c: Vec3A = s.center.into();
@@ -135,6 +137,11 @@ pub struct Accel {
     bounds_max: Vec3,
     /// The textures of cut-outs, when the scene has any (`set_alpha_mask`).
     alpha: Option<Arc<Texturing>>,
+    /// The binary BVH over the primitives' bounds (joint index space),
+    /// built on first use ([`Accel::binary_bvh`]): the wide BVH and the
+    /// GPU's flat BVH are both laid out from it, so a scene posed anew
+    /// (every frame of an animation) pays for one build, not one each.
+    bvh2: OnceLock<Bvh2>,
     /// The wide BVH of single-ray and packet queries, built on the first
     /// one (None where it cannot run: `WideBvh::build`; the CWBVH answers
     /// then, ray by ray).
@@ -208,9 +215,38 @@ impl Accel {
             bounds_min: lo,
             bounds_max: hi,
             alpha: None,
+            bvh2: OnceLock::new(),
             wide: OnceLock::new(),
             cwbvh: OnceLock::new(),
         }
+    }
+
+    /// [`Accel::build`] for `rest`'s primitives moved (the same ones, in the
+    /// same order: a scene posed anew, its meshes deformed or moved), whose
+    /// binary BVH is `rest`'s refitted to where they are now
+    /// (`bvh_build::refit`, a linear pass) rather than built afresh, unless
+    /// the refitted tree would cost traversals more than
+    /// `REFIT_COST_LIMIT` times what `rest`'s does (then it is built anew
+    /// on first use, as `build` does). Builds `rest`'s BVH if it has none.
+    pub fn build_moved(
+        triangles: Vec<Triangle>,
+        triangle_surfaces: Vec<u32>,
+        spheres: Vec<Sphere>,
+        sphere_surfaces: Vec<u32>,
+        rest: &Accel,
+    ) -> Self {
+        let accel = Accel::build(triangles, triangle_surfaces, spheres, sphere_surfaces);
+        if accel.triangles.len() != rest.triangles.len() || accel.spheres.len() != rest.spheres.len() {
+            return accel;
+        }
+        if let Some(bvh) = rest.binary_bvh() {
+            let refitted = super::bvh_build::refit(bvh, &prim_bounds(&accel.triangles, &accel.spheres));
+            let limit = REFIT_COST_LIMIT * super::bvh_build::relative_cost(bvh);
+            if super::bvh_build::relative_cost(&refitted) <= limit {
+                let _ = accel.bvh2.set(refitted);
+            }
+        }
+        accel
     }
 
     /// Makes the triangles of `texturing`'s MASK cut-out surfaces
@@ -229,6 +265,8 @@ impl Accel {
             p.prim = if masked { p.prim | MASKED_BIT } else { p.prim & !MASKED_BIT };
         }
         self.alpha = texturing;
+        // The binary BVH stays: cut-outs change the primitives' flags, not
+        // their bounds.
         self.wide = OnceLock::new();
         self.cwbvh = OnceLock::new();
     }
@@ -378,7 +416,32 @@ impl Accel {
     /// The wide BVH, built on first use.
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     fn wide_bvh(&self) -> Option<&WideBvh> {
-        self.wide.get_or_init(|| WideBvh::build(&self.packed, &prim_bounds(&self.triangles, &self.spheres))).as_ref()
+        self.wide.get_or_init(|| WideBvh::build(&self.packed, self.binary_bvh()?)).as_ref()
+    }
+
+    /// Builds now what the first query would build: the binary BVH and,
+    /// where the CPU runs it, the wide one (else the CWBVH). For timing a
+    /// posed scene's cost, and for building off the thread that queries.
+    pub fn build_bvhs(&self) {
+        if self.wide_bvh().is_none() {
+            self.cwbvh();
+        }
+        self.binary_bvh();
+    }
+
+    /// The binary BVH of obvhs's PLOC builder (medium build, leaves of up
+    /// to `wide::LEAF_PRIMS`, one of its blocks) over the primitives, built on first use;
+    /// None for an empty scene. `Bvh2::primitive_indices` are in the joint
+    /// index space.
+    pub(crate) fn binary_bvh(&self) -> Option<&Bvh2> {
+        if self.packed.is_empty() {
+            return None;
+        }
+        Some(self.bvh2.get_or_init(|| {
+            let params =
+                BvhBuildParams { max_prims_per_leaf: super::wide::LEAF_PRIMS, ..BvhBuildParams::medium_build() };
+            super::bvh_build::build_bvh2(&prim_bounds(&self.triangles, &self.spheres), params)
+        }))
     }
 
     /// The CWBVH, built on first use (None for an empty scene).
@@ -706,6 +769,77 @@ mod tests {
             spheres.to_vec(),
             (0..spheres.len() as u32).map(|i| 1000 + i).collect(),
         )
+    }
+
+    /// `random_scene` bent: each primitive turned about the y axis by an
+    /// angle growing with its height `bend` (radians a unit), as a skinned
+    /// limb bends; the spheres moved the same way.
+    fn bent_scene(bend: f32, shift: Vec3) -> (Vec<Triangle>, Vec<Sphere>) {
+        let (tris, spheres) = random_scene();
+        let move_point = |p: Vec3| glam::Quat::from_rotation_y(bend * p.y) * p + shift;
+        let tris = tris.iter().map(|t| Triangle { v: t.v.map(move_point), normals: None }).collect();
+        let spheres = spheres.iter().map(|s| Sphere { center: move_point(s.center), ..*s }).collect();
+        (tris, spheres)
+    }
+
+    /// Closest hits and occlusion of random rays: the same in `a` and `b`.
+    fn same_answers(a: &Accel, b: &Accel) {
+        let mut rng = Rng::for_item(21, 0);
+        let mut hits = 0;
+        for _ in 0..3000 {
+            let ray = Ray::new((rng.next_2d().extend(rng.next_f32()) - 0.5) * 12.0, uniform_sphere(rng.next_2d()));
+            let (x, y) = (a.intersect(&ray), b.intersect(&ray));
+            assert_eq!(x.map(|h| (h.t.to_bits(), h.prim)), y.map(|h| (h.t.to_bits(), h.prim)), "{ray:?}");
+            assert_eq!(a.occluded(&ray), b.occluded(&ray), "{ray:?}");
+            hits += x.is_some() as usize;
+        }
+        assert!(hits > 300, "{hits} hits of 3000");
+    }
+
+    /// A scene bent a little is answered through its rest BVH refitted
+    /// (no build), exactly as through a tree built for it; bent or moved so
+    /// far that the refitted tree would cost more than REFIT_COST_LIMIT
+    /// times its rest tree, it builds its own.
+    #[test]
+    fn moved_primitives_refit_the_rest_bvh_unless_it_costs_too_much() {
+        let (tris, spheres) = random_scene();
+        let rest = random_accel(&tris, &spheres);
+        let surfaces = |n: usize, first: u32| (first..first + n as u32).collect::<Vec<u32>>();
+        let moved = |bend: f32, shift: Vec3| {
+            let (t, s) = bent_scene(bend, shift);
+            let (nt, ns) = (t.len(), s.len());
+            let fresh = random_accel(&t, &s);
+            (Accel::build_moved(t, surfaces(nt, 0), s, surfaces(ns, 1000), &rest), fresh)
+        };
+        let (a, fresh) = moved(0.05, Vec3::new(0.3, 0.0, 0.0));
+        assert!(a.bvh2.get().is_some(), "a small bend refits the rest BVH");
+        let refit_cost = super::super::bvh_build::relative_cost(a.bvh2.get().unwrap());
+        let rest_cost = super::super::bvh_build::relative_cost(rest.binary_bvh().unwrap());
+        assert!(
+            refit_cost >= rest_cost * 0.9 && refit_cost <= REFIT_COST_LIMIT * rest_cost,
+            "{refit_cost} {rest_cost}"
+        );
+        eprintln!("refitted after a small bend: {:.3}× the rest tree's cost", refit_cost / rest_cost);
+        same_answers(&a, &fresh);
+        // The flat BVH the GPU traverses is the refitted tree too.
+        let flat = super::super::FlatBvh::new(&a);
+        let mut rng = Rng::for_item(22, 0);
+        for _ in 0..500 {
+            let ray = Ray::new((rng.next_2d().extend(rng.next_f32()) - 0.5) * 12.0, uniform_sphere(rng.next_2d()));
+            let want = fresh.intersect(&ray).map(|h| h.prim);
+            assert_eq!(flat.intersect(&ray).map(|(_, k)| flat.source[k]), want, "{ray:?}");
+        }
+        // A quarter turn per unit of height scrambles the tree's boxes.
+        let (b, fresh) = moved(1.6, Vec3::ZERO);
+        assert!(b.bvh2.get().is_none(), "a refit costing {}× was kept", {
+            let t = super::super::bvh_build::refit(rest.binary_bvh().unwrap(), &prim_bounds(&b.triangles, &b.spheres));
+            super::super::bvh_build::relative_cost(&t) / rest_cost
+        });
+        same_answers(&b, &fresh);
+        // Other primitives: no refit.
+        let (t, s) = bent_scene(0.0, Vec3::ZERO);
+        let fewer = Accel::build_moved(t[1..].to_vec(), surfaces(t.len() - 1, 0), s, surfaces(40, 1000), &rest);
+        assert!(fewer.bvh2.get().is_none());
     }
 
     /// The BVH must find exactly what a brute-force loop over all primitives finds.

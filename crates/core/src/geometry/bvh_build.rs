@@ -57,6 +57,36 @@ fn ploc<T: Boundable>(primitives: &[T], params: &BvhBuildParams) -> Bvh2 {
     )
 }
 
+/// `bvh`, a binary BVH over primitives in the same order as `primitives`,
+/// refitted to where they are now: each leaf takes the union of its
+/// primitives' boxes, each inner node its children's. The tree keeps its
+/// shape, so traversals cost more the further the primitives moved from
+/// where it was built ([`relative_cost`] measures it).
+pub(crate) fn refit<T: Boundable>(bvh: &Bvh2, primitives: &[T]) -> Bvh2 {
+    let mut refitted = bvh.clone();
+    let indices = &refitted.primitive_indices;
+    for node in refitted.nodes.iter_mut().filter(|n| n.is_leaf()) {
+        let first = node.first_index as usize;
+        let leaf = &indices[first..first + node.prim_count as usize];
+        node.set_aabb(leaf.iter().fold(Aabb::empty(), |b, &i| b.union(&primitives[i as usize].aabb())));
+    }
+    refitted.refit_all();
+    refitted
+}
+
+/// A binary BVH's surface-area cost over its root's area: the expected
+/// number of nodes and primitives a ray through the root meets (SAH, unit
+/// costs), which grows as a refitted tree's boxes spread and overlap.
+pub(crate) fn relative_cost(bvh: &Bvh2) -> f32 {
+    let Some(root) = bvh.nodes.first() else { return 0.0 };
+    let cost: f32 = bvh
+        .nodes
+        .iter()
+        .map(|n| n.aabb().half_area().max(0.0) * if n.is_leaf() { n.prim_count as f32 } else { 1.0 })
+        .sum();
+    cost / root.aabb().half_area().max(f32::MIN_POSITIVE)
+}
+
 /// Number of levels of a binary BVH (a lone leaf: 1), without recursion.
 pub(crate) fn depth(bvh: &Bvh2) -> usize {
     let mut deepest = 0;

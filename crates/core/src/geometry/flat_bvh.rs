@@ -1,11 +1,10 @@
-//! A flat binary BVH for GPU traversal: obvhs's Bvh2 over the same
-//! primitives as `Accel`, nodes and primitives in plain `#[repr(C)]` arrays.
+//! A flat binary BVH for GPU traversal: `Accel`'s own binary BVH (obvhs's
+//! Bvh2, `Accel::binary_bvh`) over its primitives, nodes and primitives in plain `#[repr(C)]` arrays.
 //! `FlatBvh::intersect` is the CPU mirror of the WGSL traversal.
 
 use super::{Accel, Ray};
 use bytemuck::Zeroable;
-use glam::{Vec3, Vec3A};
-use obvhs::{Boundable, BvhBuildParams, aabb::Aabb};
+use glam::Vec3;
 
 /// A node: inner when `prim_count` is 0 (children at `first` and `first + 1`),
 /// else a leaf holding primitives `first .. first + prim_count`.
@@ -59,13 +58,6 @@ pub struct FlatBvh {
     pub epsilon: f32,
 }
 
-struct Bounds(Aabb);
-impl Boundable for Bounds {
-    fn aabb(&self) -> Aabb {
-        self.0
-    }
-}
-
 impl FlatBvh {
     pub fn new(accel: &Accel) -> Self {
         let mut prims: Vec<FlatPrim> = accel
@@ -104,19 +96,9 @@ impl FlatBvh {
         if prims.is_empty() {
             return FlatBvh { nodes: Vec::new(), prims, shading, source: Vec::new(), epsilon: accel.epsilon };
         }
-        let bounds: Vec<Bounds> = prims
-            .iter()
-            .map(|p| {
-                if p.is_sphere != 0 {
-                    let c = Vec3A::from(p.a);
-                    Bounds(Aabb::new(c - p.b[0], c + p.b[0]))
-                } else {
-                    let v0 = Vec3A::from(p.a);
-                    Bounds(Aabb::from_points(&[v0, v0 + Vec3A::from(p.b), v0 + Vec3A::from(p.c)]))
-                }
-            })
-            .collect();
-        let bvh = super::bvh_build::build_bvh2(&bounds, BvhBuildParams::medium_build());
+        // The scene's own binary BVH (built once for the CPU's wide BVH
+        // and this): the same tree, not a second build.
+        let bvh = accel.binary_bvh().expect("a scene with primitives has a binary BVH");
         let nodes = bvh
             .nodes
             .iter()

@@ -17,8 +17,7 @@
 // a wide BVH.
 #![cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
 
-use super::accel::{MASKED_BIT, PackedPrim, PrimBounds, SPHERE_BIT};
-use obvhs::BvhBuildParams;
+use super::accel::{MASKED_BIT, PackedPrim, SPHERE_BIT};
 use obvhs::bvh2::Bvh2;
 
 /// Children per node, triangles per block.
@@ -31,9 +30,9 @@ pub(super) const LEAF: u32 = 1 << 31;
 /// more is not built.
 pub(super) const STACK: usize = 256;
 
-/// Primitives per leaf of the binary BVH the wide one is made from: one
-/// block.
-const LEAF_PRIMS: u32 = 8;
+/// Primitives per leaf of the binary BVH the wide one is made from
+/// (`Accel::binary_bvh`): one block.
+pub(super) const LEAF_PRIMS: u32 = 8;
 
 /// An inner node: its children's boxes, component by component.
 #[repr(C, align(32))]
@@ -74,15 +73,14 @@ pub(super) struct WideBvh {
 }
 
 impl WideBvh {
-    /// A wide BVH over `prims` (in the joint index space, with their
-    /// bounds), or None where it cannot run: no AVX2, no primitives, or a
-    /// tree deeper than the traversal stack holds.
-    pub fn build(prims: &[PackedPrim], bounds: &[PrimBounds]) -> Option<WideBvh> {
+    /// A wide BVH over `prims` (in the joint index space) laid out from
+    /// `bvh`, their binary BVH (leaves of up to `LEAF_PRIMS`), or None where
+    /// it cannot run: no AVX2, no primitives, or a tree deeper than the
+    /// traversal stack holds.
+    pub fn build(prims: &[PackedPrim], bvh: &Bvh2) -> Option<WideBvh> {
         if !super::packet::avx2_available() || prims.is_empty() {
             return None;
         }
-        let params = BvhBuildParams { max_prims_per_leaf: LEAF_PRIMS, ..BvhBuildParams::medium_build() };
-        let bvh = super::bvh_build::build_bvh2(bounds, params);
         let mut wide = WideBvh { nodes: vec![], blocks: vec![], prims: vec![] };
         let mut deepest = 0;
         // (wide node to fill, binary node whose subtree it holds, depth)
@@ -90,7 +88,7 @@ impl WideBvh {
         wide.nodes.push(empty_node());
         while let Some((at, from, depth)) = todo.pop() {
             deepest = deepest.max(depth);
-            let members = open_up(&bvh, from);
+            let members = open_up(bvh, from);
             let mut node = empty_node();
             for (slot, &m) in members.iter().enumerate() {
                 let b = &bvh.nodes[m];
