@@ -446,6 +446,56 @@ pub mod gltf_textures {
         crate::scene::gltf::export::glb(&root, bin)
     }
 
+    /// The factors of `layered_glb`'s material, each of which a texture
+    /// multiplies: clear coat, its roughness, the sheen's colour and
+    /// roughness, the specular factor and colour.
+    pub const LAYER_FACTORS: (f32, f32, [f32; 3], f32, f32, [f32; 3]) =
+        (0.8, 0.5, [1.0, 0.5, 0.25], 0.6, 0.9, [1.0, 0.8, 0.6]);
+
+    /// `layered_glb`'s checker alpha (its RGB is `GREYS`).
+    pub const LAYER_ALPHA: [u8; 4] = [64, 128, 0, 255];
+
+    /// One glossy quad as `transformed_checker_glb`'s (x, y in [0, 1], z =
+    /// 0, texture coordinates (x, 1 − y)) with a clear coat, a sheen and
+    /// `KHR_materials_specular` (`LAYER_FACTORS`), every one of their six
+    /// textures the grey checker with alpha `LAYER_ALPHA` (REPEAT).
+    pub fn layered_glb() -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let image = b.image(&grey_checker(LAYER_ALPHA), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let m = b.material(&PbrMaterial { roughness: 0.4, ..Default::default() });
+        let root = quad(&mut b, Vec3::Y, Vec3::X, -Vec3::Y, 1.0, m);
+        let (root, bin) = b.finish(vec![root]);
+        let (coat, coat_roughness, sheen, sheen_roughness, specular, specular_color) = LAYER_FACTORS;
+        let [sr, sg, sb] = sheen;
+        let [cr, cg, cb] = specular_color;
+        let info = format!(r#"{{"index": {}}}"#, t.value());
+        let extensions = format!(
+            r#"{{
+                "KHR_materials_clearcoat": {{
+                    "clearcoatFactor": {coat}, "clearcoatTexture": {info},
+                    "clearcoatRoughnessFactor": {coat_roughness}, "clearcoatRoughnessTexture": {info}
+                }},
+                "KHR_materials_sheen": {{
+                    "sheenColorFactor": [{sr}, {sg}, {sb}], "sheenColorTexture": {info},
+                    "sheenRoughnessFactor": {sheen_roughness}, "sheenRoughnessTexture": {info}
+                }},
+                "KHR_materials_specular": {{
+                    "specularFactor": {specular}, "specularTexture": {info},
+                    "specularColorFactor": [{cr}, {cg}, {cb}], "specularColorTexture": {info}
+                }}
+            }}"#
+        );
+        let mut value = json::serialize::to_value(&root).unwrap();
+        value["materials"][0]["extensions"] = json::deserialize::from_str(&extensions).unwrap();
+        value["extensionsUsed"] = json::deserialize::from_str(
+            r#"["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular"]"#,
+        )
+        .unwrap();
+        let root: json::Root = json::deserialize::from_value(value).unwrap();
+        crate::scene::gltf::export::glb(&root, bin)
+    }
+
     /// `checker_glb` as a `.gltf` with its buffer and image in files of
     /// their own, as exporters write them: (name, bytes) of
     /// `checker.gltf`, `checker.bin` and `checker texture.png` (its URI

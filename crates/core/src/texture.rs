@@ -270,6 +270,8 @@ pub struct MaterialTextures {
     /// their x and y.
     pub normal: Option<TextureRef>,
     pub normal_scale: f32,
+    /// The clear-coat, sheen and specular extensions' textures.
+    pub layers: LayerTextures,
 }
 
 impl MaterialTextures {
@@ -278,6 +280,69 @@ impl MaterialTextures {
             || self.metallic_roughness.is_some()
             || self.emissive.is_some()
             || self.normal.is_some()
+            || self.layers.any()
+    }
+}
+
+/// The textures of the layers over glTF's base BRDF, each multiplying its
+/// factor as its extension says: `KHR_materials_clearcoat` (R × the coat,
+/// G × its roughness), `KHR_materials_sheen` (sRGB RGB × the sheen's
+/// colour, A × its roughness), `KHR_materials_specular` (A × the specular
+/// factor, sRGB RGB × the specular colour).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LayerTextures {
+    pub clearcoat: Option<TextureRef>,
+    pub clearcoat_roughness: Option<TextureRef>,
+    pub sheen_color: Option<TextureRef>,
+    pub sheen_roughness: Option<TextureRef>,
+    pub specular: Option<TextureRef>,
+    pub specular_color: Option<TextureRef>,
+}
+
+impl LayerTextures {
+    pub fn any(&self) -> bool {
+        self.all().iter().any(Option::is_some)
+    }
+
+    /// Every texture, in the order of the fields.
+    pub fn all(&self) -> [Option<TextureRef>; 6] {
+        [
+            self.clearcoat,
+            self.clearcoat_roughness,
+            self.sheen_color,
+            self.sheen_roughness,
+            self.specular,
+            self.specular_color,
+        ]
+    }
+
+    /// `bsdf` with the layers' texels applied: `texel(t)` is texture `t`'s
+    /// linear RGBA at the point (None where the point has no coordinates:
+    /// the factors alone).
+    fn apply(
+        &self,
+        mut bsdf: crate::bsdf::Bsdf,
+        texel: impl Fn(Option<TextureRef>) -> Option<Vec4>,
+    ) -> crate::bsdf::Bsdf {
+        if let Some(c) = texel(self.clearcoat) {
+            bsdf.clearcoat = (bsdf.clearcoat * c.x).clamp(0.0, 1.0);
+        }
+        if let Some(c) = texel(self.clearcoat_roughness) {
+            bsdf.clearcoat_roughness = (bsdf.clearcoat_roughness * c.y).clamp(0.0, 1.0);
+        }
+        if let Some(c) = texel(self.sheen_color) {
+            bsdf.sheen_color *= c.xyz();
+        }
+        if let Some(c) = texel(self.sheen_roughness) {
+            bsdf.sheen_roughness = (bsdf.sheen_roughness * c.w).clamp(0.0, 1.0);
+        }
+        if let Some(c) = texel(self.specular) {
+            bsdf.specular = (bsdf.specular * c.w).clamp(0.0, 1.0);
+        }
+        match texel(self.specular_color) {
+            Some(c) => bsdf.with_specular_color(bsdf.specular_color * c.xyz()),
+            None => bsdf,
+        }
     }
 }
 
@@ -442,7 +507,7 @@ impl Texturing {
                     bsdf.metallic = (bsdf.metallic * mr.z).clamp(0.0, 1.0);
                     bsdf.roughness = (bsdf.roughness * mr.y).clamp(0.0, 1.0);
                 }
-                Material::Pbr(bsdf)
+                Material::Pbr(t.layers.apply(bsdf, |texture| self.lookup(texture, uv)))
             }
             // An exactly Lambertian glTF material (metallic 0, no specular
             // lobe: `Material::from_bsdf`); a metallic texture cannot change
@@ -457,6 +522,18 @@ impl Texturing {
                 Material::Glass(glass)
             }
             other => other,
+        }
+    }
+
+    /// `material` (of index `index`) with its layer textures' means
+    /// (`LayerTextures`; over the whole image) as factors: what the GPU
+    /// renderer draws, which reads those textures nowhere per point yet.
+    pub fn with_layer_means(&self, material: Material, index: u32) -> Material {
+        match (material, self.textures(index)) {
+            (Material::Pbr(bsdf), Some(t)) if t.layers.any() => {
+                Material::Pbr(t.layers.apply(bsdf, |texture| texture.map(|t| self.images[t.image as usize].mean())))
+            }
+            (other, _) => other,
         }
     }
 

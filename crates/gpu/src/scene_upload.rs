@@ -237,7 +237,12 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
         .surfaces
         .iter()
         .map(|s| {
-            let material = &scene.materials[s.material as usize];
+            // Clear-coat, sheen and specular textures as their means (the
+            // GPU reads them nowhere per point yet; the scene's notes say so).
+            let material = &match &scene.texturing {
+                Some(t) => t.with_layer_means(scene.materials[s.material as usize], s.material),
+                None => scene.materials[s.material as usize],
+            };
             let (kind, albedo, ior) = match material {
                 Material::Diffuse { albedo, .. } => (kind::DIFFUSE, *albedo, 1.0),
                 Material::Mirror { reflectance } => (kind::MIRROR, *reflectance, 1.0),
@@ -351,6 +356,28 @@ impl SceneBuffers {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The record of a surface with clear-coat, sheen and specular
+    /// textures holds each factor times its texture's mean
+    /// (`Texturing::with_layer_means`, which hikari-core's tests pin).
+    #[test]
+    fn layer_textures_upload_as_their_means() {
+        use hikari_core::test_scenes::gltf_textures::{LAYER_FACTORS, layered_glb, load};
+        let scene = load("gpu-layers", &layered_glb());
+        let surfaces = scene_surfaces(&scene);
+        let glossy = surfaces.iter().find(|s| s.glossy == 1).expect("the layered quad");
+        let texturing = scene.texturing.as_ref().unwrap();
+        let index = scene.surfaces.iter().position(|s| texturing.materials[s.material as usize].is_some()).unwrap();
+        let material = scene.surfaces[index].material;
+        let Material::Pbr(mean) = texturing.with_layer_means(scene.materials[material as usize], material) else {
+            panic!()
+        };
+        assert_eq!(glossy.clearcoat, mean.clearcoat);
+        assert!(glossy.clearcoat < LAYER_FACTORS.0 * 0.99, "the texture's mean (below 1) applied");
+        assert_eq!(glossy.sheen_color, mean.sheen_color.to_array());
+        assert_eq!(glossy.specular_factor, mean.specular);
+        assert_eq!(glossy.specular_color, mean.specular_color.to_array());
+    }
 
     #[test]
     fn tessellated_sphere_winds_outward() {

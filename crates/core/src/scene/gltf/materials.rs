@@ -5,9 +5,10 @@
 //! `KHR_materials_ior` (which also sets an opaque dielectric's
 //! reflectance); `KHR_materials_specular`'s factor scales the
 //! dielectric's Fresnel and its colour F0's; `KHR_materials_clearcoat`
-//! and `KHR_materials_sheen` add their layers (factors; their textures are
-//! noted as not read); `KHR_materials_volume` gives glass an absorbing
-//! inside. Base-colour,
+//! and `KHR_materials_sheen` add their layers; the three extensions'
+//! textures multiply their factors (`texture::LayerTextures`; the coat's
+//! normal texture is noted as not read); `KHR_materials_volume` gives glass
+//! an absorbing inside. Base-colour,
 //! metallic–roughness, emissive and normal textures are read
 //! (`crate::texture`; normal maps bend the CPU renderers' shading normals);
 //! occlusion textures are not. `alphaMode` MASK makes cut-outs,
@@ -18,7 +19,7 @@ use super::textures::Images;
 use crate::bsdf::Bsdf;
 use crate::bsdf::dielectric::Dielectric;
 use crate::material::{Material, Rgb};
-use crate::texture::{AlphaMode, ColorSpace, MaterialTextures};
+use crate::texture::{AlphaMode, ColorSpace, LayerTextures, MaterialTextures};
 use glam::{Vec3, Vec4Swizzles};
 
 /// Light a surface emits: `emissiveFactor` × `KHR_materials_emissive_strength`,
@@ -47,12 +48,12 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut unread_maps = 0;
     let mut other_sets = 0;
     let mut approximated = 0;
-    let mut specular_textures = 0;
+    let mut layer_textures = 0;
+    let mut missing_layer_textures = 0;
     let mut transmission_textures = 0;
-    let mut coat_textures = 0;
+    let mut coat_normals = 0;
     let mut malformed_coats = 0;
     let mut coated_glass = 0;
-    let mut sheen_textures = 0;
     let mut malformed_sheens = 0;
     let mut sheened_glass = 0;
     let mut opaque_volumes = 0;
@@ -89,11 +90,14 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
             transmission_textures += m.transmission().is_some_and(|t| t.transmission_texture().is_some()) as usize;
             let coat = Clearcoat::of(&m);
-            coat_textures += coat.textured as usize;
+            coat_normals += coat.normal_textured as usize;
             malformed_coats += coat.malformed as usize;
             let sheen = Sheen::of(&m);
-            sheen_textures += sheen.textured as usize;
             malformed_sheens += sheen.malformed as usize;
+            let (layers, unread_layers, missing) = layer_textures_of(doc, &m, images);
+            layer_textures += layers.any() as usize;
+            other_sets += unread_layers as usize;
+            missing_layer_textures += missing as usize;
             let material = if transmission >= 0.5 {
                 coated_glass += (coat.factor > 0.0) as usize;
                 sheened_glass += (sheen.color.max_element() > 0.0) as usize;
@@ -123,10 +127,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 let specular = m.specular().map_or(1.0, |s| s.specular_factor());
                 // Its colour scales F0 per channel.
                 let specular_color = m.specular().map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor()));
-                specular_textures += m
-                    .specular()
-                    .is_some_and(|s| s.specular_texture().is_some() || s.specular_color_texture().is_some())
-                    as usize;
                 // KHR_materials_ior sets the dielectric's reflectance.
                 Material::from_bsdf(
                     Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
@@ -152,6 +152,7 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 alpha_mode,
                 normal: normal.map(|(t, _)| t),
                 normal_scale: normal.map_or(1.0, |(_, scale)| if scale.is_finite() { scale } else { 1.0 }),
+                layers,
             };
             textures.push((t.is_textured() || alpha_mode != AlphaMode::Opaque).then_some(t));
             (material, emission)
@@ -176,10 +177,10 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             "{approximated} material(s) approximated: transmission from 0.5 as glass (factor 1), below 0.5 as none"
         ));
     }
-    if specular_textures > 0 {
+    if layer_textures > 0 {
         notes.push(format!(
-            "{specular_textures} material(s) have KHR_materials_specular textures, which are not read yet: their \
-             specularFactor and specularColorFactor apply uniformly"
+            "{layer_textures} material(s) have clear-coat, sheen or specular textures: the CPU renderers read them at \
+             each point; the GPU renderer draws each with its mean over the image"
         ));
     }
     if transmission_textures > 0 {
@@ -188,10 +189,16 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
              transmissionFactor applies uniformly"
         ));
     }
-    if coat_textures > 0 {
+    if missing_layer_textures > 0 {
         notes.push(format!(
-            "{coat_textures} material(s) have clear-coat textures, which are not read yet: their clearcoatFactor and \
-             clearcoatRoughnessFactor apply uniformly"
+            "{missing_layer_textures} material(s) have a clear-coat or sheen texture whose index names no texture of \
+             the file: ignored (the factor applies alone)"
+        ));
+    }
+    if coat_normals > 0 {
+        notes.push(format!(
+            "{coat_normals} material(s) have a clearcoatNormalTexture, which is not read: the coat takes the base's \
+             shading normal"
         ));
     }
     if malformed_coats > 0 {
@@ -201,12 +208,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     }
     if coated_glass > 0 {
         notes.push(format!("{coated_glass} transmissive material(s) have a clear coat, which is ignored on glass"));
-    }
-    if sheen_textures > 0 {
-        notes.push(format!(
-            "{sheen_textures} material(s) have sheen textures, which are not read yet: their sheenColorFactor and \
-             sheenRoughnessFactor apply uniformly"
-        ));
     }
     if malformed_sheens > 0 {
         notes.push(format!(
@@ -293,8 +294,8 @@ pub const CLEARCOAT: &str = "KHR_materials_clearcoat";
 struct Clearcoat {
     factor: f32,
     roughness: f32,
-    /// It names a texture (coat, coat roughness or coat normal).
-    textured: bool,
+    /// It names a coat normal texture (which hikari does not read).
+    normal_textured: bool,
     /// A factor is not a number (read as the default, 0).
     malformed: bool,
 }
@@ -302,20 +303,17 @@ struct Clearcoat {
 impl Clearcoat {
     fn of(m: &gltf::Material) -> Clearcoat {
         let Some(v) = m.extension_value(CLEARCOAT) else {
-            return Clearcoat { factor: 0.0, roughness: 0.0, textured: false, malformed: false };
+            return Clearcoat { factor: 0.0, roughness: 0.0, normal_textured: false, malformed: false };
         };
         let malformed = ["clearcoatFactor", "clearcoatRoughnessFactor"]
             .iter()
             .any(|key| v.get(*key).is_some_and(|x| !x.is_number()));
         // The specification's defaults are 0.
         let number = |key: &str| sane(Vec3::splat(v.get(key).and_then(|x| x.as_f64()).unwrap_or(0.0) as f32), 1.0).x;
-        let textured = ["clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"]
-            .iter()
-            .any(|key| v.get(*key).is_some());
         Clearcoat {
             factor: number("clearcoatFactor"),
             roughness: number("clearcoatRoughnessFactor"),
-            textured,
+            normal_textured: v.get("clearcoatNormalTexture").is_some(),
             malformed,
         }
     }
@@ -328,8 +326,6 @@ pub const SHEEN: &str = "KHR_materials_sheen";
 struct Sheen {
     color: Rgb,
     roughness: f32,
-    /// It names a texture (sheen colour or sheen roughness).
-    textured: bool,
     /// A factor is not a number, or the colour not three of them (read as
     /// the default, 0).
     malformed: bool,
@@ -338,7 +334,7 @@ struct Sheen {
 impl Sheen {
     fn of(m: &gltf::Material) -> Sheen {
         let Some(v) = m.extension_value(SHEEN) else {
-            return Sheen { color: Rgb::ZERO, roughness: 0.0, textured: false, malformed: false };
+            return Sheen { color: Rgb::ZERO, roughness: 0.0, malformed: false };
         };
         let color = v.get("sheenColorFactor").map(|c| {
             c.as_array()
@@ -347,15 +343,55 @@ impl Sheen {
         });
         let roughness = v.get("sheenRoughnessFactor");
         let malformed = color.is_some_and(|c| c.is_none()) || roughness.is_some_and(|x| !x.is_number());
-        let textured = ["sheenColorTexture", "sheenRoughnessTexture"].iter().any(|key| v.get(*key).is_some());
         // The specification's defaults are 0.
         Sheen {
             color: sane(color.flatten().unwrap_or(Vec3::ZERO), 1.0),
             roughness: sane(Vec3::splat(roughness.and_then(|x| x.as_f64()).unwrap_or(0.0) as f32), 1.0).x,
-            textured,
             malformed,
         }
     }
+}
+
+/// A material's clear-coat, sheen and specular textures
+/// (`LayerTextures`), whether it names one that is not read (through a
+/// texture coordinate set other than 0), and whether its clear coat or
+/// sheen names a texture the file does not have (the `gltf` crate checks
+/// the specular's).
+fn layer_textures_of(doc: &gltf::Document, m: &gltf::Material, images: &Images) -> (LayerTextures, bool, bool) {
+    use super::textures::{LAYER_JSON_TEXTURES, extension_textures};
+    let mut named = 0;
+    let mut missing = false;
+    let mut json = |extension: usize, key: &str| {
+        let (name, keys) = LAYER_JSON_TEXTURES[extension];
+        let (_, info, space) = extension_textures(m, name, keys).into_iter().find(|(k, ..)| *k == key)?;
+        let index = info.get("index").and_then(|i| i.as_u64());
+        if index.is_none_or(|i| i >= doc.textures().len() as u64) {
+            missing = true;
+            return None;
+        }
+        named += 1;
+        images.from_json(doc, info, space)
+    };
+    let mut layers = LayerTextures {
+        clearcoat: json(0, "clearcoatTexture"),
+        clearcoat_roughness: json(0, "clearcoatRoughnessTexture"),
+        sheen_color: json(1, "sheenColorTexture"),
+        sheen_roughness: json(1, "sheenRoughnessTexture"),
+        ..Default::default()
+    };
+    if let Some(s) = m.specular() {
+        for (info, space, slot) in [
+            (s.specular_texture(), ColorSpace::Linear, &mut layers.specular),
+            (s.specular_color_texture(), ColorSpace::Srgb, &mut layers.specular_color),
+        ] {
+            if let Some(info) = info {
+                named += 1;
+                *slot = images.texture(&info, space);
+            }
+        }
+    }
+    let read = layers.all().iter().flatten().count();
+    (layers, read < named, missing)
 }
 
 /// Each component made finite and clamped to [0, max] (the specification's

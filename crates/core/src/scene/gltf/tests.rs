@@ -380,13 +380,14 @@ fn the_clearcoat_extension_is_read() {
         scene.materials[0],
         Material::Pbr(crate::bsdf::Bsdf::new(Vec3::splat(0.5), 0.0, 1.0, 0.0).with_clearcoat(0.8, 0.25))
     );
-    // A coat texture is named: the factors still apply, with a note.
+    // A coat texture that the file does not have: the factors still
+    // apply, with a note (texture_tests reads real ones).
     let ext = root.materials[0].extensions.as_mut().unwrap();
     let value = ext.others.get_mut(materials::CLEARCOAT).unwrap().as_object_mut().unwrap();
     value.insert("clearcoatTexture".into(), json::Value::from_iter([("index", json::Value::from(0))]));
     let path = write(&dir, "t.glb", &glb(&root, bin));
     let scene = crate::scene::Scene::load(path.to_str().unwrap()).unwrap();
-    assert!(scene.notes.iter().any(|n| n.contains("clear-coat textures")), "{:?}", scene.notes);
+    assert!(scene.notes.iter().any(|n| n.contains("names no texture of the file")), "{:?}", scene.notes);
     assert!(matches!(scene.materials[0], Material::Pbr(b) if b.clearcoat == 0.8));
 }
 
@@ -417,12 +418,13 @@ fn the_sheen_extension_is_read() {
     let again = super::export::scene_to_glb(&placed).unwrap();
     let reloaded = crate::scene::Scene::load(write(&dir, "again.glb", &again).to_str().unwrap()).unwrap();
     assert_eq!(reloaded.materials[0], Material::Pbr(want));
-    // A sheen texture is named: the factors still apply, with a note.
+    // A sheen texture that the file does not have: the factors still
+    // apply, with a note.
     let ext = root.materials[0].extensions.as_mut().unwrap();
     let value = ext.others.get_mut(materials::SHEEN).unwrap().as_object_mut().unwrap();
     value.insert("sheenRoughnessTexture".into(), json::Value::from_iter([("index", json::Value::from(0))]));
     let scene = crate::scene::Scene::load(write(&dir, "t.glb", &glb(&root, bin.clone())).to_str().unwrap()).unwrap();
-    assert!(scene.notes.iter().any(|n| n.contains("sheen textures")), "{:?}", scene.notes);
+    assert!(scene.notes.iter().any(|n| n.contains("names no texture of the file")), "{:?}", scene.notes);
     assert_eq!(scene.materials[0], Material::Pbr(want));
     // A colour of two numbers is noted and read as no sheen.
     let ext = root.materials[0].extensions.as_mut().unwrap();
@@ -497,12 +499,15 @@ fn the_specular_colour_is_read() {
     let again = super::export::scene_to_glb(&scene).unwrap();
     let reloaded = crate::scene::Scene::load(write(&dir, "again.glb", &again).to_str().unwrap()).unwrap();
     assert!(matches!(reloaded.materials[0], Material::Pbr(b) if b.specular_color == tint));
-    // A specular texture is noted.
+    // A specular texture is read (white: the factors alone), with the
+    // note on what the GPU renderer does with it.
     let ext = root.materials[0].extensions.as_mut().unwrap();
     ext.specular.as_mut().unwrap().specular_texture =
         Some(json::texture::Info { index: texture, tex_coord: 0, extensions: None, extras: Default::default() });
     let scene = crate::scene::Scene::load(write(&dir, "t.glb", &glb(&root, bin)).to_str().unwrap()).unwrap();
-    assert!(scene.notes.iter().any(|n| n.contains("KHR_materials_specular textures")), "{:?}", scene.notes);
+    assert!(scene.notes.iter().any(|n| n.contains("the GPU renderer draws each with its mean")), "{:?}", scene.notes);
+    let textures = scene.texturing.as_ref().unwrap().materials[0].unwrap();
+    assert!(textures.layers.specular.is_some() && textures.layers.specular_color.is_none());
 }
 
 /// `KHR_materials_transmission` is glass of the material's roughness,

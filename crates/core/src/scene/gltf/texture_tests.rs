@@ -519,3 +519,52 @@ fn a_webp_texture_reads_as_the_png_one() {
         assert!((a - texel[t]).abs() < 1e-5, "({x}, {y}): {a} vs texel {t} = {}", texel[t]);
     }
 }
+
+/// Clear coat, sheen and specular textures each multiply their factor at
+/// the point hit, read in their extension's channel and colour space: R
+/// and G of the coat's (linear), the sheen colour's RGB (sRGB) and its
+/// roughness's A, the specular's A (linear) and its colour's RGB (sRGB).
+/// The GPU's surface record holds each factor times its texture's mean.
+#[test]
+fn layer_textures_multiply_their_factors_where_the_ray_hits() {
+    use crate::test_scenes::gltf_textures::{LAYER_ALPHA, LAYER_FACTORS, layered_glb};
+    let scene = load("layers", &layered_glb());
+    assert!(
+        scene.notes.iter().any(|n| n.contains("clear-coat, sheen or specular textures: the CPU renderers read them")),
+        "{:?}",
+        scene.notes
+    );
+    assert!(scene.notes.iter().all(|n| !n.contains("not read")), "{:?}", scene.notes);
+    let (coat, coat_roughness, sheen, sheen_roughness, specular, specular_color) = LAYER_FACTORS;
+    let linear = GREYS.map(|g| g as f32 / 255.0);
+    let srgb = GREYS.map(|g| srgb_to_linear(g as f32 / 255.0));
+    let alpha = LAYER_ALPHA.map(|a| a as f32 / 255.0);
+    let close = |a: f32, b: f32| (a - b).abs() < 1e-5;
+    for (x, y, t) in [(0.25, 0.75, 0), (0.75, 0.75, 1), (0.25, 0.25, 2), (0.75, 0.25, 3)] {
+        let hit = scene.accel.intersect(&down_at(x, y)).expect("the quad");
+        let Material::Pbr(b) = *scene.material_at(&hit) else { panic!("{:?}", scene.material_at(&hit)) };
+        let at = format!("texel {t}: {b:?}");
+        assert!(close(b.clearcoat, coat * linear[t]), "{at}");
+        assert!(close(b.clearcoat_roughness, coat_roughness * linear[t]), "{at}");
+        assert!(b.sheen_color.abs_diff_eq(Vec3::from(sheen) * srgb[t], 1e-5), "{at}");
+        assert!(close(b.sheen_roughness, sheen_roughness * alpha[t]), "{at}");
+        assert!(close(b.specular, specular * alpha[t]), "{at}");
+        let color = Vec3::from(specular_color) * srgb[t];
+        assert!(b.specular_color.abs_diff_eq(color, 1e-5), "{at}");
+        // The Fresnel reads the scaled colour (the cached F0 follows it).
+        assert!(b.dielectric_f0.abs_diff_eq(color * b.f0, 1e-6), "{at}");
+        // Untouched: what no texture here scales.
+        assert!(close(b.roughness, 0.4) && b.base_color == Vec3::ONE, "{at}");
+    }
+    // The GPU's record (without the GPU: its material as uploaded).
+    let texturing = scene.texturing.as_ref().unwrap();
+    let surface = scene.surfaces.iter().find(|s| texturing.materials[s.material as usize].is_some()).unwrap();
+    let Material::Pbr(mean) = texturing.with_layer_means(scene.materials[surface.material as usize], surface.material)
+    else {
+        panic!()
+    };
+    let avg = |v: [f32; 4]| v.iter().sum::<f32>() / 4.0;
+    assert!(close(mean.clearcoat, coat * avg(linear)), "{mean:?}");
+    assert!(mean.sheen_color.abs_diff_eq(Vec3::from(sheen) * avg(srgb), 1e-5), "{mean:?}");
+    assert!(close(mean.specular, specular * avg(alpha)), "{mean:?}");
+}

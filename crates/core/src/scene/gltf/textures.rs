@@ -39,6 +39,14 @@ impl Images {
         Some((self.reference(&info.texture(), info.tex_coord(), transform, ColorSpace::Linear)?, info.scale()))
     }
 
+    /// A texture named by a texture info in raw JSON (`KHR_materials_clearcoat`'s and
+    /// `KHR_materials_sheen`'s, which the `gltf` crate does not parse);
+    /// None where it names no texture or reads a set other than 0.
+    pub fn from_json(&self, doc: &gltf::Document, info: &gltf::json::Value, space: ColorSpace) -> Option<TextureRef> {
+        let (texture, tex_coord, transform) = json_info(doc, info)?;
+        self.reference(&texture, tex_coord, transform, space)
+    }
+
     fn reference(
         &self,
         texture: &gltf::Texture,
@@ -72,6 +80,42 @@ pub fn normal_tex_coord(info: &gltf::material::NormalTexture, json: &gltf::json:
     let transform = json.extensions.as_ref().and_then(|e| e.others.get(TRANSFORM)).and_then(Transform::from_json);
     transform.and_then(|t| t.tex_coord).unwrap_or(info.tex_coord())
 }
+
+/// A texture info given as raw JSON: its texture, `texCoord` and
+/// `KHR_texture_transform`; None where `index` names no texture.
+fn json_info<'a>(
+    doc: &'a gltf::Document,
+    info: &gltf::json::Value,
+) -> Option<(gltf::Texture<'a>, u32, Option<Transform>)> {
+    let texture = doc.textures().nth(usize::try_from(info.get("index")?.as_u64()?).ok()?)?;
+    let tex_coord = info.get("texCoord").and_then(|c| c.as_u64()).map_or(0, |c| c.min(u32::MAX as u64) as u32);
+    let transform = info.get("extensions").and_then(|e| e.get(TRANSFORM)).and_then(Transform::from_json);
+    Some((texture, tex_coord, transform))
+}
+
+/// The texture infos of a material extension's JSON (`extension`), by key
+/// and the colour space each is read in.
+pub fn extension_textures<'v>(
+    m: &'v gltf::Material,
+    extension: &str,
+    keys: &[(&'static str, ColorSpace)],
+) -> Vec<(&'static str, &'v gltf::json::Value, ColorSpace)> {
+    let Some(v) = m.extension_value(extension) else { return Vec::new() };
+    keys.iter().filter_map(|&(key, space)| Some((key, v.get(key)?, space))).collect()
+}
+
+/// The clear coat's and the sheen's textures hikari reads, with their
+/// colour spaces (the coat's normal texture is not read).
+pub const LAYER_JSON_TEXTURES: [(&str, &[(&str, ColorSpace)]); 2] = [
+    (
+        super::materials::CLEARCOAT,
+        &[("clearcoatTexture", ColorSpace::Linear), ("clearcoatRoughnessTexture", ColorSpace::Linear)],
+    ),
+    (
+        super::materials::SHEEN,
+        &[("sheenColorTexture", ColorSpace::Srgb), ("sheenRoughnessTexture", ColorSpace::Linear)],
+    ),
+];
 
 /// The extension's name, as it appears in a texture info's `extensions`.
 pub const TRANSFORM: &str = "KHR_texture_transform";
@@ -140,6 +184,19 @@ fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::Texture<'a>,
         let json = m.index().and_then(|i| doc.as_json().materials.get(i)).and_then(|m| m.normal_texture.as_ref());
         let normal = m.normal_texture().zip(json).map(|(n, json)| (n.texture(), normal_tex_coord(&n, json)));
         push("normalTexture", normal, ColorSpace::Linear);
+        if let Some(s) = m.specular() {
+            push("extensions.KHR_materials_specular.specularTexture", info(s.specular_texture()), ColorSpace::Linear);
+            let color = info(s.specular_color_texture());
+            push("extensions.KHR_materials_specular.specularColorTexture", color, ColorSpace::Srgb);
+        }
+        for (extension, keys) in LAYER_JSON_TEXTURES {
+            for (key, value, space) in extension_textures(&m, extension, keys) {
+                let read = json_info(doc, value).map(|(texture, tex_coord, transform)| {
+                    (texture, transform.and_then(|t| t.tex_coord).unwrap_or(tex_coord))
+                });
+                push(&format!("extensions.{extension}.{key}"), read, space);
+            }
+        }
     }
     used
 }
