@@ -5,7 +5,7 @@
 //! Lookups happen once per surface interaction ([`Texturing::apply`],
 //! called by `Scene::material_at`, pbrt's `MaterialEvalContext`), and in
 //! the BVH's alpha test of `alphaMode` MASK cut-outs
-//! ([`Texturing::opaque_at`]).
+//! ([`Texturing::is_there_at`]).
 //!
 //! # Memory
 //!
@@ -21,6 +21,7 @@
 //! mip level.
 
 use crate::material::{Material, Rgb};
+use crate::sampling::hash_u32;
 use glam::{Affine2, Vec2, Vec4, Vec4Swizzles};
 
 /// How texture coordinates outside [0, 1] wrap (glTF's `wrapS`, `wrapT`).
@@ -238,14 +239,6 @@ pub fn blend_threshold(origin: glam::Vec3, dir: glam::Vec3, prim: u32) -> f32 {
         h = hash_u32(h ^ bits);
     }
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
-}
-
-/// PCG's output permutation as a hash (Jarzynski & Olano 2020, "Hash
-/// Functions for GPU Rendering"); random.wgsl's `hash_u32`.
-pub fn hash_u32(x: u32) -> u32 {
-    let state = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
-    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
-    (word >> 22) ^ word
 }
 
 /// What a material takes from textures (glTF's metallic–roughness model);
@@ -478,7 +471,7 @@ impl Texturing {
     /// ray of BLEND threshold `u()` ([`blend_threshold`], asked only of
     /// BLEND surfaces): its alpha (factor × base-colour texture) decides as
     /// its [`AlphaMode`] says.
-    pub fn opaque_at(&self, surface: u32, prim: u32, b: Vec2, u: impl FnOnce() -> f32) -> bool {
+    pub fn is_there_at(&self, surface: u32, prim: u32, b: Vec2, u: impl FnOnce() -> f32) -> bool {
         let Some(t) = self.surface_materials.get(surface as usize).and_then(|&m| self.textures(m)) else {
             return true;
         };

@@ -32,7 +32,8 @@
 //! Textures (`textures`) are one storage buffer of 8-bit texels with their
 //! mip chains, sampled by `textures.wgsl` with the CPU's filter: in the
 //! G-buffer (mip-mapped by the pixel's footprint), the shadow maps and
-//! the ray-traced passes (level 0), cut-outs (alphaMode MASK) included.
+//! the ray-traced passes (level 0), cut-outs (alphaMode MASK) and
+//! stochastic transparency (BLEND) included.
 
 pub mod accumulate;
 pub mod binding;

@@ -150,18 +150,15 @@ pub fn scene_buffer_bytes(scene: &Scene) -> (u64, u64) {
 }
 
 /// All vertices, area-light bodies last; returns them and the occluder count.
+/// One pass into vectors of their final size: a posed scene is uploaded
+/// anew every frame of an animation (a 100,000-triangle character: 300,000
+/// vertices of 56 bytes).
 pub fn scene_vertices(scene: &Scene) -> (Vec<GpuVertex>, u32) {
-    let is_emitter = |surface: u32| scene.surfaces[(surface & !HAS_UV) as usize].emitter.is_some();
-    let mut occluders = Vec::new();
-    let mut emitters = Vec::new();
-    for_each_vertex(scene, |v| if is_emitter(v.surface) { emitters.push(v) } else { occluders.push(v) });
-    let count = occluders.len() as u32;
-    occluders.extend(emitters);
-    (occluders, count)
-}
-
-fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
-    let mut out = Vec::new();
+    let is_emitter = |surface: u32| scene.surfaces[surface as usize].emitter.is_some();
+    let emitter_triangles = scene.accel.triangles().filter(|&(_, s)| is_emitter(s)).count();
+    let triangles = scene.accel.triangles().len();
+    let mut occluders = Vec::with_capacity(3 * (triangles - emitter_triangles));
+    let mut emitters = Vec::with_capacity(3 * emitter_triangles);
     let uvs = scene.texturing.as_ref().map(|t| &t.uvs);
     let tangents = scene.texturing.as_ref().map(|t| &t.tangents);
     for (prim, (tri, surface)) in scene.accel.triangles().enumerate() {
@@ -171,8 +168,9 @@ fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
             None => [ng; 3],
         };
         let uv = uvs.and_then(|t| t.triangle(prim as u32));
-        let surface = if uv.is_some() { surface | HAS_UV } else { surface };
         let tangent = tangents.and_then(|t| t.triangle(prim as u32));
+        let out = if is_emitter(surface) { &mut emitters } else { &mut occluders };
+        let surface = if uv.is_some() { surface | HAS_UV } else { surface };
         for k in 0..3 {
             out.push(GpuVertex {
                 position: tri.v[k].to_array(),
@@ -185,9 +183,12 @@ fn for_each_vertex(scene: &Scene, mut emit: impl FnMut(GpuVertex)) {
         }
     }
     for (sphere, surface) in scene.accel.spheres() {
-        tessellate_sphere(sphere.center, sphere.radius, surface, &mut out);
+        let out = if is_emitter(surface) { &mut emitters } else { &mut occluders };
+        tessellate_sphere(sphere.center, sphere.radius, surface, out);
     }
-    out.into_iter().for_each(&mut emit);
+    let count = occluders.len() as u32;
+    occluders.extend(emitters);
+    (occluders, count)
 }
 
 /// UV sphere, wound so triangle normals point outward.

@@ -58,7 +58,7 @@ pub(super) const SPHERE_BIT: u32 = 1 << 31;
 /// frame pays the difference in cost.
 const REFIT_COST_LIMIT: f32 = 1.5;
 /// The triangle is a cut-out or BLEND: a hit counts only where its alpha
-/// says the surface is there (`Texturing::opaque_at`; BLEND by the ray's
+/// says the surface is there (`Texturing::is_there_at`; BLEND by the ray's
 /// `blend_threshold`). Only flagged primitives pay for the test, so scenes
 /// without them cost nothing more.
 pub(super) const MASKED_BIT: u32 = 1 << 30;
@@ -286,7 +286,7 @@ impl Accel {
         let i = prim & INDEX_BITS;
         self.alpha.as_ref().is_none_or(|t| {
             let u = || crate::texture::blend_threshold(ray.origin, ray.dir, i);
-            t.opaque_at(self.info[i as usize].surface, i, Vec2::new(b1, b2), u)
+            t.is_there_at(self.info[i as usize].surface, i, Vec2::new(b1, b2), u)
         })
     }
 
@@ -309,7 +309,7 @@ impl Accel {
     }
 
     /// Every triangle with its surface id (for rasterization).
-    pub fn triangles(&self) -> impl Iterator<Item = (&Triangle, u32)> {
+    pub fn triangles(&self) -> impl ExactSizeIterator<Item = (&Triangle, u32)> {
         self.triangles.iter().zip(self.surface_of.iter().copied())
     }
 

@@ -18,6 +18,15 @@ pub use sobol::SobolSampler;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
+/// PCG's output permutation as a hash (Jarzynski & Olano 2020, "Hash
+/// Functions for GPU Rendering"); random.wgsl's `hash_u32`. What a ray
+/// decides by without a random stream (`texture::blend_threshold`).
+pub fn hash_u32(x: u32) -> u32 {
+    let state = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
 /// A source of uniform numbers in [0, 1) for one path: independent ones
 /// ([`Rng`]) or a quasi-random sample ([`SobolSampler`]).
 pub trait Sampler {

@@ -7,7 +7,8 @@
 
 // Some surface has a texture (base colour, metallic–roughness, emissive).
 override TEXTURED: bool = true;
-// Some surface is a cut-out (alphaMode MASK).
+// Some surface is a cut-out (alphaMode MASK) or stochastically transparent
+// (BLEND).
 override CUT_OUTS: bool = true;
 // Some surface reflects by the glTF BRDF's specular lobe (`Surface::glossy`).
 override GLOSSY: bool = true;

@@ -1,5 +1,5 @@
 // A surface at one point, its textures applied: hikari_core::texture::
-// Texturing::apply (base colour, metallic, roughness), the alpha opaque_at
+// Texturing::apply (base colour, metallic, roughness), the alpha is_there_at
 // reads (`is_there` decides with it)
 // and emission_scale (the emissive texture), in one lookup of each texture.
 // `uv` is the point's texture coordinates (xy) and z = 1 where the
