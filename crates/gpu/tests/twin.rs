@@ -226,3 +226,40 @@ fn gpu_glossy_estimates_equal_cpu_estimates() {
         }
     }
 }
+
+/// estimate.wgsl's `shading_normal_factor` against the CPU's, on random
+/// directions and normals bent up to 60° (the cap and the zeros included).
+#[test]
+fn wgsl_shading_normal_factor_matches_the_cpu() {
+    use hikari_core::estimate::shading_normal_factor;
+    use hikari_core::sampling::{Rng, uniform_sphere};
+    let ctx = test_context("wgsl_shading_normal_factor_matches_the_cpu");
+    let mut rng = Rng::for_item(23, 0);
+    let n = 4096;
+    let mut cases = Vec::new();
+    let mut input = vec![0u32; n * 10];
+    for item in input.chunks_mut(10) {
+        let wi = uniform_sphere(rng.next_2d());
+        let ng = uniform_sphere(rng.next_2d());
+        let ns = (ng + uniform_sphere(rng.next_2d()) * rng.next_f32()).normalize();
+        for (k, v) in [wi, ns, ng].iter().flat_map(|v| v.to_array()).enumerate() {
+            item[k] = v.to_bits();
+        }
+        cases.push((wi, ns, ng));
+    }
+    let main = "let o = 10u * id.x; if (o >= arrayLength(&io)) { return; }\n\
+                let v = array<f32, 9>(bitcast<f32>(io[o]), bitcast<f32>(io[o + 1u]), bitcast<f32>(io[o + 2u]),\n\
+                    bitcast<f32>(io[o + 3u]), bitcast<f32>(io[o + 4u]), bitcast<f32>(io[o + 5u]),\n\
+                    bitcast<f32>(io[o + 6u]), bitcast<f32>(io[o + 7u]), bitcast<f32>(io[o + 8u]));\n\
+                let f = shading_normal_factor(vec3<f32>(v[0], v[1], v[2]), vec3<f32>(v[3], v[4], v[5]), vec3<f32>(v[6], v[7], v[8]));\n\
+                io[o + 9u] = bitcast<u32>(f);";
+    let gpu = hikari_gpu::test_support::run_kernel(&ctx, &[&hikari_gpu::wgsl::ESTIMATE], main, &input);
+    let (mut zeros, mut capped) = (0, 0);
+    for (out, (wi, ns, ng)) in gpu.chunks(10).zip(&cases) {
+        let (got, want) = (f32::from_bits(out[9]), shading_normal_factor(*wi, *ns, *ng));
+        assert!((got - want).abs() <= 1e-5 * want.max(1.0), "wi {wi} ns {ns} ng {ng}: {got} vs {want}");
+        zeros += (want == 0.0) as usize;
+        capped += (want == hikari_core::estimate::MAX_SHADING_NORMAL_FACTOR) as usize;
+    }
+    assert!(zeros > 100 && capped > 0, "{zeros} zeros, {capped} capped of {n}");
+}

@@ -9,7 +9,7 @@
 use super::{Image, LitSides, direct_diffuse, direct_reflected, direct_scattered, render_pixels};
 use crate::bsdf::ShadingFrame;
 use crate::bsdf::dielectric::Transport;
-use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf};
+use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf, shading_normal_factor};
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, reflect};
 use crate::medium::MediaAlong;
@@ -139,7 +139,16 @@ impl<'a> PhotonCpuRenderer<'a> {
 
     /// The photon-map part of the light leaving a diffuse point: indirect
     /// (global map) plus caustics (caustic map), per the enabled components.
-    pub fn photon_radiance(&self, x: glam::Vec3, normal: glam::Vec3, albedo: Rgb) -> Rgb {
+    /// The photon-map part of the light a Lambertian surface of `albedo`
+    /// reflects, shading with `normal` where its geometric normal is `ng`
+    /// (where the two differ, smooth-shaded and normal-mapped meshes, each
+    /// photon weighs `estimate::shading_normal_factor`).
+    pub fn photon_radiance(&self, x: glam::Vec3, normal: glam::Vec3, ng: glam::Vec3, albedo: Rgb) -> Rgb {
+        if normal != ng {
+            let frame = ShadingFrame::new(normal);
+            let lambert = albedo / std::f32::consts::PI;
+            return self.photon_radiance_brdf(x, &frame, ng, |wi| if wi.z > 0.0 { lambert } else { Rgb::ZERO });
+        }
         let c = self.settings.components;
         let mut l = Rgb::ZERO;
         if c.indirect {
@@ -152,12 +161,23 @@ impl<'a> PhotonCpuRenderer<'a> {
     }
 
     /// The photon-map part of the light a `Pbr` surface reflects toward
-    /// `wo` (local frame `frame`): each photon weighted by `brdf` for its
-    /// own direction (the whole BRDF where the photon maps stand for it,
-    /// else the diffuse lobe).
-    fn photon_radiance_brdf(&self, x: glam::Vec3, frame: &ShadingFrame, brdf: impl Fn(glam::Vec3) -> Rgb) -> Rgb {
+    /// `wo` (local frame `frame`, on a surface of geometric normal `ng`):
+    /// each photon weighted by `brdf` for its own direction (the whole BRDF
+    /// where the photon maps stand for it, else the diffuse lobe), and by
+    /// `estimate::shading_normal_factor` where the normals differ.
+    fn photon_radiance_brdf(
+        &self,
+        x: glam::Vec3,
+        frame: &ShadingFrame,
+        ng: glam::Vec3,
+        brdf: impl Fn(glam::Vec3) -> Rgb,
+    ) -> Rgb {
         let c = self.settings.components;
-        let f = |wi: glam::Vec3| brdf(frame.to_local(wi));
+        let bent = frame.normal != ng;
+        let f = |wi: glam::Vec3| {
+            let f = brdf(frame.to_local(wi));
+            if bent { f * shading_normal_factor(wi, frame.normal, ng) } else { f }
+        };
         let mut l = Rgb::ZERO;
         if c.indirect {
             l += fixed_radius_radiance_brdf(&self.global, x, frame.normal, &self.global_params, f);
@@ -295,7 +315,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                     let f = |wi: glam::Vec3| bsdf.f(wo, frame.to_local(wi));
                     l += direct_reflected(self.scene, hit.point, ns, ng, f, self.settings.area_light_samples, rng);
                 }
-                l += self.photon_radiance_brdf(hit.point, &frame, part);
+                l += self.photon_radiance_brdf(hit.point, &frame, ng, part);
                 // A lobe smoother than the gather threshold is followed, one
                 // sampled direction per eye ray. A glossy (non-delta) one
                 // leaves out what it sees emitted: its shadow rays counted that.
@@ -323,7 +343,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                             rng,
                         );
                     }
-                    l += self.photon_radiance(hit.point, ns, albedo);
+                    l += self.photon_radiance(hit.point, ns, ng, albedo);
                 }
                 let rho_s = material.mirror_reflectance();
                 if rho_s.max_element() > 0.0 && can_recurse {

@@ -152,8 +152,13 @@ fn bucket_of(cell: vec3<i32>, buckets: u32) -> u32 {
 // of the 27 cells is read twice: a photon counts only from its own cell
 // (which costs no loop, unlike remembering the buckets read). A glossy
 // surface weights each photon by its BRDF `bsdf` seen from `eye`; a
-// Lambertian one takes its base colour as its albedo.
-fn gather(x: vec3<f32>, n: vec3<f32>, glossy: bool, bsdf: Bsdf, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
+// Lambertian one takes its base colour as its albedo. With `bent` (the
+// shading normal `n` is not the geometric `ng`), each photon also weighs
+// shading_normal_factor (photon-cpu's gathers). Callers pass `bent` as a
+// literal in each branch of an `if`: drivers inline the call and fold the
+// test out of the loop, where a per-photon test of a run-time flag cost the
+// pass 13-16% on lavapipe (BENCHMARKS.md).
+fn gather(x: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, bent: bool, glossy: bool, bsdf: Bsdf, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
     let centre = vec3<i32>(floor(x / radius));
     var power = vec3<f32>(0.0);
     for (var k = 0u; k < 27u; k++) {
@@ -179,6 +184,9 @@ fn gather(x: vec3<f32>, n: vec3<f32>, glossy: bool, bsdf: Bsdf, eye: vec3<f32>, 
                 var p_power = decode_rgb9e5(grid[base + 3u]);
                 if (glossy) {
                     p_power *= photon_brdf(bsdf, eye, n, dir);
+                }
+                if (bent) {
+                    p_power *= shading_normal_factor(-dir, n, ng);
                 }
                 power += p_power;
             }
@@ -456,9 +464,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                         let r = surface_reflector(s, bsdf, eye, ns);
                         radiance += weight * direct_radiance(x, ns, r, &light_rng);
                     }
-                    let g = gather(x, ns, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset);
-                    let c = gather(x, ns, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
-                    radiance += weight * (g + c);
+                    var gathered: vec3<f32>;
+                    if (any(ns != n)) {
+                        gathered = gather(x, ns, n, true, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
+                            + gather(x, ns, n, true, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    } else {
+                        gathered = gather(x, ns, n, false, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
+                            + gather(x, ns, n, false, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    }
+                    radiance += weight * gathered;
                 }
                 if (follows_lobe(s, bsdf)) {
                     // One direction of the specular lobe per pass.
