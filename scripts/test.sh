@@ -71,14 +71,21 @@ read -r dir exe <<<"${web_tests[0]}"
 # slurm-wlm and munge; skipped, loudly, only where Slurm cannot start.
 bash scripts/slurm/test.sh target/debug/hikari
 
-# The Python module (#43): `pip install .` in a fresh virtual environment,
-# then its tests (python/tests), which compare pixels with the CLI built above.
-echo "Python: pip install . and pytest"
+# The Python module (#43): its wheel, built by `pip wheel .` (what `pip
+# install .` builds), installed in a fresh virtual environment, then its
+# tests (python/tests), which compare pixels with the CLI built above.
+echo "Python: pip wheel ., pip install and pytest"
+wheel=$(bash scripts/blender.sh wheel)
 venv="$(mktemp -d)/venv"
 python3 -m venv "$venv"
 "$venv/bin/pip" install --quiet --upgrade pip
-"$venv/bin/pip" install --quiet ".[test]"
+"$venv/bin/pip" install --quiet "$wheel" "pytest>=7"
 (cd python/tests && HIKARI_BIN="$PWD/../../target/debug/hikari" "$venv/bin/python" -m pytest -q .)
+
+# The Blender add-on (#45): its zip (with that wheel inside) installed into
+# Blender from PyPI (bpy 5.x on CPython 3.13), rendering against Cycles.
+echo "Blender add-on: bash scripts/blender.sh test"
+bash scripts/blender.sh test
 
 # A minute of the structured scene fuzzer (new mutants for every commit).
 bash scripts/fuzz-ci.sh "$@"

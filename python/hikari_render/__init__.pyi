@@ -153,6 +153,11 @@ class Scene:
     ) -> dict[str, Image]:
         """"color", "albedo", "normal" (height, width, 3) and "depth" (height, width)."""
 
+    def aovs(
+        self, *, resolution: tuple[int, int] | None = None, at: float = 0.0
+    ) -> dict[str, Image]:
+        """"albedo", "normal" (height, width, 3) and "depth" (height, width), without rendering the colour."""
+
     def progressive(
         self,
         renderer: Renderer = "gpu",

@@ -321,6 +321,22 @@ def test_aovs_against_hand_computed_values(tmp_path):
         assert np.array_equal(other[key], out[key]), key
 
 
+def test_aovs_alone_are_those_of_a_render(tmp_path):
+    """Scene.aovs gives a render's albedo, normal and depth without one, at
+    another resolution too."""
+    path = tmp_path / "wall.toml"
+    path.write_text(WALL)
+    scene = hk.load(path)
+    alone = scene.aovs()
+    rendered = scene.render("path", spp=1, aovs=True)
+    assert set(alone) == {"albedo", "normal", "depth"}
+    for key in alone:
+        assert np.array_equal(alone[key], rendered[key]), key
+    assert scene.aovs(resolution=(4, 3))["depth"].shape == (3, 4)
+    with pytest.raises(ValueError, match="resolution"):
+        scene.aovs(resolution=(0, 3))
+
+
 def test_depth_is_infinite_where_nothing_is_hit(tmp_path):
     path = tmp_path / "empty.toml"
     path.write_text(WALL.replace("[-5.0, -5.0, 0.0]", "[20.0, 20.0, 0.0]"))  # the wall out of view

@@ -107,6 +107,27 @@ impl Scene {
         Ok(Passes { worker: std::sync::Mutex::new(Some(Worker::start(posed, request, true))) })
     }
 
+    /// The images denoisers take, without rendering the colour: a dict
+    /// with "albedo", "normal" (float32 (height, width, 3)) and "depth"
+    /// (float32 (height, width)), as `render(..., aovs=True)` gives them,
+    /// for the scene at `resolution` and posed `at` seconds (a caller
+    /// that renders pass by pass asks for them once, beside its passes).
+    #[pyo3(signature = (*, resolution = None, at = 0.0))]
+    fn aovs<'py>(&self, py: Python<'py>, resolution: Option<(u32, u32)>, at: f32) -> PyResult<Bound<'py, PyDict>> {
+        let kwargs = PyDict::new(py);
+        kwargs.set_item("resolution", resolution)?;
+        kwargs.set_item("at", at)?;
+        let request = request("path", Some(&kwargs))?;
+        let posed = self.posed(py, &request)?;
+        let aovs = py.detach(|| hikari_core::render::aov::render_aovs(&posed));
+        let (width, height) = (aovs.albedo.width, aovs.albedo.height);
+        let dict = PyDict::new(py);
+        dict.set_item("albedo", image_to_array(py, &aovs.albedo)?)?;
+        dict.set_item("normal", image_to_array(py, &aovs.normal)?)?;
+        dict.set_item("depth", depth_to_array(py, &aovs.depth, width, height)?)?;
+        Ok(dict)
+    }
+
     /// The image's size as the scene's camera gives it: (width, height).
     #[getter]
     fn resolution(&self) -> (u32, u32) {

@@ -1,0 +1,177 @@
+"""The render engine "HIKARI": F12 and Ctrl-F12 through hikari_render.
+
+Each render exports the evaluated scene (export.py) to a temporary
+directory, loads it with hikari's glTF loader and renders it pass by pass,
+updating the render window after each pass; then the images Blender's
+denoiser takes."""
+
+import logging
+import tempfile
+import warnings
+
+import bpy
+import numpy as np
+
+from . import export
+
+# Blender's pass names, so the compositor's Denoise node and file outputs
+# take them: (name, channels, channel ids, socket type).
+DENOISING_PASSES = [
+    ("Denoising Albedo", 3, "RGB", "COLOR"),
+    ("Denoising Normal", 3, "XYZ", "VECTOR"),
+]
+DEPTH_PASS = ("Depth", 1, "Z", "VALUE")
+# Every warning shown in Blender's report area also goes to this logger.
+log = logging.getLogger("hikari_blender")
+
+# What Blender writes as the depth where nothing is hit (Cycles' value).
+BACKGROUND_DEPTH = 1e10
+
+
+def bottom_up(image: np.ndarray) -> np.ndarray:
+    """hikari's rows run top to bottom, a render result's bottom to top."""
+    return image[::-1]
+
+
+def combined_rect(image: np.ndarray) -> np.ndarray:
+    """(height, width, 3) radiance as the Combined pass's RGBA rows."""
+    h, w, _ = image.shape
+    rgba = np.ones((h, w, 4), dtype=np.float32)
+    rgba[:, :, :3] = np.nan_to_num(image, nan=0.0, posinf=0.0, neginf=0.0)
+    return bottom_up(rgba).reshape(-1, 4)
+
+
+def camera_axes(matrix_world) -> np.ndarray:
+    """Rows: the camera's right, up and forward directions in Blender's
+    world (its local X, Y and −Z)."""
+    m = np.array(matrix_world, dtype=np.float64)[:3, :3]
+    axes = np.stack([m[:, 0], m[:, 1], -m[:, 2]])
+    return axes / np.linalg.norm(axes, axis=1, keepdims=True)
+
+
+def normal_rect(normal: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """World-space normals (glTF's Y-up frame) as Cycles writes its
+    Denoising Normal: in the camera's frame, x right, y up, z forward."""
+    blender = np.stack([normal[:, :, 0], -normal[:, :, 2], normal[:, :, 1]], axis=-1)
+    return bottom_up(blender @ axes.T).reshape(-1, 3).astype(np.float32)
+
+
+def planar_depth(depth: np.ndarray, fov_y_degrees: float) -> np.ndarray:
+    """Distances along the rays through the pixels' centres as distances
+    along the camera's axis (Cycles' Depth pass); Blender's 10¹⁰ where
+    nothing is hit."""
+    h, w = depth.shape
+    tan = np.tan(np.radians(fov_y_degrees) / 2)
+    ys, xs = np.mgrid[0:h, 0:w] + 0.5
+    u = (2 * xs / w - 1) * tan * w / h
+    v = (1 - 2 * ys / h) * tan
+    planar = depth / np.sqrt(1 + u * u + v * v)
+    return np.where(np.isfinite(planar), planar, BACKGROUND_DEPTH)
+
+
+def depth_rect(depth: np.ndarray, fov_y_degrees: float) -> np.ndarray:
+    return bottom_up(planar_depth(depth, fov_y_degrees)).reshape(-1, 1).astype(np.float32)
+
+
+class HikariRenderEngine(bpy.types.RenderEngine):
+    bl_idname = "HIKARI"
+    bl_label = "hikari"
+    bl_use_preview = False
+    bl_use_postprocess = True
+    bl_use_eevee_viewport = True
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        for name, channels, ids, kind in DENOISING_PASSES + [DEPTH_PASS]:
+            self.register_pass(scene, renderlayer, name, channels, ids, kind)
+
+    def render(self, depsgraph):
+        scene = depsgraph.scene
+        scale = scene.render.resolution_percentage / 100.0
+        width = max(1, int(scene.render.resolution_x * scale))
+        height = max(1, int(scene.render.resolution_y * scale))
+        layer_name = depsgraph.view_layer.name
+        for name, channels, ids, _ in DENOISING_PASSES:
+            self.add_pass(name, channels, ids, layer=layer_name)
+        if not depsgraph.view_layer.use_pass_z:
+            self.add_pass(*DEPTH_PASS[:3], layer=layer_name)
+        with tempfile.TemporaryDirectory(prefix="hikari-blender-") as directory:
+            self.render_in(depsgraph, directory, width, height, layer_name)
+
+    def render_in(self, depsgraph, directory, width, height, layer_name):
+        import hikari_render as hk
+
+        settings = depsgraph.scene.hikari
+        if self.is_animation:
+            # The render moved the scene to its frame, but the exporter reads
+            # the view layer's own depsgraph, still at the first frame.
+            scene = depsgraph.scene
+            scene.frame_set(scene.frame_current, subframe=scene.frame_subframe)
+        self.update_stats("", "hikari: exporting the scene")
+        exported = export.export_scene(depsgraph, directory)
+        for note in exported.warnings:
+            self.warn(note)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                loaded = hk.load(exported.glb, camera=exported.camera, environment=exported.environment)
+            except hk.SceneError as e:
+                message = f"hikari could not load the exported scene: {e}"
+                log.error(message)
+                self.report({"ERROR"}, message)
+                return
+            self.report_caught(caught)
+            result = self.begin_result(0, 0, width, height, layer=layer_name)
+            camera = depsgraph.scene.camera
+            axes = camera_axes(camera.evaluated_get(depsgraph).matrix_world if camera else np.eye(4))
+            try:
+                self.render_passes(loaded, settings, (width, height), result, axes)
+            finally:
+                self.report_caught(caught)
+                self.end_result(result)
+
+    def render_passes(self, loaded, settings, resolution, result, axes):
+        layer = result.layers[0]
+        combined = layer.passes.find_by_name("Combined", "")
+        kwargs = settings.render_arguments()
+        self.update_stats("", f"hikari {settings.renderer}: first pass")
+        for p in loaded.progressive(settings.renderer, resolution=resolution, **kwargs):
+            combined.rect = combined_rect(p.image)
+            self.update_result(result)
+            noise = "not yet estimated" if p.noise is None else f"noise {p.noise:.2%}"
+            self.update_stats("", f"hikari {settings.renderer}: pass {p.index}, {noise}, {p.seconds:.1f} s")
+            self.update_progress(self.fraction_done(kwargs, p))
+            if self.test_break():
+                break
+        aovs = loaded.aovs(resolution=resolution)
+        layer.passes.find_by_name("Denoising Albedo", "").rect = bottom_up(aovs["albedo"]).reshape(-1, 3)
+        layer.passes.find_by_name("Denoising Normal", "").rect = normal_rect(aovs["normal"], axes)
+        layer.passes.find_by_name("Depth", "").rect = depth_rect(aovs["depth"], loaded.camera.fov_y)
+
+    @staticmethod
+    def fraction_done(kwargs, p) -> float:
+        fractions = [0.0]
+        if "time" in kwargs:
+            fractions.append(p.seconds / kwargs["time"])
+        if "passes" in kwargs:
+            fractions.append(p.index / kwargs["passes"])
+        if "target_error" in kwargs and p.noise:
+            fractions.append(min(1.0, (kwargs["target_error"] / p.noise) ** 2))
+        return min(1.0, max(fractions))
+
+    def report_caught(self, caught):
+        for w in caught:
+            self.warn(f"hikari: {w.message}")
+        caught.clear()
+
+    def warn(self, message: str):
+        log.warning(message)
+        self.report({"WARNING"}, message)
+
+
+def register():
+    bpy.utils.register_class(HikariRenderEngine)
+
+
+def unregister():
+    bpy.utils.unregister_class(HikariRenderEngine)

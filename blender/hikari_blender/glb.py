@@ -1,0 +1,102 @@
+"""Reading, extending and writing a binary glTF (.glb) in memory, without
+Blender: what the exporter cannot write (area lights as emitting polygons)
+is added to its file here."""
+
+import json
+import math
+import struct
+
+MAGIC = 0x46546C67  # "glTF"
+JSON_CHUNK = 0x4E4F534A
+BIN_CHUNK = 0x004E4942
+EMISSIVE_STRENGTH = "KHR_materials_emissive_strength"
+
+
+class Glb:
+    """A .glb's JSON (a dict) and binary buffer (a bytearray)."""
+
+    def __init__(self, data: bytes):
+        magic, version, length = struct.unpack_from("<III", data, 0)
+        if magic != MAGIC or version != 2 or length > len(data):
+            raise ValueError("not a glTF 2.0 binary file")
+        offset, self.json, self.bin = 12, None, bytearray()
+        while offset + 8 <= length:
+            size, kind = struct.unpack_from("<II", data, offset)
+            chunk = data[offset + 8 : offset + 8 + size]
+            if kind == JSON_CHUNK:
+                self.json = json.loads(chunk.decode("utf-8"))
+            elif kind == BIN_CHUNK:
+                self.bin = bytearray(chunk)
+            offset += 8 + size
+        if self.json is None:
+            raise ValueError("a glTF binary file without its JSON chunk")
+
+    def to_bytes(self) -> bytes:
+        buffers = self.json.setdefault("buffers", [])
+        if self.bin:
+            if not buffers:
+                buffers.append({})
+            buffers[0]["byteLength"] = len(self.bin)
+        text = json.dumps(self.json, separators=(",", ":")).encode("utf-8")
+        text += b" " * (-len(text) % 4)
+        binary = bytes(self.bin) + b"\0" * (-len(self.bin) % 4)
+        chunks = struct.pack("<II", len(text), JSON_CHUNK) + text
+        if binary:
+            chunks += struct.pack("<II", len(binary), BIN_CHUNK) + binary
+        return struct.pack("<III", MAGIC, 2, 12 + len(chunks)) + chunks
+
+    def _append(self, data: bytes, target: int) -> int:
+        """A buffer view of `data` at the end of the binary buffer: its index."""
+        self.bin += b"\0" * (-len(self.bin) % 4)
+        views = self.json.setdefault("bufferViews", [])
+        views.append({"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data), "target": target})
+        self.bin += data
+        return len(views) - 1
+
+    def add_emitter(self, name: str, polygon: list, radiance: tuple) -> None:
+        """A flat, convex `polygon` (corners in glTF's frame, counter-clockwise
+        seen from the side it lights) emitting `radiance` (W/(m² sr), RGB)
+        from its front face only: a node at the root of the first scene."""
+        if len(polygon) < 3:
+            raise ValueError(f"{name}: an emitter needs at least three corners")
+        positions = b"".join(struct.pack("<3f", *p) for p in polygon)
+        indices = b"".join(struct.pack("<3I", 0, i, i + 1) for i in range(1, len(polygon) - 1))
+        accessors = self.json.setdefault("accessors", [])
+        lo = [min(p[k] for p in polygon) for k in range(3)]
+        hi = [max(p[k] for p in polygon) for k in range(3)]
+        accessors.append({"bufferView": self._append(positions, 34962), "componentType": 5126,
+                          "count": len(polygon), "type": "VEC3", "min": lo, "max": hi})
+        position = len(accessors) - 1
+        accessors.append({"bufferView": self._append(indices, 34963), "componentType": 5125,
+                          "count": 3 * (len(polygon) - 2), "type": "SCALAR"})
+        index = len(accessors) - 1
+        peak = max(radiance)
+        materials = self.json.setdefault("materials", [])
+        materials.append({
+            "name": name,
+            "pbrMetallicRoughness": {"baseColorFactor": [0, 0, 0, 1], "metallicFactor": 0, "roughnessFactor": 1},
+            "emissiveFactor": [c / peak for c in radiance],
+            "extensions": {EMISSIVE_STRENGTH: {"emissiveStrength": peak}},
+            "doubleSided": False,
+        })
+        used = self.json.setdefault("extensionsUsed", [])
+        if EMISSIVE_STRENGTH not in used:
+            used.append(EMISSIVE_STRENGTH)
+        meshes = self.json.setdefault("meshes", [])
+        meshes.append({"name": name, "primitives": [
+            {"attributes": {"POSITION": position}, "indices": index, "material": len(materials) - 1}]})
+        nodes = self.json.setdefault("nodes", [])
+        nodes.append({"name": name, "mesh": len(meshes) - 1})
+        scenes = self.json.setdefault("scenes", [{"nodes": []}])
+        scenes[self.json.get("scene", 0)].setdefault("nodes", []).append(len(nodes) - 1)
+
+
+def ellipse(half_x: float, half_y: float, segments: int = 48) -> list:
+    """Corners of a polygon of `segments` sides with the area of the ellipse
+    of half-axes `half_x`, `half_y` (its corners a little outside it), in
+    the plane z = 0, counter-clockwise seen from +z."""
+    # A regular n-gon inscribed in a circle of radius r has area
+    # n r² sin(2π/n) / 2: scaled to the circle's π r².
+    grow = math.sqrt(2 * math.pi / (segments * math.sin(2 * math.pi / segments)))
+    return [(half_x * grow * math.cos(2 * math.pi * i / segments),
+             half_y * grow * math.sin(2 * math.pi * i / segments), 0.0) for i in range(segments)]

@@ -1,0 +1,152 @@
+"""The scenes the add-on's tests render, built in Blender's Python as a
+user would build them."""
+
+import math
+
+import bpy
+
+
+def principled(name, color, roughness=0.5, metallic=0.0, specular=0.5, emission=None, strength=0.0):
+    m = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        m.use_nodes = True
+    p = m.node_tree.nodes["Principled BSDF"]
+    p.distribution = "GGX"
+    p.inputs["Base Color"].default_value = (*color, 1.0)
+    p.inputs["Roughness"].default_value = roughness
+    p.inputs["Metallic"].default_value = metallic
+    p.inputs["Specular IOR Level"].default_value = specular
+    if emission is not None:
+        p.inputs["Emission Color"].default_value = (*emission, 1.0)
+        p.inputs["Emission Strength"].default_value = strength
+    return m
+
+
+def box(name, location, size, material):
+    bpy.ops.mesh.primitive_cube_add(location=location)
+    o = bpy.context.object
+    o.name = name
+    o.scale = (size[0] / 2, size[1] / 2, size[2] / 2)
+    bpy.ops.object.transform_apply(scale=True)
+    o.data.materials.append(material)
+    return o
+
+
+def empty_scene(width=64, height=48):
+    # The startup file's settings with no data; unlike a factory reset it
+    # keeps the preferences, and with them the installed add-on.
+    bpy.ops.wm.read_homefile(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.resolution_percentage = 100
+    scene.view_settings.view_transform = "Standard"
+    return scene
+
+
+def camera(scene, location, rotation_deg, lens=30.0):
+    bpy.ops.object.camera_add(location=location)
+    cam = bpy.context.object
+    cam.rotation_euler = tuple(math.radians(a) for a in rotation_deg)
+    cam.data.lens = lens
+    scene.camera = cam
+    return cam
+
+
+def world_color(scene, color, strength=1.0):
+    world = bpy.data.worlds.new("sky")
+    scene.world = world
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
+    background = world.node_tree.nodes["Background"]
+    background.inputs["Color"].default_value = (*color, 1.0)
+    background.inputs["Strength"].default_value = strength
+    return world
+
+
+def light(kind, location, energy, rotation_deg=(0, 0, 0), **data):
+    bpy.ops.object.light_add(type=kind, location=location)
+    o = bpy.context.object
+    o.rotation_euler = tuple(math.radians(a) for a in rotation_deg)
+    o.data.energy = energy
+    for key, value in data.items():
+        setattr(o.data, key, value)
+    return o
+
+
+def floor_and_balls(scene):
+    """A grey floor and back wall, a plastic and a metal ball, a world of
+    dim blue, a camera: what the lights of each test fall on."""
+    grey = principled("grey", (0.5, 0.5, 0.5), roughness=1.0, specular=0.0)
+    box("floor", (0, 0, -0.05), (8, 6, 0.1), grey)
+    box("wall", (0, 2.0, 1.5), (8, 0.2, 3), grey)
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.6, location=(-0.8, 0, 0.6))
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(principled("plastic", (0.7, 0.15, 0.1), roughness=0.4))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.6, location=(0.8, 0, 0.6))
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(principled("metal", (0.9, 0.8, 0.5), roughness=0.3, metallic=1.0))
+    world_color(scene, (0.05, 0.06, 0.1))
+    camera(scene, (0, -6, 1.6), (84, 0, 0))
+
+
+def cycles(scene, samples, seed=0):
+    """Cycles as the comparisons take it: CPU, no denoising, box filter,
+    GGX, bounces as hikari's."""
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.seed = seed
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.filter_width = 1.0
+    for attr in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
+        setattr(scene.cycles, attr, 16)
+    scene.cycles.blur_glossy = 0.0
+    scene.cycles.sample_clamp_direct = 0.0
+    scene.cycles.sample_clamp_indirect = 0.0
+
+
+def render_to(scene, path):
+    """Renders the current frame to a multilayer EXR at `path`."""
+    settings = scene.render.image_settings
+    if hasattr(settings, "media_type"):
+        settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    settings.color_depth = "32"
+    scene.render.filepath = str(path)
+    bpy.ops.render.render(write_still=True)
+
+
+def checker_floor_material():
+    """A Principled BSDF whose Base Color is an 8 × 8 checker image (two
+    greys, sRGB-encoded 0.25 and 0.6), as an artist's textured floor. 256
+    texels a side: the squares' edges are sharp (a coarse image's bilinear
+    ramps, which Cycles and hikari place a fraction of a texel apart, made
+    blocks straddling an edge differ by 10%)."""
+    import numpy as np
+
+    image = bpy.data.images.new("checker", 256, 256, alpha=False)
+    squares = (np.indices((256, 256)) // 32).sum(axis=0) % 2
+    value = np.where(squares == 0, 0.25, 0.6).astype(np.float32)
+    rgba = np.stack([value, value, value, np.ones_like(value)], axis=-1)
+    image.pixels.foreach_set(rgba.ravel())
+    image.pack()
+    m = principled("checker floor", (1, 1, 1), roughness=1.0, specular=0.0)
+    nodes = m.node_tree.nodes
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    m.node_tree.links.new(texture.outputs["Color"], nodes["Principled BSDF"].inputs["Base Color"])
+    return m
+
+
+def lit_stage(scene):
+    """floor_and_balls on a checker floor, lit by a sun, a spot, an area
+    light (out of view) and an emissive strip on the wall."""
+    floor_and_balls(scene)
+    bpy.data.objects["floor"].data.materials[0] = checker_floor_material()
+    light("SUN", (0, 0, 5), 2.0, (40, 0, 30))
+    light("SPOT", (2.5, -2.0, 3.0), 400.0, (45, 0, 50), spot_size=math.radians(60), spot_blend=0.2,
+          shadow_soft_size=0.0)
+    light("AREA", (0, -2, 3.8), 300.0, size=1.0)
+    glow = principled("glow", (0, 0, 0), emission=(1.0, 0.8, 0.5), strength=4.0)
+    box("strip", (0, 1.88, 2.4), (3, 0.04, 0.1), glow)

@@ -1,0 +1,166 @@
+"""F12 with engine HIKARI against Cycles, its passes, a frame range, and
+the warnings for what it cannot read."""
+
+import logging
+
+import bpy
+import numpy as np
+import pytest
+import stage
+from exr import blocks, read_passes
+
+RENDERERS = ["gpu", "photon-cpu", "path", "vcm"]
+
+
+def hikari(scene, renderer="path", passes=32, seed=0):
+    scene.render.engine = "HIKARI"
+    settings = scene.hikari
+    settings.renderer = renderer
+    settings.passes, settings.time_limit, settings.target_error = passes, 0.0, 0.0
+    settings.photons, settings.seed = 20_000, seed
+
+
+def test_the_engine_and_its_settings_are_registered(addon):
+    scene = stage.empty_scene()
+    scene.render.engine = "HIKARI"  # a TypeError for an engine nobody registered
+    assert scene.render.engine == "HIKARI"
+    items = scene.hikari.bl_rna.properties["renderer"].enum_items
+    assert [i.identifier for i in items] == RENDERERS
+    for name in ["time_limit", "passes", "target_error", "photons", "seed", "threads"]:
+        assert name in scene.hikari.bl_rna.properties, name
+
+
+@pytest.fixture(scope="module")
+def renders(addon, tmp_path_factory):
+    """The lit stage rendered by hikari's path tracer with two seeds and by
+    Cycles with two seeds (all passes)."""
+    out = tmp_path_factory.mktemp("stage")
+    scene = stage.empty_scene()
+    stage.lit_stage(scene)
+    paths = {}
+    for seed in [0, 1]:
+        hikari(scene, passes=32, seed=seed)
+        stage.render_to(scene, out / f"hikari{seed}.exr")
+        paths[f"hikari{seed}"] = out / f"hikari{seed}.exr"
+    scene.view_layers[0].use_pass_z = True
+    scene.view_layers[0].cycles.denoising_store_passes = True
+    for seed in [0, 1]:
+        stage.cycles(scene, 128, seed=seed)
+        stage.render_to(scene, out / f"cycles{seed}.exr")
+        paths[f"cycles{seed}"] = out / f"cycles{seed}.exr"
+    return {key: read_passes(path) for key, path in paths.items()} | {"scene": scene, "out": out}
+
+
+def test_the_stage_matches_cycles(renders):
+    """Sun, spot, area light, emissive strip, world colour, checker floor,
+    plastic and metal: the mean within 3% of Cycles', each 16 × 16 block
+    within what the renders' noise allows (three standard deviations of
+    the difference of the two means, from each renderer's two seeds) plus
+    1.5% of the mean for what the two renderers draw differently."""
+    h = [renders[f"hikari{s}"]["Combined"][:, :, :3] for s in (0, 1)]
+    c = [renders[f"cycles{s}"]["Combined"][:, :, :3] for s in (0, 1)]
+    ours, theirs = (h[0] + h[1]) / 2, (c[0] + c[1]) / 2
+    mean = theirs.mean()
+    assert abs(ours.mean() / mean - 1) < 0.03, (ours.mean(), mean)
+    # The noise of a mean of two renders: half the two renders' difference.
+    noise = np.hypot(blocks(h[0] - h[1]) / 2, blocks(c[0] - c[1]) / 2)
+    error = np.abs(blocks(ours) - blocks(theirs))
+    allowed = 3 * noise + 0.015 * mean
+    print("block error / mean", np.round(error.mean(-1) / mean, 4), "noise / mean", np.round(noise.mean(-1) / mean, 4))
+    assert (error <= allowed).all(), np.round(error.mean(-1) / mean, 4)
+
+
+@pytest.mark.parametrize("renderer, passes", [("gpu", 8), ("photon-cpu", 8), ("vcm", 8)])
+def test_every_renderer_draws_the_stage_as_cycles_does(renders, renderer, passes, caplog):
+    """The other renderers from the same export: the mean within 3% of
+    Cycles', and the GPU renderer on the GPU (no fallback warning)."""
+    scene = renders["scene"]
+    hikari(scene, renderer=renderer, passes=passes)
+    with caplog.at_level(logging.WARNING, logger="hikari_blender"):
+        stage.render_to(scene, renders["out"] / f"{renderer}.exr")
+    ours = read_passes(renders["out"] / f"{renderer}.exr")["Combined"][:, :, :3]
+    theirs = (renders["cycles0"]["Combined"][:, :, :3] + renders["cycles1"]["Combined"][:, :, :3]) / 2
+    print(f"{renderer}: mean {ours.mean() / theirs.mean():.4f} of Cycles'")
+    assert abs(ours.mean() / theirs.mean() - 1) < 0.03, (ours.mean(), theirs.mean())
+    fallbacks = [r.getMessage() for r in caplog.records if "instead" in r.getMessage()]
+    assert not fallbacks, fallbacks
+
+
+def test_the_passes_blenders_denoiser_takes(renders):
+    """Combined, Denoising Albedo, Denoising Normal and Depth, under those
+    names, as Cycles writes them: the normal in the camera's frame, the
+    depth along its axis, the albedo the checker's and the walls' greys."""
+    ours, theirs = renders["hikari0"], renders["cycles0"]
+    for name in ["Combined", "Denoising Albedo", "Denoising Normal", "Depth"]:
+        assert name in ours, (name, sorted(ours))
+        assert np.isfinite(ours[name]).all(), name
+    assert (ours["Combined"][:, :, 3] == 1).all()
+    # Where both see the same surface (not across an edge): equal.
+    depth_ours, depth_theirs = ours["Depth"], theirs["Depth"]
+    same = np.abs(depth_ours / depth_theirs - 1) < 1e-3
+    assert same.mean() > 0.9, same.mean()
+    background = depth_theirs >= 1e9
+    assert (depth_ours[background] >= 1e9).all()
+    normal_ours, normal_theirs = ours["Denoising Normal"], theirs["Denoising Normal"]
+    flat = same & (np.abs(normal_theirs - normal_theirs.mean(axis=(0, 1))).max(-1) < 1)
+    assert np.median(np.abs(normal_ours - normal_theirs).max(-1)[same]) < 0.01
+    assert np.allclose(np.linalg.norm(normal_ours[~background], axis=-1), 1, atol=1e-3)
+    assert flat.any()
+    # The wall (seen straight on above the balls) is grey 0.5; the floor
+    # shows the checker's two greys, decoded from sRGB as Blender decodes
+    # a byte image (0.25 → 0.0508, 0.6 → 0.3185).
+    albedo = ours["Denoising Albedo"]
+    assert np.allclose(albedo[20, 8:20], 0.5, atol=1e-3), albedo[20, 8:20]
+    def linear(c):
+        return ((c + 0.055) / 1.055) ** 2.4
+    floor = albedo[-10:-4, :, 0].ravel()
+    assert np.isclose(floor.min(), linear(0.25), atol=0.002) and np.isclose(floor.max(), linear(0.6), atol=0.002), (
+        floor.min(), floor.max())
+    assert np.allclose(albedo[-10:-4, :4], theirs["Denoising Albedo"][-10:-4, :4], atol=0.002)
+
+
+def test_a_frame_range_renders_each_frame_at_its_time(addon, tmp_path):
+    """Ctrl-F12 over two frames of a ball keyed to move to the right: two
+    files, the red ball's centroid further right in the second."""
+    scene = stage.empty_scene()
+    stage.floor_and_balls(scene)
+    stage.light("SUN", (0, 0, 5), 3.0, (40, 0, 30))
+    ball = next(o for o in scene.objects if o.data and o.data.materials and o.data.materials[0].name == "plastic")
+    ball.location.x = -1.5
+    ball.keyframe_insert("location", frame=1)
+    ball.location.x = 0.0
+    ball.keyframe_insert("location", frame=2)
+    scene.frame_start, scene.frame_end = 1, 2
+    hikari(scene, passes=4)
+    settings = scene.render.image_settings
+    if hasattr(settings, "media_type"):
+        settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    scene.render.filepath = str(tmp_path / "frame_")
+    bpy.ops.render.render(animation=True)
+    centroids = []
+    for frame in [1, 2]:
+        rgb = read_passes(tmp_path / f"frame_{frame:04d}.exr")["Combined"][:, :, :3]
+        red = (rgb[:, :, 0] > 2 * rgb[:, :, 1]) & (rgb[:, :, 0] > 0.05)
+        assert red.sum() > 20, frame
+        centroids.append(np.nonzero(red)[1].mean())
+    assert centroids[1] > centroids[0] + 5, centroids
+
+
+def test_what_cannot_be_read_is_a_warning(addon, tmp_path, caplog):
+    """Lens shift, an area light the camera sees though Blender hides it, a
+    sky texture driving the world: one warning each, and the render goes on."""
+    scene = stage.empty_scene()
+    stage.floor_and_balls(scene)
+    scene.camera.data.shift_x = 0.1
+    stage.light("AREA", (0, -1, 3), 300.0, size=1.0)
+    tree = scene.world.node_tree
+    sky = tree.nodes.new("ShaderNodeTexSky")
+    tree.links.new(sky.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    hikari(scene, passes=1)
+    with caplog.at_level(logging.WARNING, logger="hikari_blender"):
+        stage.render_to(scene, tmp_path / "warned.exr")
+    messages = [r.getMessage() for r in caplog.records if r.name == "hikari_blender"]
+    for expected in ["lens shift", "the camera sees this area light", "Sky Texture"]:
+        assert any(expected in m for m in messages), (expected, messages)
+    assert read_passes(tmp_path / "warned.exr")["Combined"].mean() > 0
