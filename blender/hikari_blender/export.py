@@ -184,6 +184,47 @@ def world_environment(world, path: str):
     return path, notes
 
 
+# Shader nodes the glTF exporter turns into glTF material properties (a
+# Principled BSDF and what feeds it: image textures with their UV maps and
+# mapping, channel splits, factors, emission, the unlit and transparent
+# mixes, its "glTF Material Output" group). Any other node on the way to
+# the Material Output is dropped by the exporter, and so unseen by hikari.
+EXPORTED_NODES = {
+    "OUTPUT_MATERIAL", "BSDF_PRINCIPLED", "EMISSION", "BSDF_TRANSPARENT", "MIX_SHADER", "ADD_SHADER",
+    "LIGHT_PATH", "TEX_IMAGE", "NORMAL_MAP", "MAPPING", "UVMAP", "TEX_COORD", "SEPARATE_COLOR", "SEPARATE_RGB",
+    "MIX", "MIX_RGB", "MATH", "RGB", "VALUE", "VERTEX_COLOR", "ATTRIBUTE", "GROUP", "GROUP_INPUT",
+    "GROUP_OUTPUT", "REROUTE", "AMBIENT_OCCLUSION",
+}
+
+
+def material_warnings(material) -> list:
+    """What of `material`'s node tree the glTF exporter does not write."""
+    tree = material.node_tree
+    if tree is None:
+        return []
+    output = next((n for n in tree.nodes if n.type == "OUTPUT_MATERIAL" and n.is_active_output), None)
+    if output is None:
+        return [f"material {material.name}: no Material Output; drawn as the exporter's default grey"]
+    notes = []
+    for socket, what in [("Volume", "its volume shader"), ("Displacement", "its displacement")]:
+        if socket in output.inputs and output.inputs[socket].links:
+            notes.append(f"material {material.name}: {what} is not exported (not drawn)")
+    unread, seen, stack = [], set(), [link.from_node for link in output.inputs["Surface"].links]
+    while stack:
+        node = stack.pop()
+        if node.name in seen:
+            continue
+        seen.add(node.name)
+        if node.type not in EXPORTED_NODES:
+            unread.append(node.bl_label or node.type)
+            continue
+        stack.extend(link.from_node for socket in node.inputs for link in socket.links)
+    if unread:
+        names = ", ".join(sorted(set(unread)))
+        notes.append(f"material {material.name}: {names} not exported by the glTF exporter (drawn without)")
+    return notes
+
+
 def scene_warnings(scene, camera) -> list:
     notes = []
     render = scene.render
@@ -236,8 +277,12 @@ def export_scene(depsgraph, directory: str) -> Exported:
     with open(glb_path, "rb") as f:
         glb = Glb(f.read())
     added = 0
+    materials = {}
     for instance in depsgraph.object_instances:
         obj = instance.object
+        for slot in getattr(obj, "material_slots", []):
+            if slot.material is not None:
+                materials[slot.material.name] = slot.material
         if obj.type != "LIGHT":
             continue
         light = obj.data
@@ -253,6 +298,8 @@ def export_scene(depsgraph, directory: str) -> Exported:
                             "(Visibility > Ray Visibility > Camera is off); hikari draws it")
         glb.add_emitter(f"area light {obj.name}", polygon, area_light_radiance(light, area))
         added += 1
+    for material in materials.values():
+        warnings += material_warnings(material)
     if added + match_spot_blends(glb, scene):
         with open(glb_path, "wb") as f:
             f.write(glb.to_bytes())
