@@ -150,3 +150,35 @@ def lit_stage(scene):
     light("AREA", (0, -2, 3.8), 300.0, size=1.0)
     glow = principled("glow", (0, 0, 0), emission=(1.0, 0.8, 0.5), strength=4.0)
     box("strip", (0, 1.88, 2.4), (3, 0.04, 0.1), glow)
+
+
+def room(scene):
+    """The issue's room: 6 m × 6 m × 3 m inside, lit by a sun through a
+    window in its left wall (and the sky's light with it), a spot on the
+    ceiling and an emissive strip on the right wall; a checker floor, a
+    plastic and a metal ball; the camera in a corner of the room."""
+    white = principled("plaster", (0.7, 0.7, 0.7), roughness=1.0, specular=0.0)
+    floor = box("floor", (0, 0, -0.1), (6.4, 6.4, 0.2), checker_floor_material())
+    floor.data.materials[0] = bpy.data.materials["checker floor"]
+    box("ceiling", (0, 0, 3.1), (6.4, 6.4, 0.2), white)
+    box("back", (0, 3.1, 1.5), (6.4, 0.2, 3.0), white)
+    box("front", (0, -3.1, 1.5), (6.4, 0.2, 3.0), white)
+    box("right", (3.1, 0, 1.5), (0.2, 6.0, 3.0), white)
+    # The left wall around a window 2 m wide, from 0.9 m to 2.3 m.
+    box("left below", (-3.1, 0, 0.45), (0.2, 6.0, 0.9), white)
+    box("left above", (-3.1, 0, 2.65), (0.2, 6.0, 0.7), white)
+    box("left back", (-3.1, 2.0, 1.6), (0.2, 2.0, 1.4), white)
+    box("left front", (-3.1, -2.0, 1.6), (0.2, 2.0, 1.4), white)
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.5, location=(-0.6, 1.0, 0.5))
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(principled("plastic", (0.7, 0.15, 0.1), roughness=0.4))
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.5, location=(0.8, 0.3, 0.5))
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(principled("metal", (0.9, 0.8, 0.5), roughness=0.3, metallic=1.0))
+    glow = principled("glow", (0, 0, 0), emission=(1.0, 0.8, 0.5), strength=6.0)
+    box("strip", (2.98, 0.5, 2.2), (0.04, 2.0, 0.1), glow)
+    world_color(scene, (0.3, 0.4, 0.6))
+    light("SUN", (-5, 0, 4), 4.0, (0, -55, 0))
+    light("SPOT", (0.8, 0.3, 2.95), 300.0, (0, 0, 0), spot_size=math.radians(50), spot_blend=0.3,
+          shadow_soft_size=0.0)
+    camera(scene, (1.8, -2.6, 1.6), (82, 0, 28), lens=16.0)

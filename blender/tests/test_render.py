@@ -30,33 +30,40 @@ def test_the_engine_and_its_settings_are_registered(addon):
         assert name in scene.hikari.bl_rna.properties, name
 
 
-@pytest.fixture(scope="module")
-def renders(addon, tmp_path_factory):
-    """The lit stage rendered by hikari's path tracer with two seeds and by
-    Cycles with two seeds (all passes)."""
-    out = tmp_path_factory.mktemp("stage")
+def render_both(out, build, hikari_passes, cycles_samples):
+    """The scene `build` makes, rendered by hikari's path tracer with two
+    seeds and by Cycles with two seeds (all passes): the passes of each."""
     scene = stage.empty_scene()
-    stage.lit_stage(scene)
+    build(scene)
     paths = {}
     for seed in [0, 1]:
-        hikari(scene, passes=32, seed=seed)
+        hikari(scene, passes=hikari_passes, seed=seed)
         stage.render_to(scene, out / f"hikari{seed}.exr")
         paths[f"hikari{seed}"] = out / f"hikari{seed}.exr"
     scene.view_layers[0].use_pass_z = True
     scene.view_layers[0].cycles.denoising_store_passes = True
     for seed in [0, 1]:
-        stage.cycles(scene, 128, seed=seed)
+        stage.cycles(scene, cycles_samples, seed=seed)
         stage.render_to(scene, out / f"cycles{seed}.exr")
         paths[f"cycles{seed}"] = out / f"cycles{seed}.exr"
-    return {key: read_passes(path) for key, path in paths.items()} | {"scene": scene, "out": out}
+    return {key: read_passes(path) for key, path in paths.items()} | {"out": out}
 
 
-def test_the_stage_matches_cycles(renders):
-    """Sun, spot, area light, emissive strip, world colour, checker floor,
-    plastic and metal: the mean within 3% of Cycles', each 16 × 16 block
-    within what the renders' noise allows (three standard deviations of
-    the difference of the two means, from each renderer's two seeds) plus
-    1.5% of the mean for what the two renderers draw differently."""
+@pytest.fixture(scope="module")
+def renders(addon, tmp_path_factory):
+    """The lit stage (stage.lit_stage)."""
+    return render_both(tmp_path_factory.mktemp("stage"), stage.lit_stage, 32, 128)
+
+
+def assert_matches_cycles(renders):
+    """The mean within 3% of Cycles', each 16 × 16 block within what the
+    renders' noise allows (three standard deviations of the difference of
+    the two means, from each renderer's two seeds) plus what the two draw
+    differently: 1.5% of the image's mean and 3% of the block's own. (In
+    the room, the block holding the gold ball under the spot is 2.5% above
+    Cycles' where the noise is 0.3%; with a diffuse ball in its place every
+    block is within 2%: Blender's metals take the F82-tint Fresnel where
+    glTF's, and hikari's, take Schlick's.)"""
     h = [renders[f"hikari{s}"]["Combined"][:, :, :3] for s in (0, 1)]
     c = [renders[f"cycles{s}"]["Combined"][:, :, :3] for s in (0, 1)]
     ours, theirs = (h[0] + h[1]) / 2, (c[0] + c[1]) / 2
@@ -65,16 +72,30 @@ def test_the_stage_matches_cycles(renders):
     # The noise of a mean of two renders: half the two renders' difference.
     noise = np.hypot(blocks(h[0] - h[1]) / 2, blocks(c[0] - c[1]) / 2)
     error = np.abs(blocks(ours) - blocks(theirs))
-    allowed = 3 * noise + 0.015 * mean
-    print("block error / mean", np.round(error.mean(-1) / mean, 4), "noise / mean", np.round(noise.mean(-1) / mean, 4))
+    allowed = 3 * noise + 0.015 * mean + 0.03 * blocks(theirs)
+    print(f"mean {ours.mean() / mean:.4f} of Cycles'; block error / mean", np.round(error.mean(-1) / mean, 4),
+          "noise / mean", np.round(noise.mean(-1) / mean, 4))
     assert (error <= allowed).all(), np.round(error.mean(-1) / mean, 4)
+
+
+def test_the_stage_matches_cycles(renders):
+    """Sun, spot, area light, emissive strip, world colour, checker floor,
+    plastic and metal, in the open."""
+    assert_matches_cycles(renders)
+
+
+def test_the_room_matches_cycles(addon, tmp_path):
+    """The issue's room: the sun and the sky through a window, a spot, an
+    emissive strip, a checker floor, plastic and metal; mostly indirect."""
+    assert_matches_cycles(render_both(tmp_path, stage.room, 32, 512))
 
 
 @pytest.mark.parametrize("renderer, passes", [("gpu", 8), ("photon-cpu", 8), ("vcm", 8)])
 def test_every_renderer_draws_the_stage_as_cycles_does(renders, renderer, passes, caplog):
     """The other renderers from the same export: the mean within 3% of
     Cycles', and the GPU renderer on the GPU (no fallback warning)."""
-    scene = renders["scene"]
+    scene = stage.empty_scene()
+    stage.lit_stage(scene)
     hikari(scene, renderer=renderer, passes=passes)
     with caplog.at_level(logging.WARNING, logger="hikari_blender"):
         stage.render_to(scene, renders["out"] / f"{renderer}.exr")
