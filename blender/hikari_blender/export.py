@@ -197,6 +197,29 @@ EXPORTED_NODES = {
 }
 
 
+def principled_unread(node) -> list:
+    """The Principled BSDF's settings neither glTF nor hikari carry, where
+    they change what it looks like (inputs left linked are the node walk's)."""
+
+    def value(name, default):
+        socket = node.inputs.get(name)
+        return default if socket is None else socket.default_value
+
+    unread = []
+    if value("Subsurface Weight", 0.0) > 0:
+        unread.append("subsurface scattering")
+    if value("Thin Film Thickness", 0.0) > 0:
+        unread.append("thin film")
+    if value("Diffuse Roughness", 0.0) > 0:
+        unread.append("diffuse roughness")
+    if value("Coat Weight", 0.0) > 0:
+        if tuple(value("Coat Tint", (1, 1, 1, 1)))[:3] != (1.0, 1.0, 1.0):
+            unread.append("coat tint")
+        if abs(value("Coat IOR", 1.5) - 1.5) > 1e-3:
+            unread.append("coat IOR other than 1.5")
+    return unread
+
+
 def material_warnings(material) -> list:
     """What of `material`'s node tree the glTF exporter does not write."""
     tree = material.node_tree
@@ -219,6 +242,9 @@ def material_warnings(material) -> list:
             unread.append(node.bl_label or node.type)
             continue
         stack.extend(link.from_node for socket in node.inputs for link in socket.links)
+    for node in tree.nodes:
+        if node.name in seen and node.type == "BSDF_PRINCIPLED":
+            notes += [f"material {material.name}: {what} is not drawn" for what in principled_unread(node)]
     if unread:
         names = ", ".join(sorted(set(unread)))
         notes.append(f"material {material.name}: {names} not exported by the glTF exporter (drawn without)")

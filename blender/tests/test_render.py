@@ -172,7 +172,8 @@ def test_a_frame_range_renders_each_frame_at_its_time(addon, tmp_path):
 
 def test_what_cannot_be_read_is_a_warning(addon, tmp_path, caplog):
     """Lens shift, an area light the camera sees though Blender hides it, a
-    sky texture driving the world, a noise texture on a material's colour:
+    sky texture driving the world, a noise texture on a material's colour,
+    subsurface scattering:
     one warning each, and the render goes on; the plain materials (the
     stage's Principled BSDFs, the checker's image texture) warn nothing."""
     scene = stage.empty_scene()
@@ -185,14 +186,16 @@ def test_what_cannot_be_read_is_a_warning(addon, tmp_path, caplog):
     metal = bpy.data.materials["metal"].node_tree
     noise = metal.nodes.new("ShaderNodeTexNoise")
     metal.links.new(noise.outputs["Color"], metal.nodes["Principled BSDF"].inputs["Base Color"])
+    bpy.data.materials["grey"].node_tree.nodes["Principled BSDF"].inputs["Subsurface Weight"].default_value = 0.3
     hikari(scene, passes=1)
     with caplog.at_level(logging.WARNING, logger="hikari_blender"):
         stage.render_to(scene, tmp_path / "warned.exr")
     messages = [r.getMessage() for r in caplog.records if r.name == "hikari_blender"]
     print(messages)
-    for expected in ["lens shift", "the camera sees this area light", "Sky Texture", "material metal: Noise Texture"]:
+    for expected in ["lens shift", "the camera sees this area light", "Sky Texture", "material metal: Noise Texture",
+                     "material grey: subsurface scattering is not drawn"]:
         assert any(expected in m for m in messages), (expected, messages)
-    assert not [m for m in messages if "material" in m and "metal" not in m], messages
+    assert not [m for m in messages if "material" in m and "metal" not in m and "grey" not in m], messages
     assert read_passes(tmp_path / "warned.exr")["Combined"].mean() > 0
 
 
