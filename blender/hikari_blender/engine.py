@@ -6,6 +6,7 @@ updating the render window after each pass; then the images Blender's
 denoiser takes."""
 
 import logging
+import os
 import tempfile
 import warnings
 
@@ -73,6 +74,24 @@ def depth_rect(depth: np.ndarray, fov_y_degrees: float) -> np.ndarray:
     return bottom_up(planar_depth(depth, fov_y_degrees)).reshape(-1, 1).astype(np.float32)
 
 
+class adapter_chosen:
+    """HIKARI_GPU (crates/gpu's adapter choice) set to the GPU setting for
+    one render, and put back by `restore`."""
+
+    VARIABLE = "HIKARI_GPU"
+
+    def __init__(self, wanted: str):
+        self.before = os.environ.get(self.VARIABLE)
+        if wanted.strip():
+            os.environ[self.VARIABLE] = wanted.strip()
+
+    def restore(self):
+        if self.before is None:
+            os.environ.pop(self.VARIABLE, None)
+        else:
+            os.environ[self.VARIABLE] = self.before
+
+
 class HikariRenderEngine(bpy.types.RenderEngine):
     bl_idname = "HIKARI"
     bl_label = "hikari"
@@ -123,10 +142,12 @@ class HikariRenderEngine(bpy.types.RenderEngine):
             self.report_caught(caught)
             result = self.begin_result(0, 0, width, height, layer=layer_name)
             camera = depsgraph.scene.camera
+            chosen = adapter_chosen(settings.gpu)
             axes = camera_axes(camera.evaluated_get(depsgraph).matrix_world if camera else np.eye(4))
             try:
                 self.render_passes(loaded, settings, (width, height), result, axes)
             finally:
+                chosen.restore()
                 self.report_caught(caught)
                 self.end_result(result)
 

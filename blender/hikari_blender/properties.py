@@ -24,6 +24,9 @@ class HikariSettings(bpy.types.PropertyGroup):
         name="Photons", description="Photon paths traced per pass", default=200_000, min=1_000, soft_max=10_000_000)
     seed: bpy.props.IntProperty(
         name="Seed", description="The same seed gives the same image whatever the thread count", default=0, min=0)
+    gpu: bpy.props.StringProperty(
+        name="GPU", description="The GPU renderer's adapter: its number or part of its name, as hikari's "
+        "HIKARI_GPU takes it (empty: the first that can)", default="")
     threads: bpy.props.IntProperty(
         name="Threads", description="CPU threads (0: all cores)", default=0, min=0, soft_max=256)
 

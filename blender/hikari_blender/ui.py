@@ -25,6 +25,9 @@ class HIKARI_PT_render(bpy.types.Panel):
         column.prop(settings, "target_error")
         layout.prop(settings, "photons")
         layout.prop(settings, "seed")
+        row = layout.row()
+        row.active = settings.renderer == "gpu"
+        row.prop(settings, "gpu")
         layout.prop(settings, "threads")
 
 

@@ -218,3 +218,25 @@ def test_the_frame_is_cycles_frame(addon, tmp_path, size, fit):
     assert ours.shape == (size[1], size[0])
     same = np.abs(ours / theirs - 1) < 1e-3
     assert same.mean() > 0.9, same.mean()
+
+
+def test_the_gpu_setting_picks_the_adapter(addon, tmp_path, caplog):
+    """The first GPU named by its number renders on it; one named by a name
+    no adapter has is refused with the adapters listed, and photon-cpu
+    renders instead (a warning, never a silent CPU render)."""
+    import os
+
+    scene = stage.empty_scene(32, 24)
+    stage.floor_and_balls(scene)
+    stage.light("SUN", (0, 0, 5), 3.0, (40, 0, 30))
+    hikari(scene, renderer="gpu", passes=1)
+    before = os.environ.get("HIKARI_GPU")
+    for wanted, refused in [("0", False), ("no such gpu", True)]:
+        scene.hikari.gpu = wanted
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="hikari_blender"):
+            stage.render_to(scene, tmp_path / "gpu.exr")
+        messages = [r.getMessage() for r in caplog.records]
+        assert any("HIKARI_GPU=no such gpu names none" in m for m in messages) == refused, messages
+        assert os.environ.get("HIKARI_GPU") == before
+        assert read_passes(tmp_path / "gpu.exr")["Combined"].mean() > 0
