@@ -74,6 +74,25 @@ def depth_rect(depth: np.ndarray, fov_y_degrees: float) -> np.ndarray:
     return bottom_up(planar_depth(depth, fov_y_degrees)).reshape(-1, 1).astype(np.float32)
 
 
+def status_line(renderer: str, p) -> str:
+    """What the status line says after pass `p`."""
+    noise = "noise not yet estimated" if p.noise is None else f"noise {p.noise:.2%}"
+    return f"hikari {renderer}: pass {p.index}, {noise}, {p.seconds:.1f} s"
+
+
+def fraction_done(kwargs, p) -> float:
+    """How far the passes are toward the first limit they will meet: the
+    time, the pass count, or the noise target (noise falls as 1/√passes)."""
+    fractions = [0.0]
+    if "time" in kwargs:
+        fractions.append(p.seconds / kwargs["time"])
+    if "passes" in kwargs:
+        fractions.append(p.index / kwargs["passes"])
+    if "target_error" in kwargs and p.noise:
+        fractions.append(min(1.0, (kwargs["target_error"] / p.noise) ** 2))
+    return min(1.0, max(fractions))
+
+
 class adapter_chosen:
     """HIKARI_GPU (crates/gpu's adapter choice) set to the GPU setting for
     one render, and put back by `restore`."""
@@ -158,10 +177,7 @@ class HikariRenderEngine(bpy.types.RenderEngine):
         self.update_stats("", f"hikari {settings.renderer}: first pass")
         for p in loaded.progressive(settings.renderer, resolution=resolution, **kwargs):
             combined.rect = combined_rect(p.image)
-            self.update_result(result)
-            noise = "not yet estimated" if p.noise is None else f"noise {p.noise:.2%}"
-            self.update_stats("", f"hikari {settings.renderer}: pass {p.index}, {noise}, {p.seconds:.1f} s")
-            self.update_progress(self.fraction_done(kwargs, p))
+            self.show_pass(result, status_line(settings.renderer, p), fraction_done(kwargs, p))
             if self.test_break():
                 break
         aovs = loaded.aovs(resolution=resolution)
@@ -169,16 +185,11 @@ class HikariRenderEngine(bpy.types.RenderEngine):
         layer.passes.find_by_name("Denoising Normal", "").rect = normal_rect(aovs["normal"], axes)
         layer.passes.find_by_name("Depth", "").rect = depth_rect(aovs["depth"], loaded.camera.fov_y)
 
-    @staticmethod
-    def fraction_done(kwargs, p) -> float:
-        fractions = [0.0]
-        if "time" in kwargs:
-            fractions.append(p.seconds / kwargs["time"])
-        if "passes" in kwargs:
-            fractions.append(p.index / kwargs["passes"])
-        if "target_error" in kwargs and p.noise:
-            fractions.append(min(1.0, (kwargs["target_error"] / p.noise) ** 2))
-        return min(1.0, max(fractions))
+    def show_pass(self, result, status: str, progress: float):
+        """The render window shows the mean so far, the status line `status`."""
+        self.update_result(result)
+        self.update_stats("", status)
+        self.update_progress(progress)
 
     def report_caught(self, caught):
         for w in caught:

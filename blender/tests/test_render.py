@@ -240,3 +240,25 @@ def test_the_gpu_setting_picks_the_adapter(addon, tmp_path, caplog):
         assert any("HIKARI_GPU=no such gpu names none" in m for m in messages) == refused, messages
         assert os.environ.get("HIKARI_GPU") == before
         assert read_passes(tmp_path / "gpu.exr")["Combined"].mean() > 0
+
+
+def test_the_render_window_shows_each_pass(addon, tmp_path, monkeypatch):
+    """Each pass shows the mean so far with the status line (pass, noise,
+    time); the progress reaches 1 at the last of `passes`."""
+    engine = addon.engine.HikariRenderEngine
+    shown = []
+    show_pass = engine.show_pass
+
+    def recording(self, result, status, progress):
+        shown.append((status, progress))
+        show_pass(self, result, status, progress)
+
+    monkeypatch.setattr(engine, "show_pass", recording)
+    scene = stage.empty_scene(32, 24)
+    stage.floor_and_balls(scene)
+    stage.light("SUN", (0, 0, 5), 3.0, (40, 0, 30))
+    hikari(scene, renderer="path", passes=3)
+    stage.render_to(scene, tmp_path / "passes.exr")
+    assert [status.split(",")[0] for status, _ in shown] == [f"hikari path: pass {i}" for i in (1, 2, 3)], shown
+    assert "noise " in shown[-1][0] and shown[-1][0].endswith(" s"), shown[-1]
+    assert [progress for _, progress in shown] == pytest.approx([1 / 3, 2 / 3, 1.0])
