@@ -629,6 +629,6 @@ impl Pass<'_> {
             self.factors.eta(scatter.in_medium()),
             &self.factors,
         );
-        eval.f * vertex.throughput * weight
+        eval.f * vertex.throughput * (weight * scatter.merge_weight(vertex.wo))
     }
 }

@@ -238,6 +238,21 @@ impl Scatter {
         self.wo
     }
 
+    /// What a light vertex merged here, arriving from `wi`, weighs beyond f:
+    /// on a reflecting surface whose shading normal is not its geometric
+    /// one, `estimate::shading_normal_factor` (the density of light vertices
+    /// is flux over the true surface, while f's connections and bounces
+    /// weigh cos θs: without it, merging and connecting estimated different
+    /// light, and MIS mixed them); 1 elsewhere (glass is evaluated in its
+    /// geometric frame, media have no normal).
+    pub fn merge_weight(&self, wi: Vec3) -> f32 {
+        match self.lobes {
+            Lobes::Medium(_) | Lobes::Glass(..) => 1.0,
+            _ if self.normal == self.geometric => 1.0,
+            _ => crate::estimate::shading_normal_factor(wi, self.normal, self.geometric),
+        }
+    }
+
     /// f and densities toward world direction `wi` (non-delta lobes);
     /// None where they carry nothing.
     pub fn evaluate(&self, wi: Vec3) -> Option<Evaluation> {
@@ -357,5 +372,40 @@ impl Scatter {
             return None;
         }
         Some(sampled)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    fn hit(shading_normal: Vec3) -> Hit {
+        Hit {
+            t: 1.0,
+            point: Vec3::ZERO,
+            geometric_normal: Vec3::Z,
+            shading_normal,
+            surface: 0,
+            prim: 0,
+            barycentrics: Vec2::ZERO,
+        }
+    }
+
+    /// A light vertex merged on a bent diffuse surface weighs
+    /// `shading_normal_factor` (as photon-cpu's gathers); on a flat one, on
+    /// glass and in a medium, 1.
+    #[test]
+    fn merges_weigh_the_shading_normal_where_it_bends() {
+        let diffuse = Material::Diffuse { albedo: Rgb::splat(0.5), specular: Rgb::ZERO };
+        let bent = Vec3::new(0.5f32.sin(), 0.0, 0.5f32.cos());
+        let down = Vec3::new(0.0, 0.3, -1.0).normalize();
+        let wi = Vec3::new(0.6, 0.0, 0.8);
+        let at = |n: Vec3, m: Material| Scatter::at(m, &hit(n), down, Transport::Radiance).unwrap();
+        let weight = at(bent, diffuse).merge_weight(wi);
+        assert!((weight - crate::estimate::shading_normal_factor(wi, bent, Vec3::Z)).abs() < 1e-6);
+        assert!((weight - wi.dot(bent) / 0.8).abs() < 1e-5, "{weight}");
+        assert_eq!(at(Vec3::Z, diffuse).merge_weight(wi), 1.0);
+        assert_eq!(at(bent, Material::Glass(Dielectric::clear(1.5))).merge_weight(wi), 1.0);
     }
 }
