@@ -182,3 +182,26 @@ def room(scene):
     light("SPOT", (0.8, 0.3, 2.95), 300.0, (0, 0, 0), spot_size=math.radians(50), spot_blend=0.3,
           shadow_soft_size=0.0)
     camera(scene, (1.8, -2.6, 1.6), (82, 0, 28), lens=16.0)
+
+
+def hdri_world(scene, strength=1.5):
+    """A world lit by an equirectangular float image (a bright warm band
+    low in the west, a blue zenith, a dark ground), as an HDRI would."""
+    import numpy as np
+
+    width, height = 64, 32
+    image = bpy.data.images.new("sky", width, height, alpha=False, float_buffer=True)
+    v, u = np.mgrid[0:height, 0:width] + 0.5
+    elevation = (0.5 - v / height) * np.pi  # Blender's rows run bottom to top: row 0 is the nadir
+    elevation = -elevation
+    blue = np.where(elevation > 0, 0.2 + 0.6 * np.sin(elevation), 0.05)
+    sun = np.exp(-(((u / width - 0.25) * 8) ** 2 + ((elevation - 0.3) * 6) ** 2)) * 20
+    rgba = np.stack([blue * 0.6 + sun, blue * 0.8 + sun * 0.8, blue + sun * 0.5, np.ones_like(blue)], axis=-1)
+    image.pixels.foreach_set(rgba.astype(np.float32).ravel())
+    image.pack()
+    world = world_color(scene, (0, 0, 0), strength)
+    tree = world.node_tree
+    texture = tree.nodes.new("ShaderNodeTexEnvironment")
+    texture.image = image
+    tree.links.new(texture.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    return world

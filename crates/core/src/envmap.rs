@@ -8,12 +8,17 @@
 //! −Z forward): a direction d toward the sky has
 //!
 //! ```text
-//! u = 0.5 + atan2(−d.z, −d.x) / 2π     v = acos(d.y) / π
+//! u = 0.5 + atan2(d.z, d.x) / 2π     v = acos(d.y) / π
 //! ```
 //!
 //! with (u, v) = (0, 0) the image's top-left corner: the top row is the
-//! zenith, the middle of the image looks along −X, its quarter to the right
-//! along −Z... Each texel holds a constant radiance (nearest texel, no
+//! zenith, the middle of the image looks along +X, its quarter to the left
+//! along −Z (Blender's +Y), to the right along +Z (Cycles'
+//! `direction_to_equirectangular`: u = ½ − atan2(y, x)/2π in Blender's
+//! Z-up frame, whose (x, y) are glTF's (x, −z)). Until 2026-12-07 hikari
+//! turned maps by 180° about the vertical (u = ½ + atan2(−z, −x)/2π): the
+//! Blender add-on's HDRI test found it, a sun in the map lighting the scene
+//! from behind. Each texel holds a constant radiance (nearest texel, no
 //! filtering), so the sampling density below is exactly proportional to
 //! what the lookup returns.
 //!
@@ -173,7 +178,7 @@ impl EnvironmentMap {
 
     /// The texture coordinates of direction `dir` (unit, toward the sky).
     pub fn uv(dir: Vec3) -> Vec2 {
-        let u = 0.5 + (-dir.z).atan2(-dir.x) / (2.0 * PI);
+        let u = 0.5 + dir.z.atan2(dir.x) / (2.0 * PI);
         let v = dir.y.clamp(-1.0, 1.0).acos() / PI;
         Vec2::new(u.rem_euclid(1.0), v)
     }
@@ -183,8 +188,8 @@ impl EnvironmentMap {
         let phi = (uv.x - 0.5) * 2.0 * PI;
         let theta = uv.y * PI;
         let (sin_t, cos_t) = theta.sin_cos();
-        // atan2(−z, −x) = φ: −x = r cos φ, −z = r sin φ.
-        Vec3::new(-sin_t * phi.cos(), cos_t, -sin_t * phi.sin())
+        // atan2(z, x) = φ: x = r cos φ, z = r sin φ.
+        Vec3::new(sin_t * phi.cos(), cos_t, sin_t * phi.sin())
     }
 
     fn texel_index(&self, uv: Vec2) -> usize {
@@ -271,11 +276,16 @@ mod tests {
             let back = EnvironmentMap::direction(EnvironmentMap::uv(d));
             assert!((back - d).length() < 1e-4, "{d} → {back}");
         }
-        // Blender's layout: the zenith on the top row, −X in the middle,
-        // −Z a quarter to its right.
+        // Blender's layout, worked out from Cycles' u = ½ − atan2(y, x)/2π
+        // in its Z-up frame: the zenith on the top row, +X in the middle,
+        // −Z (Blender's +Y) a quarter to its left, +Z a quarter to its right,
+        // −X at the seam.
         assert!(EnvironmentMap::uv(Vec3::Y).y < 1e-6);
-        assert!((EnvironmentMap::uv(-Vec3::X) - Vec2::new(0.5, 0.5)).length() < 1e-6);
-        assert!((EnvironmentMap::uv(-Vec3::Z) - Vec2::new(0.75, 0.5)).length() < 1e-6);
+        assert!((EnvironmentMap::uv(Vec3::X) - Vec2::new(0.5, 0.5)).length() < 1e-6);
+        assert!((EnvironmentMap::uv(-Vec3::Z) - Vec2::new(0.25, 0.5)).length() < 1e-6);
+        assert!((EnvironmentMap::uv(Vec3::Z) - Vec2::new(0.75, 0.5)).length() < 1e-6);
+        let seam = EnvironmentMap::uv(-Vec3::X).x;
+        assert!(seam < 1e-6 || seam > 1.0 - 1e-6, "{seam}");
     }
 
     #[test]

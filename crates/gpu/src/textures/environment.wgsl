@@ -9,8 +9,8 @@ fn environment_radiance(dir: vec3<f32>) -> vec3<f32> {
     if (!SKY_IMAGE || width == 0u) {
         return vec3<f32>(1.0);
     }
-    // u = ½ + atan2(−z, −x)/2π, v = acos(y)/π (Blender's layout).
-    let u = 0.5 + atan2(-dir.z, -dir.x) / (2.0 * PI);
+    // u = ½ + atan2(z, x)/2π, v = acos(y)/π (Blender's layout).
+    let u = 0.5 + atan2(dir.z, dir.x) / (2.0 * PI);
     let v = acos(clamp(dir.y, -1.0, 1.0)) / PI;
     let x = min(u32((u - floor(u)) * f32(width)), width - 1u);
     let y = min(u32(v * f32(height)), height - 1u);

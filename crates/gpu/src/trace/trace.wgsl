@@ -366,7 +366,7 @@ fn sample_sky_image(at: u32, u: vec2<f32>) -> SkySample {
     let radiance = vec3<f32>(bitcast<f32>(texture_data[texel]), bitcast<f32>(texture_data[texel + 1u]), bitcast<f32>(texture_data[texel + 2u]));
     let phi = (uv.x - 0.5) * 2.0 * PI;
     let theta = uv.y * PI;
-    let dir = vec3<f32>(-sin(theta) * cos(phi), cos(theta), -sin(theta) * sin(phi));
+    let dir = vec3<f32>(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
     var weight = vec3<f32>(0.0);
     if (pdf > 0.0) {
         weight = select(vec3<f32>(0.0), radiance / (pdf * max(integral, vec3<f32>(1.0e-38))), integral > vec3<f32>(0.0));
