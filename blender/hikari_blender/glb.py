@@ -5,6 +5,7 @@ is added to its file here."""
 import json
 import math
 import struct
+import zlib
 
 MAGIC = 0x46546C67  # "glTF"
 JSON_CHUNK = 0x4E4F534A
@@ -45,13 +46,49 @@ class Glb:
             chunks += struct.pack("<II", len(binary), BIN_CHUNK) + binary
         return struct.pack("<III", MAGIC, 2, 12 + len(chunks)) + chunks
 
-    def _append(self, data: bytes, target: int) -> int:
+    def _append(self, data: bytes, target: int | None) -> int:
         """A buffer view of `data` at the end of the binary buffer: its index."""
         self.bin += b"\0" * (-len(self.bin) % 4)
         views = self.json.setdefault("bufferViews", [])
-        views.append({"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data), "target": target})
+        view = {"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data)}
+        if target is not None:
+            view["target"] = target
+        views.append(view)
         self.bin += data
         return len(views) - 1
+
+    def replace_image(self, index: int, png: bytes) -> None:
+        """Image `index` becomes the PNG `png` (the old bytes stay, unused)."""
+        image = self.json["images"][index]
+        image.pop("uri", None)
+        image["mimeType"] = "image/png"
+        image["bufferView"] = self._append(png, None)
+
+    def color_images(self) -> dict:
+        """For each image a material reads: whether every use reads it as
+        colour (sRGB: base colour, emission, sheen and specular colour) —
+        True — or some use reads it as data (normals, roughness…) — False."""
+        srgb_slots = {"baseColorTexture", "emissiveTexture", "sheenColorTexture", "specularColorTexture"}
+        textures = self.json.get("textures", [])
+        uses = {}
+
+        def visit(node):
+            if isinstance(node, dict):
+                for key, value in node.items():
+                    if key.endswith("Texture") and isinstance(value, dict) and "index" in value:
+                        texture = textures[value["index"]] if value["index"] < len(textures) else {}
+                        source = texture.get("source")
+                        if source is None:
+                            source = texture.get("extensions", {}).get("EXT_texture_webp", {}).get("source")
+                        if source is not None:
+                            uses[source] = uses.get(source, True) and key in srgb_slots
+                    visit(value)
+            elif isinstance(node, list):
+                for value in node:
+                    visit(value)
+
+        visit(self.json.get("materials", []))
+        return uses
 
     def add_emitter(self, name: str, polygon: list, radiance: tuple) -> None:
         """A flat, convex `polygon` (corners in glTF's frame, counter-clockwise
@@ -100,3 +137,16 @@ def ellipse(half_x: float, half_y: float, segments: int = 48) -> list:
     grow = math.sqrt(2 * math.pi / (segments * math.sin(2 * math.pi / segments)))
     return [(half_x * grow * math.cos(2 * math.pi * i / segments),
              half_y * grow * math.sin(2 * math.pi * i / segments), 0.0) for i in range(segments)]
+
+
+def png(rgba) -> bytes:
+    """An 8-bit RGBA PNG of `rgba` (a (height, width, 4) uint8 array, top row
+    first)."""
+    height, width, _ = rgba.shape
+    raw = b"".join(b"\0" + rgba[y].tobytes() for y in range(height))
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 6, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw, 6)) + chunk(b"IEND", b"")

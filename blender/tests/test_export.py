@@ -79,3 +79,26 @@ def test_a_glb_round_trips_byte_for_byte(Glb):
     assert Glb(data).to_bytes() == data
     with pytest.raises(ValueError, match="not a glTF"):
         Glb(b"nonsense" * 4)
+
+
+def test_which_images_are_read_as_colour(Glb, addon):
+    """An image only a base colour reads is colour; one a normal map also
+    reads is data somewhere (the add-on leaves it as exported, warned)."""
+    glb = empty_glb(Glb)
+    glb.json["textures"] = [{"source": 0}, {"source": 1}, {"source": 1}]
+    glb.json["images"] = [{"name": "a"}, {"name": "b"}]
+    glb.json["materials"] = [
+        {"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "normalTexture": {"index": 1}},
+        {"emissiveTexture": {"index": 2}},
+    ]
+    assert glb.color_images() == {0: True, 1: False}
+    import struct
+    import zlib
+
+    data = addon.glb.png(np.zeros((2, 3, 4), dtype=np.uint8))
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = struct.unpack(">II", data[16:24])
+    assert (width, height) == (3, 2)
+    idat = data.index(b"IDAT")
+    (length,) = struct.unpack(">I", data[idat - 4 : idat])
+    assert len(zlib.decompress(data[idat + 4 : idat + 4 + length])) == 2 * (1 + 3 * 4)

@@ -283,3 +283,37 @@ def test_an_hdri_world_lights_as_in_cycles(addon, tmp_path, caplog):
     assert abs(ours.mean() / theirs.mean() - 1) < 0.03
     # The sky seen directly (top rows): the image's texels, where they are.
     assert np.allclose(blocks(ours)[0], blocks(theirs)[0], rtol=0.03)
+
+
+def test_a_float_colour_texture_reads_as_in_blender(addon, tmp_path, caplog):
+    """A float image (colour space Linear Rec.709) as a plane's base colour:
+    Blender's exporter writes its values unconverted into a PNG that glTF
+    readers decode as sRGB (albedo mean 0.40 where Cycles' is 0.50); the
+    add-on writes it again as sRGB, and the albedo pass is Cycles'."""
+    scene = stage.empty_scene(32, 32)
+    image = bpy.data.images.new("linear checker", 4, 4, alpha=False, float_buffer=True)
+    value = np.where(np.indices((4, 4)).sum(axis=0) % 2 == 0, 0.1, 0.9).astype(np.float32)
+    image.pixels.foreach_set(np.stack([value, value, value, np.ones_like(value)], axis=-1).ravel())
+    image.pack()
+    material = stage.principled("linear", (1, 1, 1), roughness=1.0, specular=0.0)
+    texture = material.node_tree.nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    material.node_tree.links.new(texture.outputs["Color"], material.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+    bpy.ops.mesh.primitive_plane_add(size=2)
+    bpy.context.object.data.materials.append(material)
+    stage.world_color(scene, (1, 1, 1))
+    stage.camera(scene, (0, 0, 4), (0, 0, 0), lens=60)
+    hikari(scene, passes=1)
+    with caplog.at_level(logging.WARNING, logger="hikari_blender"):
+        stage.render_to(scene, tmp_path / "hikari.exr")
+    assert not [r.getMessage() for r in caplog.records if "image" in r.getMessage()]
+    stage.cycles(scene, 16)
+    scene.view_layers[0].cycles.denoising_store_passes = True
+    stage.render_to(scene, tmp_path / "cycles.exr")
+    ours = read_passes(tmp_path / "hikari.exr")["Denoising Albedo"][:, :, 0]
+    theirs = read_passes(tmp_path / "cycles.exr")["Denoising Albedo"][:, :, 0]
+    plane = ours > 0  # hikari's albedo is 0 where the world is seen, Cycles' 1
+    inside = plane & np.roll(plane, 2, 0) & np.roll(plane, -2, 0) & np.roll(plane, 2, 1) & np.roll(plane, -2, 1)
+    print(f"float texture: albedo mean {ours[inside].mean():.4f}, Cycles' {theirs[inside].mean():.4f}")
+    assert abs(ours[inside].mean() / theirs[inside].mean() - 1) < 0.01
+    assert np.abs(ours[inside] - theirs[inside]).max() < 0.03
