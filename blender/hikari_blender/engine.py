@@ -1,7 +1,7 @@
 """The render engine "HIKARI": F12 and Ctrl-F12 through hikari_render.
 
 Each render exports the evaluated scene (export.py) to a temporary
-directory, loads it with hikari's glTF loader and renders it pass by pass,
+directory, on Blender's main thread (main_thread.py), loads it with hikari's glTF loader and renders it pass by pass,
 updating the render window after each pass; then the images Blender's
 denoiser takes."""
 
@@ -13,7 +13,8 @@ import warnings
 import bpy
 import numpy as np
 
-from . import export
+from . import export, viewport
+from .main_thread import MainThreadUnavailable, run_on_main_thread
 
 # Blender's pass names, so the compositor's Denoise node and file outputs
 # take them: (name, channels, channel ids, socket type).
@@ -93,6 +94,23 @@ def fraction_done(kwargs, p) -> float:
     return min(1.0, max(fractions))
 
 
+def load_exported(exported, warn):
+    """hikari's scene from an export (hikari_render.SceneError where it
+    cannot load); the export's notes and the loader's warnings go to
+    warn(message)."""
+    import hikari_render as hk
+
+    for note in exported.warnings:
+        warn(note)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            return hk.load(exported.glb, camera=exported.camera, environment=exported.environment)
+        finally:
+            for w in caught:
+                warn(f"hikari: {w.message}")
+
+
 class adapter_chosen:
     """HIKARI_GPU (crates/gpu's adapter choice) set to the GPU setting for
     one render, and put back by `restore`."""
@@ -140,25 +158,19 @@ class HikariRenderEngine(bpy.types.RenderEngine):
         import hikari_render as hk
 
         settings = depsgraph.scene.hikari
-        if self.is_animation:
-            # The render moved the scene to its frame, but the exporter reads
-            # the view layer's own depsgraph, still at the first frame.
-            scene = depsgraph.scene
-            scene.frame_set(scene.frame_current, subframe=scene.frame_subframe)
         self.update_stats("", "hikari: exporting the scene")
-        exported = export.export_scene(depsgraph, directory)
-        for note in exported.warnings:
-            self.warn(note)
+        try:
+            exported = run_on_main_thread(lambda: self.export(depsgraph, directory))
+        except MainThreadUnavailable as e:
+            self.fail(f"hikari could not export the scene: {e}")
+            return
+        try:
+            loaded = load_exported(exported, self.warn)
+        except hk.SceneError as e:
+            self.fail(f"hikari could not load the exported scene: {e}")
+            return
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            try:
-                loaded = hk.load(exported.glb, camera=exported.camera, environment=exported.environment)
-            except hk.SceneError as e:
-                message = f"hikari could not load the exported scene: {e}"
-                log.error(message)
-                self.report({"ERROR"}, message)
-                return
-            self.report_caught(caught)
             result = self.begin_result(0, 0, width, height, layer=layer_name)
             camera = depsgraph.scene.camera
             chosen = adapter_chosen(settings.gpu)
@@ -170,6 +182,98 @@ class HikariRenderEngine(bpy.types.RenderEngine):
                 self.report_caught(caught)
                 self.end_result(result)
 
+    # The 3D view's Rendered shading (viewport.py). Blender calls
+    # view_update and view_draw on its main thread.
+
+    def view_update(self, context, depsgraph):
+        """The scene changed, or the view opened: export and load it again
+        and start the passes afresh."""
+        previous = getattr(self, "view", None)
+        if previous is not None:
+            previous.stop()
+        self.view = self.load_view(depsgraph)
+
+    def load_view(self, depsgraph):
+        import hikari_render as hk
+
+        settings = depsgraph.scene.hikari
+        with tempfile.TemporaryDirectory(prefix="hikari-viewport-") as directory:
+            try:
+                loaded = load_exported(export.export_scene(depsgraph, directory), self.note_once)
+            except hk.SceneError as e:
+                self.note_once(f"hikari could not load the exported scene: {e}")
+                return None
+
+        def redraw():
+            try:
+                self.tag_redraw()
+            except ReferenceError:  # the view was closed meanwhile
+                pass
+
+        return viewport.ProgressiveView(loaded, settings.renderer, settings.render_arguments(), on_pass=redraw)
+
+    def view_draw(self, context, depsgraph):
+        """The newest pass through the view's eye, started again when the
+        eye or the region's size changed."""
+        view = getattr(self, "view", None)
+        if view is None:
+            return
+        region, region_3d = context.region, context.region_data
+        camera = viewport.view_camera(region_3d.view_matrix, region_3d.window_matrix)
+        if camera is None:
+            self.update_stats("", "hikari draws perspective views only (numpad 5 switches)")
+            return
+        settings = depsgraph.scene.hikari
+        view.show(camera, viewport.render_size(region.width, region.height, settings.viewport_pixel_size))
+        shown = view.latest()
+        if view.error:
+            self.update_stats("", f"hikari: {view.error}")
+        if shown is None:
+            return
+        if getattr(self, "texture_key", None) != (shown.generation, shown.index):
+            self.texture = viewport.image_texture(shown.image)
+            self.texture_key = (shown.generation, shown.index)
+            noise = "" if shown.noise is None else f", noise {shown.noise:.2%}"
+            self.update_stats("", f"hikari {settings.renderer}: pass {shown.index}{noise}")
+        import gpu
+
+        gpu.state.blend_set("ALPHA_PREMULT")
+        self.bind_display_space_shader(depsgraph.scene)
+        viewport.draw_texture(self.texture, region.width, region.height)
+        self.unbind_display_space_shader()
+        gpu.state.blend_set("NONE")
+
+    def note_once(self, message: str):
+        """A warning for the viewport's renders, said once per view (they
+        export the scene again at every edit)."""
+        said = getattr(self, "said", None)
+        if said is None:
+            said = self.said = set()
+        if message not in said:
+            said.add(message)
+            log.warning(message)
+
+    def __del__(self):
+        """The viewport's passes stop when Blender frees the engine."""
+        try:
+            view = getattr(self, "view", None)
+        except ReferenceError:
+            view = None
+        if view is not None:
+            view.stop()
+        parent = getattr(super(), "__del__", None)
+        if parent is not None:
+            parent()
+
+    def export(self, depsgraph, directory):
+        """The evaluated scene as a glTF file (on Blender's main thread)."""
+        if self.is_animation:
+            # The render moved the scene to its frame, but the exporter reads
+            # the view layer's own depsgraph, still at the first frame.
+            scene = depsgraph.scene
+            scene.frame_set(scene.frame_current, subframe=scene.frame_subframe)
+        return export.export_scene(depsgraph, directory)
+
     def render_passes(self, loaded, settings, resolution, result, axes):
         layer = result.layers[0]
         combined = layer.passes.find_by_name("Combined", "")
@@ -178,12 +282,17 @@ class HikariRenderEngine(bpy.types.RenderEngine):
         for p in loaded.progressive(settings.renderer, resolution=resolution, **kwargs):
             combined.rect = combined_rect(p.image)
             self.show_pass(result, status_line(settings.renderer, p), fraction_done(kwargs, p))
-            if self.test_break():
+            if self.esc_pressed():
                 break
         aovs = loaded.aovs(resolution=resolution)
         layer.passes.find_by_name("Denoising Albedo", "").rect = bottom_up(aovs["albedo"]).reshape(-1, 3)
         layer.passes.find_by_name("Denoising Normal", "").rect = normal_rect(aovs["normal"], axes)
         layer.passes.find_by_name("Depth", "").rect = depth_rect(aovs["depth"], loaded.camera.fov_y)
+
+    def esc_pressed(self) -> bool:
+        """Whether the user asked the render to stop (Esc in the render
+        window); the passes so far stay as the result."""
+        return self.test_break()
 
     def show_pass(self, result, status: str, progress: float):
         """The render window shows the mean so far, the status line `status`."""
@@ -195,6 +304,10 @@ class HikariRenderEngine(bpy.types.RenderEngine):
         for w in caught:
             self.warn(f"hikari: {w.message}")
         caught.clear()
+
+    def fail(self, message: str):
+        log.error(message)
+        self.report({"ERROR"}, message)
 
     def warn(self, message: str):
         log.warning(message)

@@ -86,6 +86,18 @@ def srgb_bytes(linear) -> "np.ndarray":
     return np.round(encoded * 255).astype(np.uint8)
 
 
+def blender_image(name: str):
+    """The Blender image the exporter named `name`: the one of that name,
+    else the only one whose name less its extension is `name` (the
+    exporter names a file image "checker.png" "checker"); None where none
+    or several are."""
+    exact = bpy.data.images.get(name)
+    if exact is not None:
+        return exact
+    stems = [i for i in bpy.data.images if os.path.splitext(i.name)[0] == name]
+    return stems[0] if len(stems) == 1 else None
+
+
 def encode_linear_colour_images(glb: Glb):
     """Blender's exporter writes an image whose colour space is not sRGB (a
     float image, Linear or Non-Color) into its PNG as the values are, and
@@ -93,12 +105,19 @@ def encode_linear_colour_images(glb: Glb):
     with albedo mean 0.40 where Cycles' is 0.50. Such images, where every
     use reads them as colour, are written again from Blender's pixels,
     encoded as sRGB (alpha as it is). Returns how many, and warnings for
-    those also read as data (left as exported)."""
+    those also read as data (left as exported) and for colour images whose
+    Blender image cannot be told (their colour space unknown)."""
     count, notes = 0, []
     uses = glb.color_images()
     for index, image in enumerate(glb.json.get("images", [])):
-        source = bpy.data.images.get(image.get("name", ""))
-        if source is None or index not in uses or source.colorspace_settings.name.startswith("sRGB"):
+        if index not in uses:
+            continue
+        source = blender_image(image.get("name", ""))
+        if source is None:
+            notes.append(f"image {image.get('name', index)}: no one Blender image of that name; read as sRGB "
+                         "colour whatever its colour space")
+            continue
+        if source.colorspace_settings.name.startswith("sRGB"):
             continue
         if not uses[index]:
             notes.append(f"image {source.name}: in colour space {source.colorspace_settings.name}, read both as "

@@ -27,6 +27,9 @@ class HikariSettings(bpy.types.PropertyGroup):
     gpu: bpy.props.StringProperty(
         name="GPU", description="The GPU renderer's adapter: its number or part of its name, as hikari's "
         "HIKARI_GPU takes it (empty: the first that can)", default="")
+    viewport_pixel_size: bpy.props.IntProperty(
+        name="Viewport Pixel Size", description="The 3D view's Rendered shading renders one pixel per this many "
+        "pixels across (Cycles' Pixel Size)", default=2, min=1, max=16)
     threads: bpy.props.IntProperty(
         name="Threads", description="CPU threads (0: all cores)", default=0, min=0, soft_max=256)
 

@@ -29,6 +29,7 @@ class HIKARI_PT_render(bpy.types.Panel):
         row.active = settings.renderer == "gpu"
         row.prop(settings, "gpu")
         layout.prop(settings, "threads")
+        layout.prop(settings, "viewport_pixel_size")
 
 
 # Blender's own panels that edit what hikari reads: output size and

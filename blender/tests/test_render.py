@@ -285,16 +285,29 @@ def test_an_hdri_world_lights_as_in_cycles(addon, tmp_path, caplog):
     assert np.allclose(blocks(ours)[0], blocks(theirs)[0], rtol=0.03)
 
 
-def test_a_float_colour_texture_reads_as_in_blender(addon, tmp_path, caplog):
-    """A float image (colour space Linear Rec.709) as a plane's base colour:
-    Blender's exporter writes its values unconverted into a PNG that glTF
-    readers decode as sRGB (albedo mean 0.40 where Cycles' is 0.50); the
-    add-on writes it again as sRGB, and the albedo pass is Cycles'."""
+@pytest.mark.parametrize("kind", ["packed float", "png file"])
+def test_a_linear_colour_texture_reads_as_in_blender(addon, tmp_path, caplog, kind):
+    """A 0.1/0.9 checker in colour space Linear Rec.709 as a plane's base
+    colour, a packed float image or a PNG file (which the exporter names
+    after its file): Blender's exporter writes its values unconverted into
+    a PNG that glTF readers decode as sRGB (albedo mean 0.40 where Cycles'
+    is 0.50); the add-on writes it again as sRGB, and the albedo pass is
+    Cycles'."""
     scene = stage.empty_scene(32, 32)
-    image = bpy.data.images.new("linear checker", 4, 4, alpha=False, float_buffer=True)
     value = np.where(np.indices((4, 4)).sum(axis=0) % 2 == 0, 0.1, 0.9).astype(np.float32)
-    image.pixels.foreach_set(np.stack([value, value, value, np.ones_like(value)], axis=-1).ravel())
-    image.pack()
+    rgba = np.stack([value, value, value, np.ones_like(value)], axis=-1).ravel()
+    if kind == "packed float":
+        image = bpy.data.images.new("linear checker", 4, 4, alpha=False, float_buffer=True)
+        image.pixels.foreach_set(rgba)
+        image.pack()
+    else:
+        made = bpy.data.images.new("made", 4, 4, alpha=False)
+        made.pixels.foreach_set(rgba)
+        made.filepath_raw, made.file_format = str(tmp_path / "checker.png"), "PNG"
+        made.save()
+        bpy.data.images.remove(made)
+        image = bpy.data.images.load(str(tmp_path / "checker.png"))
+        image.colorspace_settings.name = "Linear Rec.709"
     material = stage.principled("linear", (1, 1, 1), roughness=1.0, specular=0.0)
     texture = material.node_tree.nodes.new("ShaderNodeTexImage")
     texture.image = image
@@ -314,6 +327,35 @@ def test_a_float_colour_texture_reads_as_in_blender(addon, tmp_path, caplog):
     theirs = read_passes(tmp_path / "cycles.exr")["Denoising Albedo"][:, :, 0]
     plane = ours > 0  # hikari's albedo is 0 where the world is seen, Cycles' 1
     inside = plane & np.roll(plane, 2, 0) & np.roll(plane, -2, 0) & np.roll(plane, 2, 1) & np.roll(plane, -2, 1)
-    print(f"float texture: albedo mean {ours[inside].mean():.4f}, Cycles' {theirs[inside].mean():.4f}")
+    print(f"{kind} texture: albedo mean {ours[inside].mean():.4f}, Cycles' {theirs[inside].mean():.4f}")
     assert abs(ours[inside].mean() / theirs[inside].mean() - 1) < 0.01
     assert np.abs(ours[inside] - theirs[inside]).max() < 0.03
+
+
+def test_esc_stops_with_the_mean_so_far(addon, tmp_path, monkeypatch):
+    """Esc (Blender's test_break true) after the second pass of a render with
+    no pass count and ten minutes to go: the render ends there, and its image is the mean of
+    those two passes, the same as a render of two passes."""
+    engine = addon.engine.HikariRenderEngine
+    asked = []
+
+    def esc_after_two(self):
+        asked.append(True)
+        return len(asked) >= 2
+
+    scene = stage.empty_scene(32, 24)
+    stage.floor_and_balls(scene)
+    stage.light("SUN", (0, 0, 5), 3.0, (40, 0, 30))
+    # A time limit makes both renders' passes open-ended ones (the path
+    # tracer's 4 samples a pass, where a fixed count takes 64 a pass).
+    hikari(scene, renderer="path", passes=2)
+    scene.hikari.time_limit = 600.0
+    stage.render_to(scene, tmp_path / "two.exr")
+    monkeypatch.setattr(engine, "esc_pressed", esc_after_two)
+    scene.hikari.passes = 0
+    stage.render_to(scene, tmp_path / "esc.exr")
+    assert len(asked) == 2
+    stopped = read_passes(tmp_path / "esc.exr")
+    assert stopped["Combined"].mean() > 0
+    assert np.array_equal(stopped["Combined"], read_passes(tmp_path / "two.exr")["Combined"])
+    assert "Denoising Albedo" in stopped and "Depth" in stopped
