@@ -352,6 +352,8 @@ def export_scene(depsgraph, directory: str) -> Exported:
             export_animations=False,
             # Else the exporter moves the scene to frame 0 to export it.
             export_current_frame=True,
+            # Geometry-nodes instances (else dropped without a word).
+            export_gn_mesh=True,
             export_skins=False,
             export_morph=False,
             export_yup=True,
@@ -386,7 +388,7 @@ def export_scene(depsgraph, directory: str) -> Exported:
         warnings += material_warnings(material)
     reencoded, notes = encode_linear_colour_images(glb)
     warnings += notes
-    if added + match_spot_blends(glb, scene) + reencoded:
+    if added + match_spot_blends(glb, scene) + reencoded + glb.drop_doubled_instances():
         with open(glb_path, "wb") as f:
             f.write(glb.to_bytes())
     environment, notes = world_environment(scene.world, os.path.join(directory, "world.exr"))

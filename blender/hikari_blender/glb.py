@@ -11,6 +11,8 @@ MAGIC = 0x46546C67  # "glTF"
 JSON_CHUNK = 0x4E4F534A
 BIN_CHUNK = 0x004E4942
 EMISSIVE_STRENGTH = "KHR_materials_emissive_strength"
+# The name Blender's exporter gives a geometry-nodes instance's node.
+GN_INSTANCE = "GN Instance"
 
 
 class Glb:
@@ -89,6 +91,43 @@ class Glb:
 
         visit(self.json.get("materials", []))
         return uses
+
+    def mesh_shape(self, index: int) -> tuple:
+        """What tells exported meshes apart without reading their buffers:
+        each primitive's material and its positions' count and bounds."""
+        accessors = self.json.get("accessors", [])
+        shape = []
+        for primitive in self.json["meshes"][index].get("primitives", []):
+            position = accessors[primitive.get("attributes", {}).get("POSITION", 0)] if accessors else {}
+            shape.append((primitive.get("material"), position.get("count"),
+                          tuple(round(v, 6) for v in position.get("min", ())),
+                          tuple(round(v, 6) for v in position.get("max", ()))))
+        return tuple(shape)
+
+    def drop_doubled_instances(self) -> int:
+        """With geometry-nodes instances on, Blender's exporter writes a
+        particle system's instances twice: as the instanced objects and as
+        "GN Instance" nodes of a copy of their mesh, at the same places.
+        Each "GN Instance" node with a sibling of the same transform and
+        the same mesh shape loses its mesh (the node stays, so no index
+        changes). Returns how many."""
+        nodes = self.json.get("nodes", [])
+        groups = [n.get("children", []) for n in nodes] + [s.get("nodes", []) for s in self.json.get("scenes", [])]
+
+        def placed(node):
+            where = tuple((key, tuple(round(v, 6) for v in node[key]))
+                          for key in ("matrix", "translation", "rotation", "scale") if key in node)
+            return where, self.mesh_shape(node["mesh"])
+
+        dropped = 0
+        for siblings in groups:
+            meshed = [nodes[i] for i in siblings if i < len(nodes) and "mesh" in nodes[i]]
+            plain = {placed(n) for n in meshed if not n.get("name", "").startswith(GN_INSTANCE)}
+            for node in meshed:
+                if node.get("name", "").startswith(GN_INSTANCE) and placed(node) in plain:
+                    del node["mesh"]
+                    dropped += 1
+        return dropped
 
     def add_emitter(self, name: str, polygon: list, radiance: tuple) -> None:
         """A flat, convex `polygon` (corners in glTF's frame, counter-clockwise

@@ -205,3 +205,41 @@ def hdri_world(scene, strength=1.5):
     texture.image = image
     tree.links.new(texture.outputs["Color"], tree.nodes["Background"].inputs["Color"])
     return world
+
+
+def instanced(scene):
+    """Things drawn as instances, each kind of Blender's: balls a geometry-
+    nodes modifier puts on a grid's points, cubes a hair particle system
+    scatters on a plane, and a collection instance; on a grey floor under
+    a sun."""
+    grey = principled("grey", (0.5, 0.5, 0.5), roughness=1.0, specular=0.0)
+    box("floor", (0, 0, -0.05), (8, 8, 0.1), grey)
+    bpy.ops.mesh.primitive_ico_sphere_add(radius=0.25, subdivisions=3, location=(0, 0, -20))
+    ball = bpy.context.object
+    ball.data.materials.append(principled("red", (0.8, 0.1, 0.1), roughness=0.6))
+    ball.hide_render = True  # drawn only where the modifier puts it
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=3, y_subdivisions=3, size=2, location=(-1.5, 0, 0.25))
+    tree = bpy.data.node_groups.new("balls on points", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    inputs, outputs = tree.nodes.new("NodeGroupInput"), tree.nodes.new("NodeGroupOutput")
+    on_points, info = tree.nodes.new("GeometryNodeInstanceOnPoints"), tree.nodes.new("GeometryNodeObjectInfo")
+    info.inputs["Object"].default_value = ball
+    tree.links.new(inputs.outputs[0], on_points.inputs["Points"])
+    tree.links.new(info.outputs["Geometry"], on_points.inputs["Instance"])
+    tree.links.new(on_points.outputs["Instances"], outputs.inputs[0])
+    bpy.context.object.modifiers.new("balls", "NODES").node_group = tree
+    things = bpy.data.collections.new("things")
+    cube = box("cube", (0, 0, 0.2), (0.4, 0.4, 0.4), principled("blue", (0.1, 0.2, 0.8), roughness=0.5))
+    for owner in cube.users_collection:
+        owner.objects.unlink(cube)
+    things.objects.link(cube)
+    bpy.ops.object.collection_instance_add(collection=things.name, location=(0, 1.5, 0))
+    bpy.ops.mesh.primitive_plane_add(size=2, location=(1.5, 0, 0.001))
+    bpy.context.object.data.materials.append(grey)
+    hair = bpy.context.object.modifiers.new("scatter", "PARTICLE_SYSTEM").particle_system.settings
+    hair.type, hair.count, hair.use_advanced_hair = "HAIR", 6, True
+    hair.render_type, hair.instance_object, hair.particle_size = "OBJECT", cube, 0.3
+    light("SUN", (0, 0, 5), 3.0, (35, 0, 25))
+    world_color(scene, (0.05, 0.06, 0.1))
+    camera(scene, (0, -5.5, 3.5), (58, 0, 0))
