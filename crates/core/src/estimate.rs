@@ -85,6 +85,20 @@ pub fn fixed_radius_radiance(
 /// reflects (a test integrates it); 4 lost 2.1% at 30°.
 pub const MAX_SHADING_NORMAL_FACTOR: f32 = 8.0;
 
+/// Below this cosine between the shading and the geometric normal a surface
+/// point counts as bent (`is_bent`): 0.26°, well above the rounding of an
+/// interpolated normal that equals the face's, well below any shading
+/// that shows.
+pub const BENT_COS: f32 = 0.99999;
+
+/// Whether a point shading with unit normal `ns` across unit `ng` weighs
+/// its photons by `shading_normal_factor` (smooth-shaded and normal-mapped
+/// meshes); elsewhere the factor is 1 up to rounding and is skipped.
+#[inline]
+pub fn is_bent(ns: Vec3, ng: Vec3) -> bool {
+    ns.dot(ng) < BENT_COS
+}
+
 /// What one photon arriving from `wi` (toward where it came from) counts for
 /// where the surface shades with normal `ns` but lies across `ng` (both on
 /// the side the eye sees): max(ns·ωi, 0) / |ng·ωi|, at most

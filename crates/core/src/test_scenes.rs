@@ -616,6 +616,18 @@ pub mod gltf_textures {
 /// point light 1 unit above its centre; no camera (loading frames it).
 /// What `examples/gltf_load` and `hikari bench`'s large-mesh row load.
 pub fn wavy_grid_glb(triangles: u64) -> Vec<u8> {
+    wave_glb(triangles, false)
+}
+
+/// [`wavy_grid_glb`] with the wave's own normals at its vertices: shaded
+/// smooth, so every point's shading normal is bent off its facet's (up to
+/// about 25°), where the photon gathers weigh
+/// `estimate::shading_normal_factor`.
+pub fn smooth_wavy_grid_glb(triangles: u64) -> Vec<u8> {
+    wave_glb(triangles, true)
+}
+
+fn wave_glb(triangles: u64, smooth: bool) -> Vec<u8> {
     use crate::scene::gltf::export::{GltfBuilder, PbrMaterial};
     use gltf::json;
     use gltf::json::extensions::scene::khr_lights_punctual::Type;
@@ -638,7 +650,15 @@ pub fn wavy_grid_glb(triangles: u64) -> Vec<u8> {
     let mut builder = GltfBuilder::new();
     // Lambertian (no specular lobe), so the GPU renderer draws it exactly.
     let material = builder.material(&PbrMaterial { base_color: Vec3::splat(0.7), specular: 0.0, ..Default::default() });
-    let mesh = builder.mesh(&positions, None, Some(&indices), Some(material));
+    // The height 0.05·sin 9x·cos 7z has the normal (−∂h/∂x, 1, −∂h/∂z).
+    let normals: Vec<Vec3> = positions
+        .iter()
+        .map(|p| {
+            let (dx, dz) = (0.45 * (9.0 * p.x).cos() * (7.0 * p.z).cos(), -0.35 * (9.0 * p.x).sin() * (7.0 * p.z).sin());
+            Vec3::new(-dx, 1.0, -dz).normalize()
+        })
+        .collect();
+    let mesh = builder.mesh(&positions, smooth.then_some(&normals[..]), Some(&indices), Some(material));
     let grid = builder.node(json::Node { mesh: Some(mesh), ..Default::default() });
     let light = builder.light(Type::Point, Vec3::ONE, 2000.0, None);
     let light = builder.node(GltfBuilder::light_node(light, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY));

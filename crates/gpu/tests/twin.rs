@@ -5,13 +5,14 @@
 
 use glam::Vec3;
 use hikari_core::bsdf::ShadingFrame;
-use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf};
+use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf, shading_normal_factor};
 use hikari_core::material::Material;
 use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_seed};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
+use hikari_gpu::gbuffer::geometric_normal::unpack_geometric_normal;
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuRenderer, GpuSettings};
@@ -24,6 +25,9 @@ struct TwinStats {
     within: usize,
     worst: f32,
     tolerance: f32,
+    /// Surface pixels whose shading normal is bent (the G-buffer's
+    /// position.w < 0): their photons weigh shading_normal_factor.
+    bent: usize,
 }
 
 fn twin(scene_name: &str, photons: u64, normal_test: bool, estimator: Estimator) -> Option<(TwinStats, TwinStats)> {
@@ -80,23 +84,31 @@ fn twin_pass(
     let caustic = gpu.read(&t.caustic).unwrap();
 
     let compare = |gpu_image: &[glam::Vec4], map, params: &FixedRadius| {
-        let mut stats = TwinStats { lit: 0, within: 0, worst: 0.0, tolerance };
+        let mut stats = TwinStats { lit: 0, within: 0, worst: 0.0, tolerance, bent: 0 };
         for i in 0..position.len() {
             if position[i].w == 0.0 || albedo[i].w != 0.0 {
                 continue; // no surface, or not diffuse
             }
             let (x, n) = (position[i].truncate(), normal[i].truncate());
+            // Where the shading normal is bent (position.w < 0), each
+            // photon also weighs shading_normal_factor across the
+            // geometric normal the G-buffer keeps, as photon-cpu's do.
+            let bent = position[i].w < 0.0;
+            stats.bent += bent as usize;
+            let ng = unpack_geometric_normal(position[i].w, n);
+            let across = |wi: Vec3| if bent { shading_normal_factor(wi, n, ng) } else { 1.0 };
             // The glTF BRDF weights each photon by f at its own direction
             // (the lobes the maps stand for); Lambertian surfaces by ρ/π.
             let material = scene.materials[scene.surfaces[normal[i].w as usize].material as usize];
+            let frame = ShadingFrame::new(n);
             let want = match material {
                 Material::Pbr(bsdf) if bsdf.is_glossy() => {
-                    let frame = ShadingFrame::new(n);
                     let wo = frame.to_local((scene.camera.position - x).normalize());
-                    fixed_radius_radiance_brdf(map, x, n, params, |wi| {
-                        let wi = frame.to_local(wi);
-                        bsdf.f_gathered(wo, wi)
-                    })
+                    fixed_radius_radiance_brdf(map, x, n, params, |wi| bsdf.f_gathered(wo, frame.to_local(wi)) * across(wi))
+                }
+                _ if bent => {
+                    let lambert = albedo[i].truncate() / std::f32::consts::PI;
+                    fixed_radius_radiance_brdf(map, x, n, params, |wi| lambert * across(wi))
                 }
                 _ => fixed_radius_radiance(map, None, x, n, albedo[i].truncate(), params),
             };
@@ -120,8 +132,8 @@ fn twin_pass(
 
 fn assert_twin(name: &str, stats: &TwinStats, min_lit: usize) {
     eprintln!(
-        "{name}: {} lit pixels, {} within {:e}, worst relative error {:e}",
-        stats.lit, stats.within, stats.tolerance, stats.worst
+        "{name}: {} lit pixels ({} bent), {} within {:e}, worst relative error {:e}",
+        stats.lit, stats.bent, stats.within, stats.tolerance, stats.worst
     );
     assert!(stats.lit >= min_lit, "{name}: only {} lit pixels", stats.lit);
     assert!(
@@ -210,6 +222,26 @@ fn gpu_splat_equals_cpu_estimate_under_a_sky_and_an_emissive_mesh() {
     }
 }
 
+/// The Cornell box with a white ball where cornell-caustic has its glass
+/// one: the G-buffer draws the ball tessellated with smooth normals, so
+/// its pixels' shading normals are bent off their facets' and each photon
+/// also weighs shading_normal_factor (as photon-cpu's), in both estimators.
+#[test]
+fn gpu_estimates_on_bent_normals_equal_cpu_estimates() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/cornell-caustic.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    assert_eq!(text.matches("material = \"glass\"").count(), 1, "cornell-caustic changed: update this test");
+    let text = text.replace("material = \"glass\"", "material = \"white\"");
+    let mut scene = Scene::from_toml(&text, "cornell box with a white ball", None).unwrap();
+    scene.camera = scene.camera.with_resolution(64, 64).unwrap();
+    for estimator in ESTIMATORS {
+        let (indirect, _) = twin_scene(scene.clone(), 20_000, false, estimator).expect("a twin");
+        let name = format!("white ball indirect ({estimator:?})");
+        assert_twin(&name, &indirect, 2000);
+        assert!(indirect.bent > 200, "{name}: only {} bent pixels", indirect.bent);
+    }
+}
+
 /// The glTF BRDF: photons weighted by f for their own directions, on a box
 /// of metals and dielectrics from roughness 0.1 to 1 (the smoother ones
 /// gathering their diffuse lobe only), both estimators, with and without
@@ -262,4 +294,37 @@ fn wgsl_shading_normal_factor_matches_the_cpu() {
         capped += (want == hikari_core::estimate::MAX_SHADING_NORMAL_FACTOR) as usize;
     }
     assert!(zeros > 100 && capped > 0, "{zeros} zeros, {capped} capped of {n}");
+}
+
+/// geometric_normal.wgsl's packing of the G-buffer's geometric normal, bit
+/// for bit as its Rust twin packs it, on random normals bent up to 30° and
+/// on unbent ones.
+#[test]
+fn wgsl_geometric_normal_packing_matches_the_cpu() {
+    use hikari_core::sampling::{Rng, uniform_sphere};
+    use hikari_gpu::gbuffer::geometric_normal::{GEOMETRIC_NORMAL, pack_geometric_normal};
+    let ctx = test_context("wgsl_geometric_normal_packing_matches_the_cpu");
+    let mut rng = Rng::for_item(29, 0);
+    let mut cases = Vec::new();
+    let mut input = vec![0u32; 4096 * 7];
+    for (k, item) in input.chunks_mut(7).enumerate() {
+        let ng = uniform_sphere(rng.next_2d());
+        let ns = if k % 4 == 0 { ng } else { (ng + uniform_sphere(rng.next_2d()) * 0.5 * rng.next_f32()).normalize() };
+        for (j, v) in [ns, ng].iter().flat_map(|v| v.to_array()).enumerate() {
+            item[j] = v.to_bits();
+        }
+        cases.push((ns, ng));
+    }
+    let main = "let o = 7u * id.x; if (o >= arrayLength(&io)) { return; }\n\
+                let ns = vec3<f32>(bitcast<f32>(io[o]), bitcast<f32>(io[o + 1u]), bitcast<f32>(io[o + 2u]));\n\
+                let ng = vec3<f32>(bitcast<f32>(io[o + 3u]), bitcast<f32>(io[o + 4u]), bitcast<f32>(io[o + 5u]));\n\
+                io[o + 6u] = bitcast<u32>(pack_geometric_normal(ns, ng));";
+    let gpu = hikari_gpu::test_support::run_kernel(&ctx, &[&GEOMETRIC_NORMAL], main, &input);
+    let mut bent = 0;
+    for (out, (ns, ng)) in gpu.chunks(7).zip(&cases) {
+        let (got, want) = (f32::from_bits(out[6]), pack_geometric_normal(*ns, *ng));
+        assert_eq!(got, want, "ns {ns} ng {ng}");
+        bent += (want < 0.0) as usize;
+    }
+    assert!(bent > 2000, "{bent} bent of {}", cases.len());
 }

@@ -40,25 +40,38 @@ pub fn decode_rgb9e5(bits: u32) -> Vec3 {
     Vec3::new((bits & 511) as f32, ((bits >> 9) & 511) as f32, ((bits >> 18) & 511) as f32) * scale
 }
 
-/// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.
+/// The octahedral map: a unit direction's point in the square [-1, 1]²
+/// (each code quantises the square its own way).
 #[inline]
-pub fn encode_octahedral_15(d: Vec3) -> u32 {
+pub fn octahedral_square(d: Vec3) -> Vec2 {
     let d = d / (d.x.abs() + d.y.abs() + d.z.abs());
     let mut p = Vec2::new(d.x, d.y);
     if d.z < 0.0 {
         p = (Vec2::ONE - Vec2::new(p.y.abs(), p.x.abs())) * Vec2::new(p.x.signum(), p.y.signum());
     }
-    let q = |x: f32| ((x.clamp(-1.0, 1.0) * 0.5 + 0.5) * 32767.0 + 0.5) as u32 & 0x7fff;
-    q(p.x) | (q(p.y) << 15)
+    p.clamp(Vec2::NEG_ONE, Vec2::ONE)
 }
 
-pub fn decode_octahedral_15(bits: u32) -> Vec3 {
-    let p = Vec2::new((bits & 0x7fff) as f32, ((bits >> 15) & 0x7fff) as f32) / 32767.0 * 2.0 - 1.0;
+/// The direction at point `p` of the octahedral map's square.
+#[inline]
+pub fn octahedral_direction(p: Vec2) -> Vec3 {
     let z = 1.0 - p.x.abs() - p.y.abs();
     let t = (-z).max(0.0);
     let x = p.x + if p.x >= 0.0 { -t } else { t };
     let y = p.y + if p.y >= 0.0 { -t } else { t };
     Vec3::new(x, y, z).normalize()
+}
+
+/// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.
+#[inline]
+pub fn encode_octahedral_15(d: Vec3) -> u32 {
+    let q = |x: f32| ((x * 0.5 + 0.5) * 32767.0 + 0.5) as u32 & 0x7fff;
+    let p = octahedral_square(d);
+    q(p.x) | (q(p.y) << 15)
+}
+
+pub fn decode_octahedral_15(bits: u32) -> Vec3 {
+    octahedral_direction(Vec2::new((bits & 0x7fff) as f32, ((bits >> 15) & 0x7fff) as f32) / 32767.0 * 2.0 - 1.0)
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 use super::{Image, LitSides, direct_diffuse, direct_reflected, direct_scattered, render_pixels};
 use crate::bsdf::ShadingFrame;
 use crate::bsdf::dielectric::Transport;
-use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf, shading_normal_factor};
+use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf, is_bent, shading_normal_factor};
 use crate::geometry::Ray;
 use crate::material::{Material, Rgb, reflect};
 use crate::medium::MediaAlong;
@@ -144,7 +144,7 @@ impl<'a> PhotonCpuRenderer<'a> {
     /// (where the two differ, smooth-shaded and normal-mapped meshes, each
     /// photon weighs `estimate::shading_normal_factor`).
     pub fn photon_radiance(&self, x: glam::Vec3, normal: glam::Vec3, ng: glam::Vec3, albedo: Rgb) -> Rgb {
-        if normal != ng {
+        if is_bent(normal, ng) {
             let frame = ShadingFrame::new(normal);
             let lambert = albedo / std::f32::consts::PI;
             return self.photon_radiance_brdf(x, &frame, ng, |wi| if wi.z > 0.0 { lambert } else { Rgb::ZERO });
@@ -173,7 +173,7 @@ impl<'a> PhotonCpuRenderer<'a> {
         brdf: impl Fn(glam::Vec3) -> Rgb,
     ) -> Rgb {
         let c = self.settings.components;
-        let bent = frame.normal != ng;
+        let bent = is_bent(frame.normal, ng);
         let f = |wi: glam::Vec3| {
             let f = brdf(frame.to_local(wi));
             if bent { f * shading_normal_factor(wi, frame.normal, ng) } else { f }

@@ -22,3 +22,8 @@ override SAMPLED_LIGHTS: bool = true;
 override SKY_IMAGE: bool = true;
 // Some medium fills the scene or a region (media.wgsl, view_depth.wgsl).
 override MEDIA: bool = true;
+// Some diffuse surface shades with a normal off its facets' (smooth vertex
+// normals, spheres, normal textures): the G-buffer keeps its geometric
+// normal and the photon gathers weigh shading_normal_factor
+// (gbuffer/geometric_normal.wgsl).
+override BENT: bool = true;

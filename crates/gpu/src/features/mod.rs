@@ -5,7 +5,7 @@
 //! (no texture, no cut-out, nothing glossy) took 9x its time before the
 //! glTF materials with the texture and cut-out code in it (BENCHMARKS.md).
 
-use crate::scene_upload::GpuSurface;
+use crate::scene_upload::{GpuSurface, kind};
 use crate::textures::NO_TEXTURE;
 use hikari_core::light::Light;
 
@@ -25,6 +25,7 @@ pub struct SceneFeatures {
     pub sampled_lights: bool,
     pub sky_image: bool,
     pub media: bool,
+    pub bent: bool,
 }
 
 impl SceneFeatures {
@@ -38,6 +39,7 @@ impl SceneFeatures {
         sampled_lights: false,
         sky_image: false,
         media: false,
+        bent: false,
     };
     pub const ALL: SceneFeatures = SceneFeatures {
         textured: true,
@@ -48,11 +50,13 @@ impl SceneFeatures {
         sampled_lights: true,
         sky_image: true,
         media: true,
+        bent: true,
     };
 
     /// What `surfaces` (scene_upload::scene_surfaces) and `lights` use, in
-    /// a scene with media where `media`.
-    pub fn of(surfaces: &[GpuSurface], lights: &[Light], media: bool) -> Self {
+    /// a scene with media where `media` and whose diffuse surfaces' meshes
+    /// shade with normals off their facets' where `bent_geometry`.
+    pub fn of(surfaces: &[GpuSurface], lights: &[Light], media: bool, bent_geometry: bool) -> Self {
         SceneFeatures {
             textured: surfaces.iter().any(|s| {
                 [s.base_color_texture, s.metallic_roughness_texture, s.emissive_texture, s.normal_texture]
@@ -66,6 +70,7 @@ impl SceneFeatures {
             sampled_lights: lights.iter().any(|l| matches!(l, Light::Environment { .. } | Light::Mesh(_))),
             sky_image: lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. })),
             media,
+            bent: bent_geometry || surfaces.iter().any(|s| s.kind == kind::DIFFUSE && s.normal_texture != NO_TEXTURE),
         }
     }
 
@@ -80,12 +85,15 @@ impl SceneFeatures {
             sampled_lights: self.sampled_lights || other.sampled_lights,
             sky_image: self.sky_image || other.sky_image,
             media: self.media || other.media,
+            bent: self.bent || other.bent,
         }
     }
 
     /// What `scene`'s surfaces and lights use.
     pub fn of_scene(scene: &hikari_core::scene::Scene) -> Self {
-        Self::of(&crate::scene_upload::scene_surfaces(scene), &scene.lights, !scene.media.is_empty())
+        let surfaces = crate::scene_upload::scene_surfaces(scene);
+        let bent = bent_geometry(scene, &surfaces);
+        Self::of(&surfaces, &scene.lights, !scene.media.is_empty(), bent)
     }
 
     /// The constants for a pipeline of the shader `source`: those of
@@ -101,12 +109,28 @@ impl SceneFeatures {
             ("SAMPLED_LIGHTS", self.sampled_lights),
             ("SKY_IMAGE", self.sky_image),
             ("MEDIA", self.media),
+            ("BENT", self.bent),
         ]
         .into_iter()
         .filter(|(name, _)| source.contains(&format!("override {name}: bool")))
         .map(|(name, on)| (name, on as u32 as f64))
         .collect()
     }
+}
+
+/// Whether a diffuse (kind 0) surface's geometry shades with normals off
+/// its facets' (`estimate::is_bent`): tessellated spheres, and meshes with
+/// smooth vertex normals. Stops at the first.
+fn bent_geometry(scene: &hikari_core::scene::Scene, surfaces: &[GpuSurface]) -> bool {
+    let diffuse = |s: u32| surfaces.get(s as usize).is_some_and(|s| s.kind == kind::DIFFUSE);
+    scene.accel.spheres().any(|(_, s)| diffuse(s))
+        || scene.accel.triangles().any(|(tri, s)| {
+            diffuse(s)
+                && tri.normals.is_some_and(|n| {
+                    let ng = tri.geometric_normal().normalize();
+                    n.0.iter().any(|&v| hikari_core::estimate::is_bent(v, ng) && hikari_core::estimate::is_bent(v, -ng))
+                })
+        })
 }
 
 #[cfg(test)]
@@ -126,6 +150,7 @@ mod tests {
             ("SAMPLED_LIGHTS", 0.0),
             ("SKY_IMAGE", 1.0),
             ("MEDIA", 1.0),
+            ("BENT", 1.0),
         ];
         assert_eq!(constants, expected);
         assert!(features.constants("fn main() {}").is_empty());
@@ -145,5 +170,10 @@ mod tests {
         assert!(SceneFeatures::of_scene(&coated).coated);
         let sheened = hikari_core::test_scenes::sheen_box(hikari_core::test_scenes::glossy_lights::QUAD, 8);
         assert!(SceneFeatures::of_scene(&sheened).sheened);
+        // Bent normals: a diffuse ball, smooth-shaded meshes; not a glass ball.
+        assert!(!SceneFeatures::of_scene(&Scene::load("cornell-caustic").unwrap()).bent);
+        use hikari_core::test_scenes::{gltf_textures, smooth_wavy_grid_glb, wavy_grid_glb};
+        assert!(SceneFeatures::of_scene(&gltf_textures::load("features-smooth", &smooth_wavy_grid_glb(200))).bent);
+        assert!(!SceneFeatures::of_scene(&gltf_textures::load("features-flat", &wavy_grid_glb(200))).bent);
     }
 }

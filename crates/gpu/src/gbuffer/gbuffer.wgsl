@@ -58,7 +58,9 @@ fn vs_main(v: VertexIn) -> VertexOut {
 }
 
 struct GBufferOut {
-    // xyz: world position; w: 1 where a surface is seen, 0 elsewhere (cleared).
+    // xyz: world position; w: 0 where no surface is seen (cleared), else
+    // the geometric normal's code (pack_geometric_normal: 1 where it is
+    // the shading normal).
     @location(0) position: vec4<f32>,
     // xyz: unit shading normal turned toward the eye; w: surface id.
     @location(1) normal: vec4<f32>,
@@ -108,10 +110,15 @@ fn shade(in: VertexOut) -> GBufferOut {
     let front = dot(in.geometric_normal, view) < 0.0;
     let side = select(-1.0, 1.0, front);
     var out: GBufferOut;
-    out.position = vec4<f32>(in.world, 1.0);
     let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
     let tangent = vec4<f32>(in.tangent, in.tangent_side);
     let n = bent_normal(surface, uv, dx, dy, px, py, tangent, normalize(in.normal), in.geometric_normal, normalize(view));
+    // Both normals turned toward the eye, as the gathers read them.
+    var geometric = 1.0;
+    if (BENT) {
+        geometric = pack_geometric_normal(n * side, normalize(in.geometric_normal) * side);
+    }
+    out.position = vec4<f32>(in.world, geometric);
     out.normal = vec4<f32>(n * side, f32(id));
     out.albedo = vec4<f32>(point.base, f32(surface.kind));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);

@@ -1,6 +1,8 @@
 //! The G-buffer pass: rasterizes the scene once, storing per pixel what the
 //! later passes shade (METHOD.md §4, step 1).
 
+pub mod geometric_normal;
+
 use crate::scene_upload::{GpuVertex, SceneBuffers};
 use bytemuck::{Pod, Zeroable};
 
@@ -22,7 +24,7 @@ pub fn shader_source() -> String {
     static GBUFFER: Module = Module {
         name: "gbuffer.wgsl",
         source: include_str!("gbuffer.wgsl"),
-        requires: &[&SURFACE, &crate::textures::SURFACE_POINT],
+        requires: &[&SURFACE, &crate::textures::SURFACE_POINT, &geometric_normal::GEOMETRIC_NORMAL],
     };
     compose(&[&GBUFFER])
 }

@@ -465,7 +465,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                         radiance += weight * direct_radiance(x, ns, r, &light_rng);
                     }
                     var gathered: vec3<f32>;
-                    if (any(ns != n)) {
+                    if (is_bent(ns, n)) {
                         gathered = gather(x, ns, n, true, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
                             + gather(x, ns, n, true, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
                     } else {

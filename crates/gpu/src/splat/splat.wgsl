@@ -93,6 +93,11 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
         let eye = unit(params.camera_position - position.xyz);
         weight = photon_brdf(b, eye, normal, direction) * radiance_per_weighted_power(params.radius);
     }
+    // At a bent point (position.w < 0: smooth-shaded and normal-mapped
+    // meshes) the photon weighs as photon-cpu weighs it.
+    if (BENT && position.w < 0.0) {
+        weight *= shading_normal_factor(-direction, normal, unpack_geometric_normal(position.w, normal));
+    }
     let radiance = weight * in.power * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);

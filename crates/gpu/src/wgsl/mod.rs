@@ -116,8 +116,11 @@ pub static VOLUME_CHORD: Module = Module {
 };
 
 /// The radiance estimate (hikari_core::estimate).
-pub static ESTIMATE: Module =
-    Module { name: "estimate.wgsl", source: include_str!("estimate.wgsl"), requires: &[&CONSTANTS, &PHOTON_ENCODING] };
+pub static ESTIMATE: Module = Module {
+    name: "estimate.wgsl",
+    source: include_str!("estimate.wgsl"),
+    requires: &[&CONSTANTS, &PHOTON_ENCODING, &crate::gbuffer::geometric_normal::GEOMETRIC_NORMAL],
+};
 
 /// A photon's weight at a glossy point (the gathered lobes of bsdf.wgsl), for
 /// the passes that estimate over glossy surfaces (they bind `surfaces`).

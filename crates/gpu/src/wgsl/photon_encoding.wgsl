@@ -30,17 +30,9 @@ fn encode_rgb9e5(color: vec3<f32>) -> u32 {
     return q.x | (q.y << 9u) | (q.z << 18u) | (u32(exponent) << 27u);
 }
 
-// Octahedral direction, 15 + 15 bits.
-fn decode_octahedral_15(bits: u32) -> vec3<f32> {
-    let p = vec2<f32>(f32(bits & 0x7fffu), f32((bits >> 15u) & 0x7fffu)) / 32767.0 * 2.0 - 1.0;
-    let z = 1.0 - abs(p.x) - abs(p.y);
-    let t = max(-z, 0.0);
-    let x = p.x + select(t, -t, p.x >= 0.0);
-    let y = p.y + select(t, -t, p.y >= 0.0);
-    return normalize(vec3<f32>(x, y, z));
-}
-
-fn encode_octahedral_15(direction: vec3<f32>) -> u32 {
+// The octahedral map: a unit direction's point in the square [-1, 1]²,
+// and back (each code below quantises the square its own way).
+fn octahedral_square(direction: vec3<f32>) -> vec2<f32> {
     let d = direction / (abs(direction.x) + abs(direction.y) + abs(direction.z));
     var p = d.xy;
     if (d.z < 0.0) {
@@ -48,6 +40,23 @@ fn encode_octahedral_15(direction: vec3<f32>) -> u32 {
         let s = vec2<f32>(select(1.0, -1.0, (bitcast<u32>(p.x) & 0x80000000u) != 0u), select(1.0, -1.0, (bitcast<u32>(p.y) & 0x80000000u) != 0u));
         p = (vec2<f32>(1.0) - abs(p.yx)) * s;
     }
-    let q = vec2<u32>((clamp(p, vec2<f32>(-1.0), vec2<f32>(1.0)) * 0.5 + 0.5) * 32767.0 + 0.5) & vec2<u32>(0x7fffu);
+    return clamp(p, vec2<f32>(-1.0), vec2<f32>(1.0));
+}
+
+fn octahedral_direction(p: vec2<f32>) -> vec3<f32> {
+    let z = 1.0 - abs(p.x) - abs(p.y);
+    let t = max(-z, 0.0);
+    let x = p.x + select(t, -t, p.x >= 0.0);
+    let y = p.y + select(t, -t, p.y >= 0.0);
+    return normalize(vec3<f32>(x, y, z));
+}
+
+// Octahedral direction, 15 + 15 bits.
+fn decode_octahedral_15(bits: u32) -> vec3<f32> {
+    return octahedral_direction(vec2<f32>(f32(bits & 0x7fffu), f32((bits >> 15u) & 0x7fffu)) / 32767.0 * 2.0 - 1.0);
+}
+
+fn encode_octahedral_15(direction: vec3<f32>) -> u32 {
+    let q = vec2<u32>((octahedral_square(direction) * 0.5 + 0.5) * 32767.0 + 0.5) & vec2<u32>(0x7fffu);
     return q.x | (q.y << 15u);
 }

@@ -1,0 +1,74 @@
+//! The G-buffer's geometric normal, in its position's w (0 where no
+//! surface is seen): 1 where the shading normal is the geometric one
+//! (`estimate::is_bent` false), else −(1 + an octahedral code of 12 + 12
+//! bits), an integer down to −2^24, exact in f32. (Its albedo's alpha
+//! keeps the material kind the passes and tests read.) The photon gathers weigh `estimate::shading_normal_factor` with
+//! it, as photon-cpu does. geometric_normal.wgsl is the GPU's half; this
+//! Rust one reads a G-buffer back (the twin tests).
+
+use glam::{Vec2, Vec3};
+use hikari_core::estimate::is_bent;
+use hikari_core::photon::{octahedral_direction, octahedral_square};
+
+/// The WGSL half (`pack_geometric_normal`, `unpack_geometric_normal`, `is_bent`).
+pub static GEOMETRIC_NORMAL: crate::wgsl::Module = crate::wgsl::Module {
+    name: "geometric_normal.wgsl",
+    source: include_str!("geometric_normal.wgsl"),
+    requires: &[&crate::wgsl::PHOTON_ENCODING],
+};
+
+/// The octahedral map (`photon::encoding`) quantised to 12 + 12 bits.
+pub fn encode_octahedral_12(d: Vec3) -> u32 {
+    let q = |x: f32| ((x * 0.5 + 0.5) * 4095.0 + 0.5) as u32 & 0xfff;
+    let p = octahedral_square(d);
+    q(p.x) | (q(p.y) << 12)
+}
+
+pub fn decode_octahedral_12(bits: u32) -> Vec3 {
+    octahedral_direction(Vec2::new((bits & 0xfff) as f32, ((bits >> 12) & 0xfff) as f32) / 4095.0 * 2.0 - 1.0)
+}
+
+/// What position.w stores where a surface shading with `ns` across `ng`
+/// (unit, on the same side) is seen.
+pub fn pack_geometric_normal(ns: Vec3, ng: Vec3) -> f32 {
+    if !is_bent(ns, ng) { 1.0 } else { -((1 + encode_octahedral_12(ng)) as f32) }
+}
+
+/// The geometric normal from a seen pixel's position.w and its shading
+/// normal `ns`.
+pub fn unpack_geometric_normal(packed: f32, ns: Vec3) -> Vec3 {
+    if packed > 0.0 { ns } else { decode_octahedral_12((-packed) as u32 - 1) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hikari_core::sampling::{Rng, uniform_sphere};
+
+    #[test]
+    fn a_geometric_normal_comes_back_within_its_codes_step() {
+        let mut rng = Rng::for_item(5, 0);
+        for _ in 0..10_000 {
+            let ng = uniform_sphere(rng.next_2d());
+            let ns = (ng + uniform_sphere(rng.next_2d()) * 0.3).normalize();
+            if !is_bent(ns, ng) {
+                continue; // pushed along ng itself
+            }
+            let packed = pack_geometric_normal(ns, ng);
+            assert!(packed <= -1.0 && packed >= -16_777_216.0 && packed.fract() == 0.0, "{packed}");
+            let back = unpack_geometric_normal(packed, ns);
+            // 12 bits over [-1, 1]: steps of 1/2048, under 0.1° of arc.
+            assert!(back.dot(ng) > (0.1f32).to_radians().cos(), "{ng} -> {back}");
+        }
+    }
+
+    #[test]
+    fn a_flat_point_stores_one_and_gives_back_its_shading_normal() {
+        let n = Vec3::new(0.3, -0.4, 0.866).normalize();
+        assert_eq!(pack_geometric_normal(n, n), 1.0);
+        assert_eq!(unpack_geometric_normal(1.0, n), n);
+        // Rounding of an interpolated normal that equals the face's is flat too.
+        let nearly = (n + Vec3::splat(1e-4)).normalize();
+        assert_eq!(pack_geometric_normal(nearly, n), 1.0);
+    }
+}
