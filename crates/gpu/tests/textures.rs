@@ -448,3 +448,68 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
         }
     }
 }
+
+/// A quad whose normal texture tilts its normal 45° toward +x, lit by a
+/// point light on the +x side a little below its plane: the tilted normal
+/// faces the light, but the light is under the surface, where `path` and
+/// `photon-cpu` take none; the GPU's direct pass takes none either (it
+/// did before the G-buffer kept the geometric normal). The same light a
+/// little above the plane lights it, on the CPU and the GPU alike.
+#[test]
+fn no_direct_light_comes_from_below_a_bent_surface() {
+    use glam::Vec3;
+    use gltf::json::extensions::scene::khr_lights_punctual::Type;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial, png};
+    use hikari_core::test_scenes::gltf_textures::{load, quad};
+    let ctx = test_context("no_direct_light_comes_from_below_a_bent_surface");
+    let mut means = Vec::new();
+    for height in [-0.4f32, 0.4] {
+        let mut b = GltfBuilder::new();
+        // Tangent-space (0.71, 0, 0.71): tilted 45° toward u, here +x.
+        let image = b.image(&png(1, 1, &[218, 128, 218, 255]), "image/png");
+        let repeat = gltf::json::texture::WrappingMode::Repeat;
+        let t = b.texture(image, repeat, repeat);
+        let m = b.material(&PbrMaterial {
+            base_color: Vec3::splat(0.5),
+            specular: 0.0,
+            normal_texture: Some((t, 1.0)),
+            ..Default::default()
+        });
+        let node = quad(&mut b, Vec3::new(-0.5, -0.5, 0.0), Vec3::X, Vec3::Y, 1.0, m);
+        let light = b.light(Type::Point, Vec3::ONE, 683.0, None);
+        let light = b.node(GltfBuilder::light_node(light, Vec3::new(3.0, 0.0, height), glam::Quat::IDENTITY));
+        let mut scene = load(&format!("gpu-horizon-{height}"), &b.to_glb(vec![node, light]));
+        scene.camera =
+            hikari_core::camera::Camera::new(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, Vec3::Y, 20.0, 32, 32).unwrap();
+        let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+        let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+        let gpu =
+            hikari_gpu::GpuRenderer::new(ctx.clone(), &scene, &traced, hikari_gpu::GpuSettings::new(global, caustic))
+                .expect("GPU renderer");
+        gpu.render().unwrap();
+        let direct = gpu.read(&gpu.targets.direct).unwrap();
+        let seen: Vec<f32> = gpu
+            .read(&gpu.targets.gbuffer.position)
+            .unwrap()
+            .iter()
+            .zip(&direct)
+            .filter(|(p, _)| p.w != 0.0)
+            .map(|(_, d)| d.truncate().max_element())
+            .collect();
+        assert!(seen.len() > 500, "{} pixels see the quad", seen.len());
+        // The path tracer, the reference: the quad alone, so all it shows is direct light.
+        let settings = hikari_core::render::path::PathSettings { spp: 4, ..Default::default() };
+        let (image, _) = hikari_core::render::path::render(&scene, &settings, &Silent);
+        let cpu = image.pixels.iter().map(|p| p.max_element()).sum::<f32>() / seen.len() as f32;
+        means.push((seen.iter().sum::<f32>() / seen.len() as f32, cpu));
+    }
+    eprintln!("direct light on the quad's pixels (GPU, path): below {:?}, above {:?}", means[0], means[1]);
+    let [(below, path_below), (above, path_above)] = [means[0], means[1]];
+    assert_eq!(path_below, 0.0, "path: light from below the quad");
+    assert_eq!(below, 0.0, "GPU: light from below the quad");
+    assert!(above > 0.01 && path_above > 0.01, "light from above the quad: {above}, path {path_above}");
+    assert!((above / path_above - 1.0).abs() < 0.05, "above: GPU {above}, path {path_above}");
+}

@@ -30,6 +30,9 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let s = surfaces.all[u32(g.w)];
     let b = pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let r = surface_reflector(s, b, unit(media.camera_position - x), n);
+    if (BENT && position.w < 0.0) {
+        shaded_geometric_normal = unpack_geometric_normal(position.w, n);
+    }
     // Glossy points sample their lobe and area lights: a new stream each pass.
     var rng = pixel_stream(vec2<u32>(pixel), direct_params.pass_index, 1u);
     return vec4<f32>(direct_radiance(x, n, r, &rng), 1.0);

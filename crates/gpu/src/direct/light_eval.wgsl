@@ -134,6 +134,19 @@ fn unshadowed_irradiance(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     }
 }
 
+// The geometric normal of the point being shaded where its shading normal
+// is bent off it (the G-buffer's, the specular pass's hit), else zero: set
+// by the pass before `direct_radiance`. Light from below the geometric
+// surface is none, whatever the shading normal sees, as in `path` and
+// `photon-cpu` (a shadow ray there would start into the surface).
+var<private> shaded_geometric_normal: vec3<f32>;
+
+// Whether light arriving along `wi` (toward the light) at the point being
+// shaded comes from above its geometric surface.
+fn above_surface(wi: vec3<f32>) -> bool {
+    return !BENT || all(shaded_geometric_normal == vec3<f32>(0.0)) || dot(shaded_geometric_normal, wi) > 0.0;
+}
+
 // Is `x` (with normal `n`) seen from sample `s`?
 fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
     let d = x - s.position;
@@ -329,7 +342,7 @@ fn sky_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<funct
             }
         }
         let s = light_sample(l.first_sample + nearest);
-        if (visible(s, x, n)) {
+        if (above_surface(wi) && visible(s, x, n)) {
             sum += b.weight * light_transmittance(x, distant_start(l, x, s.direction));
         }
     }
@@ -349,7 +362,7 @@ fn sky_image(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector) -> vec3<f32> {
         }
         let s = light_sample(l.first_sample + k);
         let cos = dot(n, s.direction);
-        if (cos > 0.0 && visible(s, x, n)) {
+        if (cos > 0.0 && above_surface(s.direction) && visible(s, x, n)) {
             let t = light_transmittance(x, distant_start(l, x, s.direction));
             sum += reflector_f(r, n, s.direction) * s.weight * cos * t;
         }
@@ -508,7 +521,7 @@ fn mesh_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
         let wi = to_light / sqrt(d2);
         let weight = reflector_f(r, n, wi) * (max(dot(n, wi), 0.0) * mesh_emitting_cos(l, s.direction, wi) / (d2 + l.sample_area / PI));
         total += weight;
-        if (any(weight > vec3<f32>(0.0)) && visible(s, x, n)) {
+        if (any(weight > vec3<f32>(0.0)) && above_surface(wi) && visible(s, x, n)) {
             seen += weight * light_transmittance(x, s.position);
         }
     }
@@ -545,6 +558,7 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
         let s = light_sample(l.first_sample + k);
         var weight = 0.0;
         var end = s.position;
+        var wi = s.direction;
         if (l.kind == KIND_SKY) {
             weight = max(dot(n, s.direction), 0.0);
             total_weight += weight;
@@ -555,14 +569,14 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
             if (d2 <= 0.0) {
                 continue;
             }
-            let wi = to_light / sqrt(d2);
+            wi = to_light / sqrt(d2);
             let cos_l = mesh_emitting_cos(l, s.direction, wi);
             // Each point stands for a disc of its share of the area: on its
             // axis that gives L·a/(d² + a/π) exactly, which stays finite
             // (at most πL) where a point's a/d² would not.
             weight = max(dot(n, wi), 0.0) * cos_l / (d2 + l.sample_area / PI);
         }
-        if (weight > 0.0 && visible(s, x, n)) {
+        if (weight > 0.0 && above_surface(wi) && visible(s, x, n)) {
             seen += weight * light_transmittance(x, end);
         }
     }
@@ -585,7 +599,11 @@ fn shadowed_fraction(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             break;
         }
         let s = light_sample(l.first_sample + k);
-        if (visible(s, x, n)) {
+        var toward = s.position - x;
+        if (l.kind == KIND_SUN) {
+            toward = l.axis;
+        }
+        if (above_surface(toward) && visible(s, x, n)) {
             var end = s.position;
             if (l.kind == KIND_SUN) {
                 end = distant_start(l, x, l.axis);

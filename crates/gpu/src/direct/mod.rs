@@ -19,6 +19,7 @@ pub static LIGHT_EVAL: crate::wgsl::Module = crate::wgsl::Module {
         &crate::wgsl::RANDOM,
         &crate::wgsl::SAMPLING,
         &crate::wgsl::BSDF,
+        &crate::features::FEATURES,
     ],
 };
 
@@ -43,6 +44,7 @@ pub fn shader_source() -> String {
         &crate::wgsl::SURFACE,
         &LIGHT_EVAL,
         &LIGHT_ARRAYS,
+        &crate::gbuffer::geometric_normal::GEOMETRIC_NORMAL,
         &DIRECT,
     ])
 }

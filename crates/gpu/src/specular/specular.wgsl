@@ -462,6 +462,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                         // Its own stream, so slice 0's draws leave the path's alone.
                         var light_rng = hash_u32(path_rng ^ 0x68bc21ebu);
                         let r = surface_reflector(s, bsdf, eye, ns);
+                        // No light from below the geometric surface (light_eval.wgsl).
+                        shaded_geometric_normal = select(vec3<f32>(0.0), n, is_bent(ns, n));
                         radiance += weight * direct_radiance(x, ns, r, &light_rng);
                     }
                     var gathered: vec3<f32>;
