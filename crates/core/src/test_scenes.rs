@@ -654,7 +654,8 @@ fn wave_glb(triangles: u64, smooth: bool) -> Vec<u8> {
     let normals: Vec<Vec3> = positions
         .iter()
         .map(|p| {
-            let (dx, dz) = (0.45 * (9.0 * p.x).cos() * (7.0 * p.z).cos(), -0.35 * (9.0 * p.x).sin() * (7.0 * p.z).sin());
+            let (dx, dz) =
+                (0.45 * (9.0 * p.x).cos() * (7.0 * p.z).cos(), -0.35 * (9.0 * p.x).sin() * (7.0 * p.z).sin());
             Vec3::new(-dx, 1.0, -dz).normalize()
         })
         .collect();

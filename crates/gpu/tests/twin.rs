@@ -104,7 +104,9 @@ fn twin_pass(
             let want = match material {
                 Material::Pbr(bsdf) if bsdf.is_glossy() => {
                     let wo = frame.to_local((scene.camera.position - x).normalize());
-                    fixed_radius_radiance_brdf(map, x, n, params, |wi| bsdf.f_gathered(wo, frame.to_local(wi)) * across(wi))
+                    fixed_radius_radiance_brdf(map, x, n, params, |wi| {
+                        bsdf.f_gathered(wo, frame.to_local(wi)) * across(wi)
+                    })
                 }
                 _ if bent => {
                     let lambert = albedo[i].truncate() / std::f32::consts::PI;
