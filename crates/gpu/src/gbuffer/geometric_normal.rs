@@ -55,7 +55,7 @@ mod tests {
                 continue; // pushed along ng itself
             }
             let packed = pack_geometric_normal(ns, ng);
-            assert!(packed <= -1.0 && packed >= -16_777_216.0 && packed.fract() == 0.0, "{packed}");
+            assert!((-16_777_216.0..=-1.0).contains(&packed) && packed.fract() == 0.0, "{packed}");
             let back = unpack_geometric_normal(packed, ns);
             // 12 bits over [-1, 1]: steps of 1/2048, under 0.1° of arc.
             assert!(back.dot(ng) > (0.1f32).to_radians().cos(), "{ng} -> {back}");
