@@ -388,3 +388,44 @@ def test_instances_render_as_in_cycles(addon, tmp_path):
     theirs = read_passes(tmp_path / "cycles.exr")["Combined"][:, :, :3]
     print(f"instances: mean {ours.mean() / theirs.mean():.4f} of Cycles'")
     assert abs(ours.mean() / theirs.mean() - 1) < 0.03
+
+
+def test_the_compositors_denoise_node_takes_the_passes(addon, tmp_path):
+    """Render Layers → Denoise (Image, Denoising Normal, Denoising Albedo)
+    → Group Output, as an artist wires it: the Render Layers node offers
+    hikari's passes under Blender's names, and the denoised image of two
+    passes is nearer a 128-pass render than the two passes themselves."""
+    import warnings
+
+    scene = stage.empty_scene()
+    stage.lit_stage(scene)
+    hikari(scene, passes=2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # compositing_node_group: 5.x's, 6.0 moves it
+        tree = bpy.data.node_groups.new("denoise", "CompositorNodeTree")
+        scene.compositing_node_group = tree
+    layers, denoise = tree.nodes.new("CompositorNodeRLayers"), tree.nodes.new("CompositorNodeDenoise")
+    assert {"Denoising Albedo", "Denoising Normal", "Depth"} <= {o.name for o in layers.outputs if o.enabled}
+    tree.interface.new_socket("Image", in_out="OUTPUT", socket_type="NodeSocketColor")
+    output = tree.nodes.new("NodeGroupOutput")
+    tree.links.new(layers.outputs["Image"], denoise.inputs["Image"])
+    tree.links.new(layers.outputs["Denoising Normal"], denoise.inputs["Normal"])
+    tree.links.new(layers.outputs["Denoising Albedo"], denoise.inputs["Albedo"])
+    tree.links.new(denoise.outputs["Image"], output.inputs[0])
+
+    def render(name, passes, compositing):
+        scene.hikari.passes = passes
+        scene.render.use_compositing = compositing
+        settings = scene.render.image_settings
+        if hasattr(settings, "media_type"):
+            settings.media_type = "IMAGE"
+        settings.file_format, settings.color_depth = "OPEN_EXR", "32"
+        scene.render.filepath = str(tmp_path / name)
+        bpy.ops.render.render(write_still=True)
+        return next(iter(read_passes(tmp_path / name).values()))[:, :, :3]
+
+    denoised, raw, reference = render("denoised.exr", 2, True), render("raw.exr", 2, False), render("ref.exr", 128, False)
+    error = lambda image: np.sqrt(((image - reference) ** 2).mean()) / reference.mean()
+    print(f"denoise: relative RMS error {error(raw):.4f} raw, {error(denoised):.4f} denoised")
+    assert error(denoised) < 0.9 * error(raw)
+    assert abs(denoised.mean() / reference.mean() - 1) < 0.03
