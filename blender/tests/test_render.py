@@ -366,8 +366,6 @@ def test_instances_render_as_in_cycles(addon, tmp_path):
     instance: each drawn once (the exporter writes geometry-nodes instances
     only when asked, and then a particle system's twice), the mean within
     3% of Cycles'."""
-    from hikari_blender.glb import Glb
-
     scene = stage.empty_scene()
     stage.instanced(scene)
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -376,7 +374,7 @@ def test_instances_render_as_in_cycles(addon, tmp_path):
     assert len(instances) == 16 + 6 + 1  # a 4 × 4 grid's points, the hairs, the collection's cube
     exported = addon.export.export_scene(depsgraph, str(tmp_path))
     with open(exported.glb, "rb") as f:
-        meshed = [n.get("name") for n in Glb(f.read()).json["nodes"] if "mesh" in n]
+        meshed = [n.get("name") for n in addon.glb.Glb(f.read()).json["nodes"] if "mesh" in n]
     # Beside them the floor and the hairs' plane (the ball's original is
     # hidden from renders, the grid is only its instances).
     assert len(meshed) == len(instances) + 2, meshed
