@@ -588,6 +588,32 @@ pub mod gltf_textures {
         b.to_glb(nodes)
     }
 
+    /// A 2×2 pane at height 1 of white glass (IOR 1.5, smooth) of which a
+    /// share `transmission` is let through (`KHR_materials_transmission`)
+    /// and the rest a white Lambertian, over a Lambertian floor of albedo
+    /// `floor`, under a sun straight down (irradiance 2 W/m²): from above
+    /// the pane shows (1 − transmission) of a white Lambertian's 2/π and,
+    /// over a black floor, nothing else (the glass shows the black sky and
+    /// floor); the floor under it receives transmission × (1 − F(0)) =
+    /// transmission × 0.96 of the sun straight through.
+    pub fn mixed_pane_glb(transmission: f32, floor: f32) -> Vec<u8> {
+        let mut b = GltfBuilder::new();
+        let floor = b.material(&PbrMaterial { base_color: Vec3::splat(floor), specular: 0.0, ..Default::default() });
+        let floor = quad(&mut b, Vec3::new(-4.0, 0.0, -4.0), 8.0 * Vec3::Z, 8.0 * Vec3::X, 1.0, floor);
+        let pane = b.material(&PbrMaterial {
+            glass_ior: Some(1.5),
+            transmission,
+            roughness: 0.0,
+            specular: 0.0,
+            ..Default::default()
+        });
+        let pane = quad(&mut b, Vec3::new(-1.0, 1.0, -1.0), 2.0 * Vec3::Z, 2.0 * Vec3::X, 1.0, pane);
+        use json::extensions::scene::khr_lights_punctual::Type;
+        let sun = b.light(Type::Directional, Vec3::ONE, 2.0 * 683.0, None);
+        let sun = b.node(GltfBuilder::light_node(sun, Vec3::ZERO, looking(-Vec3::Y, Vec3::Z)));
+        b.to_glb(vec![floor, pane, sun])
+    }
+
     /// `cutout_glb`'s scene with the quad `alphaMode` BLEND of alpha
     /// `alpha` (the base colour factor's; no texture): it stops a fraction
     /// alpha of the sun's light and of the eye's rays, so from above the

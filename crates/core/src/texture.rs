@@ -23,6 +23,7 @@
 use crate::material::{Material, Rgb};
 use crate::sampling::hash_u32;
 use glam::{Affine2, Vec2, Vec4, Vec4Swizzles};
+use std::borrow::Cow;
 
 /// How texture coordinates outside [0, 1] wrap (glTF's `wrapS`, `wrapT`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -241,6 +242,78 @@ pub fn blend_threshold(origin: glam::Vec3, dir: glam::Vec3, prim: u32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
+/// The uniform number in [0, 1) that draws one of a mixed material's two
+/// materials ([`Transmission`]) at a hit on primitive `prim` at `point`: a
+/// hash of their bits, so each hit draws afresh without a random stream to
+/// thread through every renderer, and the same hit draws the same.
+pub fn mix_threshold(prim: u32, point: glam::Vec3) -> f32 {
+    let mut h = hash_u32(prim ^ 0x6a09_e667);
+    for bits in [point.x, point.y, point.z].map(f32::to_bits) {
+        h = hash_u32(h ^ bits);
+    }
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// `KHR_materials_transmission` below 1, or with a `transmissionTexture`
+/// (Cycles' Transmission Weight), on a `Material::Pbr` base: the
+/// dielectric base lets a share T (factor × the texture's R) of what it
+/// does not reflect through, as glass of its IOR and of the base's colour
+/// and roughness (textures included). Drawn per hit ([`Texturing::apply`]):
+/// the glass with probability p = T·(1 − m), else the base with its
+/// metallic m raised to m / (1 − p). The mean over draws,
+/// p·glass + (1 − p)·base, is then the extension's
+/// mix(fresnel_mix(mix(diffuse, BTDF, T), specular), metal, m) exactly,
+/// since the glass reflects as the base's specular lobe does (same IOR and
+/// roughness). Coat and sheen lie on the base's share only; the glass's
+/// inside absorbs nothing (a ray inside may leave through the base's share).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transmission {
+    pub factor: f32,
+    /// Linear: R × the factor.
+    pub texture: Option<TextureRef>,
+    /// The glass's index of refraction (`KHR_materials_ior`).
+    pub ior: f32,
+}
+
+impl Transmission {
+    /// The glass of the (textured) base `bsdf`'s colour and roughness.
+    fn glass(&self, bsdf: &crate::bsdf::Bsdf) -> Material {
+        Material::Glass(crate::bsdf::dielectric::Dielectric {
+            ior: self.ior,
+            roughness: bsdf.roughness,
+            tint: bsdf.base_color,
+            absorption: Rgb::ZERO,
+        })
+    }
+}
+
+/// The material at a point ([`Texturing::apply`]): where the file mixes
+/// two ([`Transmission`]) the one this hit drew, the probability it had and
+/// the other; else the one material, drawn with probability 1.
+/// Borrowed where nothing was looked up (`Scene::material_at` says why).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Drawn<'a> {
+    pub material: Cow<'a, Material>,
+    pub probability: f32,
+    pub other: Option<Material>,
+}
+
+impl<'a> Drawn<'a> {
+    pub fn only(material: Cow<'a, Material>) -> Drawn<'a> {
+        Drawn { material, probability: 1.0, other: None }
+    }
+
+    /// What a photon stored at this hit (which stores only where `stores`
+    /// says the drawn material does) is weighted by: 1 / the probability
+    /// that a hit here stores, so that the stored power is the incident
+    /// power whichever material was drawn.
+    pub fn store_weight(&self, stores: impl Fn(&Material) -> bool) -> f32 {
+        let other = self.other.as_ref().is_some_and(&stores) as u32 as f32;
+        let p_store = self.probability * stores(&self.material) as u32 as f32 + (1.0 - self.probability) * other;
+        if p_store > 0.0 { 1.0 / p_store } else { 0.0 }
+    }
+}
+
 /// What a material takes from textures (glTF's metallic–roughness model);
 /// each texture multiplies its factor, which the material already holds.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -265,6 +338,8 @@ pub struct MaterialTextures {
     pub normal_scale: f32,
     /// The clear-coat, sheen and specular extensions' textures.
     pub layers: LayerTextures,
+    /// A share let through as glass, drawn per hit.
+    pub transmission: Option<Transmission>,
 }
 
 impl MaterialTextures {
@@ -274,6 +349,7 @@ impl MaterialTextures {
             || self.emissive.is_some()
             || self.normal.is_some()
             || self.layers.any()
+            || self.transmission.is_some_and(|t| t.texture.is_some())
     }
 }
 
@@ -451,6 +527,16 @@ impl Texturing {
         Some(self.images[texture.image as usize].sample(texture.image_uv(uv), texture.sampler))
     }
 
+    /// Does any material let a share through as glass ([`Transmission`])?
+    pub fn has_mixes(&self) -> bool {
+        self.materials.iter().flatten().any(|m| m.transmission.is_some())
+    }
+
+    /// Does `material` let a share through as glass ([`Transmission`])?
+    pub fn mixes(&self, material: u32) -> bool {
+        self.textures(material).is_some_and(|t| t.transmission.is_some())
+    }
+
     /// Is any material a MASK cut-out or BLEND (so the BVH must test alpha)?
     pub fn has_masks(&self) -> bool {
         self.materials.iter().flatten().any(|m| m.alpha_mode != AlphaMode::Opaque)
@@ -486,14 +572,17 @@ impl Texturing {
     }
 
     /// `material` (of index `index`) at primitive `prim`, barycentrics `b`,
-    /// with its textures applied. Textures without coordinates (a primitive
-    /// without `TEXCOORD_0`) leave the factors alone.
-    pub fn apply(&self, material: Material, index: u32, prim: u32, b: Vec2) -> Material {
-        let Some(t) = self.textures(index) else { return material };
+    /// with its textures applied, and where it mixes in glass
+    /// ([`Transmission`]) one of the two drawn by `u()` (uniform in [0, 1),
+    /// [`mix_threshold`]; asked only of mixes). Textures without
+    /// coordinates (a primitive without `TEXCOORD_0`) leave the factors
+    /// alone.
+    pub fn apply(&self, material: Material, index: u32, prim: u32, b: Vec2, u: impl FnOnce() -> f32) -> Drawn<'static> {
+        let Some(t) = self.textures(index) else { return Drawn::only(Cow::Owned(material)) };
         let uv = self.uvs.at(prim, b);
         let base = self.lookup(t.base_color, uv).map_or(Rgb::ONE, |c| c.xyz());
         let mr = self.lookup(t.metallic_roughness, uv);
-        match material {
+        let textured = match material {
             Material::Pbr(mut bsdf) => {
                 bsdf.base_color *= base;
                 if let Some(mr) = mr {
@@ -515,18 +604,46 @@ impl Texturing {
                 Material::Glass(glass)
             }
             other => other,
+        };
+        let (Some(transmission), Material::Pbr(mut bsdf)) = (t.transmission, textured) else {
+            return Drawn::only(Cow::Owned(textured));
+        };
+        let share = transmission.factor * self.lookup(transmission.texture, uv).map_or(1.0, |c| c.x);
+        let p_glass = (share * (1.0 - bsdf.metallic)).clamp(0.0, 1.0);
+        if p_glass <= 0.0 {
+            return Drawn::only(Cow::Owned(textured));
+        }
+        let glass = transmission.glass(&bsdf);
+        // The metal keeps its share m of the whole: m / (1 − p) of the rest.
+        if p_glass < 1.0 {
+            bsdf.metallic = (bsdf.metallic / (1.0 - p_glass)).min(1.0);
+        }
+        let rest = Material::Pbr(bsdf);
+        if u() < p_glass {
+            Drawn { material: Cow::Owned(glass), probability: p_glass, other: Some(rest) }
+        } else {
+            Drawn { material: Cow::Owned(rest), probability: 1.0 - p_glass, other: Some(glass) }
         }
     }
 
     /// `material` (of index `index`) with its layer textures' means
-    /// (`LayerTextures`; over the whole image) as factors: what the GPU
-    /// renderer draws, which reads those textures nowhere per point yet.
+    /// (`LayerTextures`; over the whole image) as factors, and a
+    /// [`Transmission`] mix drawn as its glass where the mean share
+    /// (factor × the texture's mean R, times 1 − metallic) is a half or
+    /// more, else as the base alone: what the GPU renderer draws, which reads
+    /// those textures nowhere per point and draws no mix yet.
     pub fn with_layer_means(&self, material: Material, index: u32) -> Material {
-        match (material, self.textures(index)) {
-            (Material::Pbr(bsdf), Some(t)) if t.layers.any() => {
-                Material::Pbr(t.layers.apply(bsdf, |texture| texture.map(|t| self.images[t.image as usize].mean())))
+        let Some(t) = self.textures(index) else { return material };
+        let mean = |texture: Option<TextureRef>| texture.map(|t| self.images[t.image as usize].mean());
+        if let (Some(transmission), Material::Pbr(bsdf)) = (t.transmission, material) {
+            let share = transmission.factor * mean(transmission.texture).map_or(1.0, |c| c.x);
+            if share * (1.0 - bsdf.metallic) >= 0.5 {
+                return transmission.glass(&bsdf);
             }
-            (other, _) => other,
+        }
+        match material {
+            Material::Pbr(bsdf) if t.layers.any() => Material::Pbr(t.layers.apply(bsdf, mean)),
+            other => other,
         }
     }
 

@@ -315,6 +315,17 @@ impl<'a> PhotonCpuRenderer<'a> {
                     let f = |wi: glam::Vec3| bsdf.f(wo, frame.to_local(wi));
                     l += direct_reflected(self.scene, hit.point, ns, ng, f, self.settings.area_light_samples, rng);
                 }
+                // Behind a partly transmissive surface (inside its body) no
+                // photons are stored (`photon::trace`): one sampled bounce of
+                // the whole BRDF shows the light inside, what it sees
+                // emitted left to the shadow rays but through a mirror lobe.
+                if facing < 0.0 && self.scene.mixes_at(&hit) {
+                    if can_recurse && let Some(s) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
+                        let next = Ray::new(hit.point, frame.to_world(s.wi));
+                        l += s.weight * self.radiance_seen(&next, depth + 1, s.is_delta, rng);
+                    }
+                    return l;
+                }
                 l += self.photon_radiance_brdf(hit.point, &frame, ng, part);
                 // A lobe smoother than the gather threshold is followed, one
                 // sampled direction per eye ray. A glossy (non-delta) one

@@ -152,13 +152,42 @@ impl Scene {
     /// where nothing is textured: a copy just made and read back at once
     /// stalls the load on its store (the path tracer's step spent 5% of its
     /// time on one such load, perf).
+    ///
+    /// Where the file mixes two materials (`texture::Transmission`) this
+    /// is the one the hit drew ([`Scene::drawn_material_at`]): any estimate
+    /// that uses it once is the mix's on average.
     pub fn material_at(&self, hit: &Hit) -> Cow<'_, Material> {
         let index = self.surfaces[hit.surface as usize].material;
         let material = &self.materials[index as usize];
         match &self.texturing {
-            Some(t) => Cow::Owned(t.apply(*material, index, hit.prim, hit.barycentrics)),
+            Some(t) => t.apply(*material, index, hit.prim, hit.barycentrics, || mix_draw(hit)).material,
             None => Cow::Borrowed(material),
         }
+    }
+
+    /// [`Scene::material_at`] with the probability it was drawn with and the
+    /// material not drawn.
+    pub fn drawn_material_at(&self, hit: &Hit) -> crate::texture::Drawn<'_> {
+        let index = self.surfaces[hit.surface as usize].material;
+        let material = &self.materials[index as usize];
+        match &self.texturing {
+            Some(t) => t.apply(*material, index, hit.prim, hit.barycentrics, || mix_draw(hit)),
+            None => crate::texture::Drawn::only(Cow::Borrowed(material)),
+        }
+    }
+
+    /// Is the surface at `hit` partly transmissive (`texture::Transmission`)?
+    pub fn mixes_at(&self, hit: &Hit) -> bool {
+        self.texturing.as_ref().is_some_and(|t| t.mixes(self.surfaces[hit.surface as usize].material))
+    }
+
+    /// What a photon stored at `hit`, where [`Scene::material_at`]'s
+    /// material stores, is weighted by (`texture::Drawn::store_weight`; 1
+    /// but on partly transmissive materials). `stores` says which
+    /// materials store.
+    #[inline(never)]
+    pub fn store_weight(&self, hit: &Hit, stores: impl Fn(&Material) -> bool) -> f32 {
+        if self.mixes_at(hit) { self.drawn_material_at(hit).store_weight(stores) } else { 1.0 }
     }
 
     /// The shading normal at `hit` (reached travelling along `dir`), bent
@@ -231,4 +260,9 @@ impl Scene {
         let total: f32 = powers.iter().sum();
         powers.iter().map(|p| p / total).collect()
     }
+}
+
+/// The uniform number that draws a mixed material at `hit`.
+fn mix_draw(hit: &Hit) -> f32 {
+    crate::texture::mix_threshold(hit.prim, hit.point)
 }

@@ -40,7 +40,7 @@ use super::Image;
 use crate::bsdf::dielectric::Transport;
 use crate::geometry::Ray;
 use crate::light::Light;
-use crate::material::Rgb;
+use crate::material::{Material, Rgb};
 use crate::progressive::RadiusSchedule;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -357,10 +357,15 @@ impl Pass<'_> {
         let mut departure_density = 1.0;
         loop {
             let step = flight::step(self.scene, &ray, rng);
+            // Where glass is mixed in, merges stored on one material's draws
+            // stand for the other's draws that store none (`store_weight`).
+            let mut store_weight = 1.0;
             let (point, scatter) = match step.event {
                 Event::Escaped => break,
                 Event::Surface(hit) => {
-                    (hit.point, Scatter::at(*self.scene.material_at(&hit), &hit, ray.dir, Transport::Importance))
+                    let scatter_of = |m: &Material| Scatter::at(*m, &hit, ray.dir, Transport::Importance);
+                    store_weight = self.scene.store_weight(&hit, |m| scatter_of(m).is_some_and(|s| !s.is_delta()));
+                    (hit.point, scatter_of(&self.scene.material_at(&hit)))
                 }
                 Event::Medium { point, mask } => (point, Scatter::medium(&self.scene.media, mask, ray.dir)),
             };
@@ -387,7 +392,7 @@ impl Pass<'_> {
                             let sigma_s = self.scene.media.sigma_s(mask);
                             (&mut out.volume, Rgb::select(sigma_s.cmpgt(Rgb::ZERO), throughput / sigma_s, Rgb::ZERO))
                         }
-                        _ => (&mut out.surface, throughput),
+                        _ => (&mut out.surface, throughput * store_weight),
                     };
                     let record = MergeRecord {
                         throughput,

@@ -26,6 +26,9 @@ pub struct PbrMaterial {
     pub emission: Rgb,
     /// Smooth glass with this index of refraction (`KHR_materials_transmission`).
     pub glass_ior: Option<f32>,
+    /// The share of the glass's light let through (the extension's
+    /// `transmissionFactor`; 1: glass throughout, else a mix with the base).
+    pub transmission: f32,
     /// The glass's inside absorption per unit length (`KHR_materials_volume`,
     /// written as the colour e^−σ at distance 1; zero: none written).
     pub glass_absorption: Rgb,
@@ -54,6 +57,9 @@ pub struct PbrMaterial {
     pub emissive_texture: Option<Index<json::Texture>>,
     /// A normal texture and its `scale`.
     pub normal_texture: Option<(Index<json::Texture>, f32)>,
+    /// `KHR_materials_transmission`'s texture (R × the factor; with
+    /// `glass_ior` only).
+    pub transmission_texture: Option<Index<json::Texture>>,
 }
 
 impl Default for PbrMaterial {
@@ -65,6 +71,7 @@ impl Default for PbrMaterial {
             roughness: 1.0,
             emission: Rgb::ZERO,
             glass_ior: None,
+            transmission: 1.0,
             glass_absorption: Rgb::ZERO,
             specular: 1.0,
             specular_color: Rgb::ONE,
@@ -78,6 +85,7 @@ impl Default for PbrMaterial {
             alpha_mode: AlphaMode::Opaque,
             base_color_texture: None,
             metallic_roughness_texture: None,
+            transmission_texture: None,
             emissive_texture: None,
             normal_texture: None,
         }
@@ -235,8 +243,8 @@ impl GltfBuilder {
         }
         if let Some(ior) = m.glass_ior {
             extensions.transmission = Some(json::extensions::material::Transmission {
-                transmission_factor: json::extensions::material::TransmissionFactor(1.0),
-                transmission_texture: None,
+                transmission_factor: json::extensions::material::TransmissionFactor(m.transmission),
+                transmission_texture: info(m.transmission_texture),
                 extras: Default::default(),
             });
             extensions.ior = Some(json::extensions::material::Ior {

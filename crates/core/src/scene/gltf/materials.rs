@@ -1,9 +1,11 @@
 //! glTF materials as hikari materials: `pbrMetallicRoughness` is
 //! [`Material::Pbr`] (the specification's BRDF, `crate::bsdf`); a
-//! transmissive material (`KHR_materials_transmission` ≥ 0.5) is glass
-//! ([`Dielectric`]) of the base colour's tint, the roughness and
+//! transmissive material (`KHR_materials_transmission` 1, metallic 0) is
+//! glass ([`Dielectric`]) of the base colour's tint, the roughness and
 //! `KHR_materials_ior` (which also sets an opaque dielectric's
-//! reflectance); `KHR_materials_specular`'s factor scales the
+//! reflectance); a partly transmissive one (factor below 1, a
+//! `transmissionTexture`, metallic) is the base with a share of that glass
+//! drawn per hit (`texture::Transmission`); `KHR_materials_specular`'s factor scales the
 //! dielectric's Fresnel and its colour F0's; `KHR_materials_clearcoat`
 //! and `KHR_materials_sheen` add their layers; the three extensions'
 //! textures multiply their factors (`texture::LayerTextures`; the coat's
@@ -19,7 +21,7 @@ use super::textures::Images;
 use crate::bsdf::Bsdf;
 use crate::bsdf::dielectric::Dielectric;
 use crate::material::{Material, Rgb};
-use crate::texture::{AlphaMode, ColorSpace, LayerTextures, MaterialTextures};
+use crate::texture::{AlphaMode, ColorSpace, LayerTextures, MaterialTextures, Transmission};
 use glam::{Vec3, Vec4Swizzles};
 
 /// Light a surface emits: `emissiveFactor` × `KHR_materials_emissive_strength`,
@@ -47,10 +49,10 @@ pub struct Converted {
 pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -> Converted {
     let mut unread_maps = 0;
     let mut other_sets = 0;
-    let mut approximated = 0;
+    let mut mixed = 0;
+    let mut mixed_volumes = 0;
     let mut layer_textures = 0;
     let mut missing_layer_textures = 0;
-    let mut transmission_textures = 0;
     let mut coat_normals = 0;
     let mut malformed_coats = 0;
     let mut coated_glass = 0;
@@ -87,8 +89,11 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let base = sane(Vec3::new(r, g, b), 1.0);
             let metallic = sane(Vec3::splat(pbr.metallic_factor()), 1.0).x;
             let roughness = sane(Vec3::splat(pbr.roughness_factor()), 1.0).x;
-            let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
-            transmission_textures += m.transmission().is_some_and(|t| t.transmission_texture().is_some()) as usize;
+            let transmission = sane(Vec3::splat(m.transmission().map_or(0.0, |t| t.transmission_factor())), 1.0).x;
+            let transmission_info = m.transmission().and_then(|t| t.transmission_texture());
+            let transmission_texture =
+                transmission_info.as_ref().and_then(|info| images.texture(info, ColorSpace::Linear));
+            other_sets += (transmission_info.is_some() && transmission_texture.is_none()) as usize;
             let coat = Clearcoat::of(&m);
             coat_normals += coat.normal_textured as usize;
             malformed_coats += coat.malformed as usize;
@@ -98,11 +103,12 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             layer_textures += layers.any() as usize;
             other_sets += unread_layers as usize;
             missing_layer_textures += missing as usize;
-            let material = if transmission >= 0.5 {
-                coated_glass += (coat.factor > 0.0) as usize;
-                sheened_glass += (sheen.color.max_element() > 0.0) as usize;
-                approximated += (transmission < 1.0) as usize;
-                let absorption = match volume_absorption(&m, absorbs) {
+            let transmits = transmission > 0.0;
+            // Glass throughout: all of it transmits, nothing metallic
+            // (`texture::Transmission` draws any other share per hit).
+            let all_glass = transmission >= 1.0 && metallic == 0.0 && transmission_texture.is_none();
+            let absorption = if transmits {
+                match volume_absorption(&m, absorbs) {
                     Ok(a) => {
                         blender_volumes += (absorbs == Absorbs::AsBlender && a != Vec3::ZERO) as usize;
                         a
@@ -111,30 +117,38 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                         malformed_volumes += 1;
                         Vec3::ZERO
                     }
-                };
-                // The base colour tints what crosses (glTF's BTDF, and Cycles').
-                Material::Glass(Dielectric {
-                    ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0),
-                    roughness,
-                    tint: base,
-                    absorption,
-                })
+                }
             } else {
-                approximated += (transmission > 0.0) as usize;
                 opaque_volumes += volume_absorption(&m, absorbs).is_ok_and(|a| a != Vec3::ZERO) as usize;
+                Vec3::ZERO
+            };
+            // The base colour tints what crosses (glTF's BTDF, and Cycles').
+            let glass = Dielectric { ior: m.ior().unwrap_or(1.5).clamp(1.0, 3.0), roughness, tint: base, absorption };
+            let mix = (transmits && !all_glass).then_some(Transmission {
+                factor: transmission,
+                texture: transmission_texture,
+                ior: glass.ior,
+            });
+            mixed += mix.is_some() as usize;
+            mixed_volumes += mix.is_some_and(|_| absorption != Vec3::ZERO) as usize;
+            coated_glass += (transmits && coat.factor > 0.0) as usize;
+            sheened_glass += (transmits && sheen.color.max_element() > 0.0) as usize;
+            let material = if all_glass {
+                Material::Glass(glass)
+            } else {
                 // KHR_materials_specular's factor scales the dielectric's
                 // Fresnel (0: a pure Lambertian, as hikari's "diffuse").
                 let specular = m.specular().map_or(1.0, |s| s.specular_factor());
                 // Its colour scales F0 per channel.
                 let specular_color = m.specular().map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor()));
                 // KHR_materials_ior sets the dielectric's reflectance.
-                Material::from_bsdf(
-                    Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
-                        .with_clearcoat(coat.factor, coat.roughness)
-                        .with_sheen(sheen.color, sheen.roughness)
-                        .with_specular_color(specular_color)
-                        .with_ior(m.ior().unwrap_or(1.5).clamp(1.0, 3.0)),
-                )
+                let bsdf = Bsdf::new(base, metallic, roughness, sane(Vec3::splat(specular), 1.0).x)
+                    .with_clearcoat(coat.factor, coat.roughness)
+                    .with_sheen(sheen.color, sheen.roughness)
+                    .with_specular_color(specular_color)
+                    .with_ior(m.ior().unwrap_or(1.5).clamp(1.0, 3.0));
+                // A mix's glass takes the base's roughness: kept as a BRDF.
+                if mix.is_some() { Material::Pbr(bsdf) } else { Material::from_bsdf(bsdf) }
             };
             // An emissive texture varies the radiance over the surface; the
             // light (uniform over its mesh) emits the texture's mean.
@@ -153,8 +167,9 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 normal: normal.map(|(t, _)| t),
                 normal_scale: normal.map_or(1.0, |(_, scale)| if scale.is_finite() { scale } else { 1.0 }),
                 layers,
+                transmission: mix,
             };
-            textures.push((t.is_textured() || alpha_mode != AlphaMode::Opaque).then_some(t));
+            textures.push((t.is_textured() || alpha_mode != AlphaMode::Opaque || mix.is_some()).then_some(t));
             (material, emission)
         })
         .unzip();
@@ -172,21 +187,23 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             "{other_sets} material(s) read textures through texCoord other than 0 (TEXCOORD_0): those textures are ignored"
         ));
     }
-    if approximated > 0 {
+    if mixed > 0 {
         notes.push(format!(
-            "{approximated} material(s) approximated: transmission from 0.5 as glass (factor 1), below 0.5 as none"
+            "{mixed} material(s) let part of their light through as glass (KHR_materials_transmission below 1, a \
+             transmissionTexture or a metallic factor): the CPU renderers mix glass and the base at each point; the \
+             GPU renderer draws glass where the mean share is 0.5 or more, else the base alone"
+        ));
+    }
+    if mixed_volumes > 0 {
+        notes.push(format!(
+            "{mixed_volumes} partly transmissive material(s) have KHR_materials_volume attenuation, which only \
+             materials that are glass throughout (transmission 1, metallic 0, no transmissionTexture) absorb by: ignored"
         ));
     }
     if layer_textures > 0 {
         notes.push(format!(
             "{layer_textures} material(s) have clear-coat, sheen or specular textures: the CPU renderers read them at \
              each point; the GPU renderer draws each with its mean over the image"
-        ));
-    }
-    if transmission_textures > 0 {
-        notes.push(format!(
-            "{transmission_textures} material(s) have a transmissionTexture, which is not read: the \
-             transmissionFactor applies uniformly"
         ));
     }
     if missing_layer_textures > 0 {
@@ -207,7 +224,10 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
         ));
     }
     if coated_glass > 0 {
-        notes.push(format!("{coated_glass} transmissive material(s) have a clear coat, which is ignored on glass"));
+        notes.push(format!(
+            "{coated_glass} transmissive material(s) have a clear coat, which is ignored on their glass (the share \
+             that transmits)"
+        ));
     }
     if malformed_sheens > 0 {
         notes.push(format!(
@@ -216,7 +236,10 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
         ));
     }
     if sheened_glass > 0 {
-        notes.push(format!("{sheened_glass} transmissive material(s) have a sheen, which is ignored on glass"));
+        notes.push(format!(
+            "{sheened_glass} transmissive material(s) have a sheen, which is ignored on their glass (the share that \
+             transmits)"
+        ));
     }
     if opaque_volumes > 0 {
         notes.push(format!(

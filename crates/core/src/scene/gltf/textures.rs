@@ -189,6 +189,10 @@ fn used_textures<'a>(doc: &'a gltf::Document) -> Vec<(String, gltf::Texture<'a>,
             let color = info(s.specular_color_texture());
             push("extensions.KHR_materials_specular.specularColorTexture", color, ColorSpace::Srgb);
         }
+        if let Some(t) = m.transmission() {
+            let texture = info(t.transmission_texture());
+            push("extensions.KHR_materials_transmission.transmissionTexture", texture, ColorSpace::Linear);
+        }
         for (extension, keys) in LAYER_JSON_TEXTURES {
             for (key, value, space) in extension_textures(&m, extension, keys) {
                 let read = json_info(doc, value).map(|(texture, tex_coord, transform)| {
