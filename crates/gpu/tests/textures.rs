@@ -513,3 +513,52 @@ fn no_direct_light_comes_from_below_a_bent_surface() {
     assert!(above > 0.01 && path_above > 0.01, "light from above the quad: {above}, path {path_above}");
     assert!((above / path_above - 1.0).abs() < 0.05, "above: GPU {above}, path {path_above}");
 }
+
+/// A mesh whose normals face away from its winding: every renderer keeps
+/// the shading normal on the geometric normal's side (Accel::intersect), so
+/// the G-buffer's normals face the eye as the quad's winding does and its
+/// direct light is path's (the G-buffer had drawn it black).
+#[test]
+fn normals_against_the_winding_shade_as_the_winding() {
+    use glam::Vec3;
+    use gltf::json::extensions::scene::khr_lights_punctual::Type;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial};
+    use hikari_core::test_scenes::gltf_textures::load;
+    let ctx = test_context("normals_against_the_winding_shade_as_the_winding");
+    let mut b = GltfBuilder::new();
+    let m = b.material(&PbrMaterial { base_color: Vec3::splat(0.5), specular: 0.0, ..Default::default() });
+    // Wound toward +z, its normals −z.
+    let positions =
+        [Vec3::new(-0.5, -0.5, 0.0), Vec3::new(0.5, -0.5, 0.0), Vec3::new(0.5, 0.5, 0.0), Vec3::new(-0.5, 0.5, 0.0)];
+    let normals = [-Vec3::Z; 4];
+    let mesh = b.textured_mesh(&positions, Some(&normals), None, Some(&[0, 1, 2, 0, 2, 3]), Some(m));
+    let node = b.node(gltf::json::Node { mesh: Some(mesh), ..Default::default() });
+    let light = b.light(Type::Point, Vec3::ONE, 683.0, None);
+    let light = b.node(GltfBuilder::light_node(light, Vec3::new(0.5, 0.0, 1.5), glam::Quat::IDENTITY));
+    let mut scene = load("gpu-flipped-normals", &b.to_glb(vec![node, light]));
+    scene.camera =
+        hikari_core::camera::Camera::new(Vec3::new(0.0, 0.0, 2.5), Vec3::ZERO, Vec3::Y, 20.0, 32, 32).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let gpu = hikari_gpu::GpuRenderer::new(ctx.clone(), &scene, &traced, hikari_gpu::GpuSettings::new(global, caustic))
+        .expect("GPU renderer");
+    gpu.render().unwrap();
+    let direct = gpu.read(&gpu.targets.direct).unwrap();
+    let normals = gpu.read(&gpu.targets.gbuffer.normal).unwrap();
+    let positions = gpu.read(&gpu.targets.gbuffer.position).unwrap();
+    let seen: Vec<usize> = (0..positions.len()).filter(|&i| positions[i].w != 0.0).collect();
+    assert!(seen.len() > 500, "{} pixels see the quad", seen.len());
+    for &i in &seen {
+        assert!((normals[i].truncate() - Vec3::Z).length() < 1e-4, "pixel {i}: normal {}", normals[i].truncate());
+    }
+    let gpu_mean = seen.iter().map(|&i| direct[i].truncate().max_element()).sum::<f32>() / seen.len() as f32;
+    // The path tracer, the reference: the quad alone, so all it shows is direct light.
+    let settings = hikari_core::render::path::PathSettings { spp: 4, ..Default::default() };
+    let (image, _) = hikari_core::render::path::render(&scene, &settings, &Silent);
+    let path_mean = image.pixels.iter().map(|p| p.max_element()).sum::<f32>() / seen.len() as f32;
+    eprintln!("direct light on a quad whose normals oppose its winding: GPU {gpu_mean}, path {path_mean}");
+    assert!(path_mean > 0.01 && (gpu_mean / path_mean - 1.0).abs() < 0.05, "GPU {gpu_mean}, path {path_mean}");
+}

@@ -112,7 +112,11 @@ fn shade(in: VertexOut) -> GBufferOut {
     var out: GBufferOut;
     let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
     let tangent = vec4<f32>(in.tangent, in.tangent_side);
-    let n = bent_normal(surface, uv, dx, dy, px, py, tangent, normalize(in.normal), in.geometric_normal, normalize(view));
+    // The shading normal on the geometric normal's side, as Accel::intersect
+    // and hit_normals keep it (a mesh's normals may disagree with its winding).
+    let interpolated = normalize(in.normal);
+    let shading = select(interpolated, -interpolated, dot(interpolated, in.geometric_normal) < 0.0);
+    let n = bent_normal(surface, uv, dx, dy, px, py, tangent, shading, in.geometric_normal, normalize(view));
     // Both normals turned toward the eye, as the gathers read them.
     var geometric = 1.0;
     if (BENT) {
