@@ -62,16 +62,32 @@ pub fn octahedral_direction(p: Vec2) -> Vec3 {
     Vec3::new(x, y, z).normalize()
 }
 
-/// Octahedral map of a unit vector to [-1,1]², quantised to 15 bits per axis.
+/// A unit direction's octahedral point quantised to `bits` per axis, x in
+/// the low `bits` and y above (`bits` at most 16).
 #[inline]
-pub fn encode_octahedral_15(d: Vec3) -> u32 {
-    let q = |x: f32| ((x * 0.5 + 0.5) * 32767.0 + 0.5) as u32 & 0x7fff;
+pub fn encode_octahedral(d: Vec3, bits: u32) -> u32 {
+    let mask = (1u32 << bits) - 1;
+    let q = |x: f32| ((x * 0.5 + 0.5) * mask as f32 + 0.5) as u32 & mask;
     let p = octahedral_square(d);
-    q(p.x) | (q(p.y) << 15)
+    q(p.x) | (q(p.y) << bits)
 }
 
+/// The direction of [`encode_octahedral`]'s code of `bits` per axis.
+#[inline]
+pub fn decode_octahedral(code: u32, bits: u32) -> Vec3 {
+    let mask = (1u32 << bits) - 1;
+    octahedral_direction(Vec2::new((code & mask) as f32, ((code >> bits) & mask) as f32) / mask as f32 * 2.0 - 1.0)
+}
+
+/// The photon's direction code: 15 + 15 bits.
+#[inline]
+pub fn encode_octahedral_15(d: Vec3) -> u32 {
+    encode_octahedral(d, 15)
+}
+
+#[inline]
 pub fn decode_octahedral_15(bits: u32) -> Vec3 {
-    octahedral_direction(Vec2::new((bits & 0x7fff) as f32, ((bits >> 15) & 0x7fff) as f32) / 32767.0 * 2.0 - 1.0)
+    decode_octahedral(bits, 15)
 }
 
 #[cfg(test)]

@@ -7,7 +7,7 @@
 //! top two bits hold the photon's path class.
 
 mod encoding;
-pub use encoding::{octahedral_direction, octahedral_square};
+pub use encoding::{decode_octahedral, encode_octahedral, octahedral_direction, octahedral_square};
 mod map;
 mod trace;
 mod volume_map;

@@ -6,9 +6,9 @@
 //! it, as photon-cpu does. geometric_normal.wgsl is the GPU's half; this
 //! Rust one reads a G-buffer back (the twin tests).
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use hikari_core::estimate::is_bent;
-use hikari_core::photon::{octahedral_direction, octahedral_square};
+use hikari_core::photon::{decode_octahedral, encode_octahedral};
 
 /// The WGSL half (`pack_geometric_normal`, `unpack_geometric_normal`, `is_bent`).
 pub static GEOMETRIC_NORMAL: crate::wgsl::Module = crate::wgsl::Module {
@@ -17,27 +17,16 @@ pub static GEOMETRIC_NORMAL: crate::wgsl::Module = crate::wgsl::Module {
     requires: &[&crate::wgsl::PHOTON_ENCODING],
 };
 
-/// The octahedral map (`photon::encoding`) quantised to 12 + 12 bits.
-pub fn encode_octahedral_12(d: Vec3) -> u32 {
-    let q = |x: f32| ((x * 0.5 + 0.5) * 4095.0 + 0.5) as u32 & 0xfff;
-    let p = octahedral_square(d);
-    q(p.x) | (q(p.y) << 12)
-}
-
-pub fn decode_octahedral_12(bits: u32) -> Vec3 {
-    octahedral_direction(Vec2::new((bits & 0xfff) as f32, ((bits >> 12) & 0xfff) as f32) / 4095.0 * 2.0 - 1.0)
-}
-
 /// What position.w stores where a surface shading with `ns` across `ng`
 /// (unit, on the same side) is seen.
 pub fn pack_geometric_normal(ns: Vec3, ng: Vec3) -> f32 {
-    if !is_bent(ns, ng) { 1.0 } else { -((1 + encode_octahedral_12(ng)) as f32) }
+    if !is_bent(ns, ng) { 1.0 } else { -((1 + encode_octahedral(ng, 12)) as f32) }
 }
 
 /// The geometric normal from a seen pixel's position.w and its shading
 /// normal `ns`.
 pub fn unpack_geometric_normal(packed: f32, ns: Vec3) -> Vec3 {
-    if packed > 0.0 { ns } else { decode_octahedral_12((-packed) as u32 - 1) }
+    if packed > 0.0 { ns } else { decode_octahedral((-packed) as u32 - 1, 12) }
 }
 
 #[cfg(test)]

@@ -51,12 +51,24 @@ fn octahedral_direction(p: vec2<f32>) -> vec3<f32> {
     return normalize(vec3<f32>(x, y, z));
 }
 
-// Octahedral direction, 15 + 15 bits.
+// A unit direction's octahedral point quantised to `bits` per axis, x in
+// the low `bits` and y above: photon::encode_octahedral / decode_octahedral.
+fn encode_octahedral(direction: vec3<f32>, bits: u32) -> u32 {
+    let mask = (1u << bits) - 1u;
+    let q = vec2<u32>((octahedral_square(direction) * 0.5 + 0.5) * f32(mask) + 0.5) & vec2<u32>(mask);
+    return q.x | (q.y << bits);
+}
+
+fn decode_octahedral(code: u32, bits: u32) -> vec3<f32> {
+    let mask = (1u << bits) - 1u;
+    return octahedral_direction(vec2<f32>(f32(code & mask), f32((code >> bits) & mask)) / f32(mask) * 2.0 - 1.0);
+}
+
+// The photon's direction code: 15 + 15 bits.
 fn decode_octahedral_15(bits: u32) -> vec3<f32> {
-    return octahedral_direction(vec2<f32>(f32(bits & 0x7fffu), f32((bits >> 15u) & 0x7fffu)) / 32767.0 * 2.0 - 1.0);
+    return decode_octahedral(bits, 15u);
 }
 
 fn encode_octahedral_15(direction: vec3<f32>) -> u32 {
-    let q = vec2<u32>((octahedral_square(direction) * 0.5 + 0.5) * 32767.0 + 0.5) & vec2<u32>(0x7fffu);
-    return q.x | (q.y << 15u);
+    return encode_octahedral(direction, 15u);
 }
