@@ -627,20 +627,13 @@ impl Texturing {
     }
 
     /// `material` (of index `index`) with its layer textures' means
-    /// (`LayerTextures`; over the whole image) as factors, and a
-    /// [`Transmission`] mix drawn as its glass where the mean share
-    /// (factor × the texture's mean R, times 1 − metallic) is a half or
-    /// more, else as the base alone: what the GPU renderer draws, which reads
-    /// those textures nowhere per point and draws no mix yet.
+    /// (`LayerTextures`; over the whole image) as factors: what the GPU
+    /// renderer draws, which reads those textures nowhere per point. A
+    /// [`Transmission`] mix stays its base: the GPU draws the glass per
+    /// point as [`Texturing::apply`] does.
     pub fn with_layer_means(&self, material: Material, index: u32) -> Material {
         let Some(t) = self.textures(index) else { return material };
         let mean = |texture: Option<TextureRef>| texture.map(|t| self.images[t.image as usize].mean());
-        if let (Some(transmission), Material::Pbr(bsdf)) = (t.transmission, material) {
-            let share = transmission.factor * mean(transmission.texture).map_or(1.0, |c| c.x);
-            if share * (1.0 - bsdf.metallic) >= 0.5 {
-                return transmission.glass(&bsdf);
-            }
-        }
         match material {
             Material::Pbr(bsdf) if t.layers.any() => Material::Pbr(t.layers.apply(bsdf, mean)),
             other => other,

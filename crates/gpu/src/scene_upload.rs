@@ -92,10 +92,15 @@ pub struct GpuSurface {
     pub dielectric_f0: f32,
     /// The glTF BRDF's sheen roughness (`Bsdf::sheen_roughness`).
     pub sheen_roughness: f32,
-    pub _pad: [u32; 2],
+    /// The share of a kind-0 surface's dielectric base let through as glass
+    /// (`hikari_core::texture::Transmission`: its factor, 0: none; times
+    /// the R of `transmission_texture`), glass of IOR `transmission_ior`:
+    /// surface_point.wgsl's `draw_layer` draws it per point.
+    pub transmission: f32,
+    pub transmission_texture: u32,
     /// The glTF BRDF's sheen colour (`Bsdf::sheen_color`, black: none).
     pub sheen_color: [f32; 3],
-    pub _pad2: u32,
+    pub transmission_ior: f32,
     /// The glTF BRDF's specular colour (`Bsdf::specular_color`, white:
     /// glTF's default); for glass (kind 2), which has no such colour, its
     /// inside's absorption per scene unit (`Dielectric::absorption`,
@@ -239,7 +244,8 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
         .iter()
         .map(|s| {
             // Clear-coat, sheen and specular textures as their means (the
-            // GPU reads them nowhere per point yet; the scene's notes say so).
+            // GPU reads them nowhere per point yet; the scene's notes say so);
+            // a transmission mix as its base, with `transmission` below.
             let material = &match &scene.texturing {
                 Some(t) => t.with_layer_means(scene.materials[s.material as usize], s.material),
                 None => scene.materials[s.material as usize],
@@ -267,10 +273,16 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
             let mean = textures.emissive_mean;
             let per_texel =
                 Vec3::select(mean.cmpgt(Vec3::ZERO), emission / mean.max(Vec3::splat(f32::MIN_POSITIVE)), Vec3::ZERO);
-            // The glTF BRDF where it has a specular lobe, a coat or a sheen; exactly
-            // Lambertian ones (and the old materials) take the cheaper path.
+            // Glass mixed into a glTF material's base (only a `Pbr` one mixes).
+            let transmission = match material {
+                Material::Pbr(_) => textures.transmission,
+                _ => None,
+            };
+            // The glTF BRDF where it has a specular lobe, a coat or a sheen
+            // (or mixes in glass, which raises its metallic where drawn);
+            // exactly Lambertian ones (and the old materials) take the cheaper path.
             let glossy = match material {
-                Material::Pbr(bsdf) if bsdf.is_glossy() => Some(bsdf),
+                Material::Pbr(bsdf) if bsdf.is_glossy() || transmission.is_some() => Some(bsdf),
                 _ => None,
             };
             GpuSurface {
@@ -306,9 +318,10 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                 clearcoat_roughness: glossy.map_or(0.0, |b| b.clearcoat_roughness),
                 dielectric_f0: glossy.map_or(hikari_core::bsdf::DIELECTRIC_F0, |b| b.f0),
                 sheen_roughness: glossy.map_or(0.0, |b| b.sheen_roughness),
-                _pad: [0; 2],
+                transmission: transmission.map_or(0.0, |t| t.factor),
+                transmission_texture: views.reference(transmission.and_then(|t| t.texture)),
                 sheen_color: glossy.map_or([0.0; 3], |b| b.sheen_color.to_array()),
-                _pad2: 0,
+                transmission_ior: transmission.map_or(1.0, |t| t.ior),
                 specular_color: match material {
                     Material::Glass(glass) => glass.absorption.to_array(),
                     _ => glossy.map_or([1.0; 3], |b| b.specular_color.to_array()),

@@ -113,9 +113,10 @@ fn shared_structs_match_wgsl_layouts() {
             clearcoat_roughness,
             dielectric_f0,
             sheen_roughness,
-            _pad,
+            transmission,
+            transmission_texture,
             sheen_color,
-            _pad2,
+            transmission_ior,
             specular_color,
             _pad3
         ]

@@ -562,3 +562,92 @@ fn normals_against_the_winding_shade_as_the_winding() {
     eprintln!("direct light on a quad whose normals oppose its winding: GPU {gpu_mean}, path {path_mean}");
     assert!(path_mean > 0.01 && (gpu_mean / path_mean - 1.0).abs() < 0.05, "GPU {gpu_mean}, path {path_mean}");
 }
+
+/// `KHR_materials_transmission` below 1 on the GPU: each pixel of a pane
+/// letting 30% through as white glass over a black floor under a sun draws
+/// glass or base afresh each pass (about 30% of its pixels dark in a pass,
+/// the glass showing the black sky and floor), so the mean of passes is 70%
+/// of a white Lambertian's radiance, as on the CPU. The GPU tracer draws by
+/// the CPU tracer's hash: the same power stored on the pane (its base's
+/// draws weighing 1 / 0.7), none on its underside, and the same share
+/// through it onto a grey floor. From below, where no photon lies on the
+/// underside, its base draws show the floor's light by a sampled bounce,
+/// as photon-cpu's do.
+#[test]
+fn a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu() {
+    use glam::Vec3;
+    use hikari_core::camera::Camera;
+    use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
+    use hikari_core::scene::Scene;
+    use hikari_core::test_scenes::gltf_textures::{load, mixed_pane_glb};
+    let share = 0.3;
+    let size = 64;
+    let ctx = test_context("a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu");
+    // The mean of `passes` passes' pixels, and each pass's share of pixels
+    // above `bright`.
+    let passes_mean = |scene: &Scene, traced: &TracedPhotons, passes: u32, bright: f32| {
+        let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
+        let settings =
+            hikari_gpu::GpuSettings { shadow_map_size: 1024, ..hikari_gpu::GpuSettings::new(global, caustic) };
+        let mut gpu = hikari_gpu::GpuRenderer::new(ctx.clone(), scene, traced, settings).expect("GPU renderer");
+        let (mut sum, mut shares) = (0.0f64, Vec::new());
+        for pass in 1..=passes {
+            gpu.settings.pass = pass;
+            gpu.render().unwrap();
+            let image = gpu.read(gpu.resolved()).unwrap();
+            assert!(image.iter().all(|v| v.is_finite()));
+            sum += image.iter().map(|v| v.x as f64).sum::<f64>() / image.len() as f64;
+            shares.push(image.iter().filter(|v| v.x > bright).count() as f64 / image.len() as f64);
+        }
+        (sum / passes as f64, shares)
+    };
+    // From above: the whole image sees the pane.
+    let mut scene = load("gpu-mixed-pane", &mixed_pane_glb(share, 0.0));
+    scene.camera = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 20.0, size, size).unwrap();
+    let traced = trace_photons(&scene, &TraceSettings { photons: 20_000, ..Default::default() }, &Silent);
+    let lit = 2.0 / std::f32::consts::PI;
+    let (mean, shares) = passes_mean(&scene, &traced, 16, 0.5 * lit);
+    let expected = (1.0 - share) as f64 * lit as f64;
+    eprintln!(
+        "from above: mean of 16 passes {:.4} of lit (want {}), base shown per pass {shares:.3?}",
+        mean / lit as f64,
+        1.0 - share
+    );
+    assert!((mean / expected - 1.0).abs() < 0.03, "{mean} against {expected}");
+    for s in &shares {
+        assert!((s - (1.0 - share) as f64).abs() < 0.05, "a pass showed the base in {s} of its pixels");
+    }
+    // The GPU tracer's photons against the CPU tracer's, over a grey floor.
+    let grey = load("gpu-mixed-pane-grey", &mixed_pane_glb(share, 0.2));
+    let settings = TraceSettings { photons: 200_000, ..Default::default() };
+    let mut tracer = hikari_gpu::trace::GpuTracer::new(&ctx, &grey).expect("GPU tracer");
+    let (photons, _) = tracer.trace(&ctx, &settings).expect("photons");
+    let cpu = trace_photons(&grey, &settings, &Silent);
+    let sums = |t: &TracedPhotons| {
+        let power = |keep: &dyn Fn(&hikari_core::photon::Photon) -> bool| {
+            t.global.iter().filter(|p| keep(p)).map(|p| p.power_in_units().x as f64 * t.power_unit as f64).sum::<f64>()
+        };
+        let on_pane = power(&|p| (p.position[1] - 1.0).abs() < 1e-3 && p.direction().y < 0.0);
+        let underside = t.global.iter().filter(|p| (p.position[1] - 1.0).abs() < 1e-3 && p.direction().y > 0.0).count();
+        let direct = |p: &hikari_core::photon::Photon| p.class() != hikari_core::photon::PathClass::Indirect;
+        let under =
+            power(&|p| p.position[1].abs() < 1e-3 && direct(p) && p.position[0].abs().max(p.position[2].abs()) < 0.75);
+        (on_pane, underside, under)
+    };
+    let (g, c) = (sums(&photons), sums(&cpu));
+    eprintln!("GPU tracer (on the pane, its underside, under it): {g:?}; CPU tracer: {c:?}");
+    assert_eq!(g.1, 0, "photons stored on the pane's underside");
+    assert!((g.0 / c.0 - 1.0).abs() < 0.01, "power on the pane: GPU {} against CPU {}", g.0, c.0);
+    assert!((g.2 / c.2 - 1.0).abs() < 0.03, "power through the pane: GPU {} against CPU {}", g.2, c.2);
+    // From below: the underside's middle, against photon-cpu.
+    let mut below = grey;
+    below.camera = Camera::new(Vec3::new(0.0, 0.5, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Z, 10.0, size, size).unwrap();
+    let traced = trace_photons(&below, &TraceSettings { photons: 200_000, ..Default::default() }, &Silent);
+    let (gpu_mean, _) = passes_mean(&below, &traced, 32, f32::INFINITY);
+    let renderer = PhotonCpuRenderer::new(&below, &traced, &PhotonCpuSettings { spp: 8, ..Default::default() });
+    let cpu_mean = renderer.render(&Silent).0.mean() as f64;
+    eprintln!("the pane from below: GPU {gpu_mean:.5}, photon-cpu {cpu_mean:.5}");
+    assert!((gpu_mean / cpu_mean - 1.0).abs() < 0.08, "{gpu_mean} against {cpu_mean}");
+}

@@ -22,6 +22,9 @@ override SAMPLED_LIGHTS: bool = true;
 override SKY_IMAGE: bool = true;
 // Some medium fills the scene or a region (media.wgsl, view_depth.wgsl).
 override MEDIA: bool = true;
+// Some glTF surface lets a share of its light through as glass
+// (`Surface::transmission`; surface_point.wgsl's `draw_layer`).
+override MIXED: bool = true;
 // Some diffuse surface shades with a normal off its facets' (smooth vertex
 // normals, spheres, normal textures): the G-buffer keeps its geometric
 // normal and the photon gathers weigh shading_normal_factor

@@ -26,6 +26,7 @@ pub struct SceneFeatures {
     pub sky_image: bool,
     pub media: bool,
     pub bent: bool,
+    pub mixed: bool,
 }
 
 impl SceneFeatures {
@@ -40,6 +41,7 @@ impl SceneFeatures {
         sky_image: false,
         media: false,
         bent: false,
+        mixed: false,
     };
     pub const ALL: SceneFeatures = SceneFeatures {
         textured: true,
@@ -51,6 +53,7 @@ impl SceneFeatures {
         sky_image: true,
         media: true,
         bent: true,
+        mixed: true,
     };
 
     /// What `surfaces` (scene_upload::scene_surfaces) and `lights` use, in
@@ -59,9 +62,15 @@ impl SceneFeatures {
     pub fn of(surfaces: &[GpuSurface], lights: &[Light], media: bool, bent_geometry: bool) -> Self {
         SceneFeatures {
             textured: surfaces.iter().any(|s| {
-                [s.base_color_texture, s.metallic_roughness_texture, s.emissive_texture, s.normal_texture]
-                    .iter()
-                    .any(|&t| t != NO_TEXTURE)
+                [
+                    s.base_color_texture,
+                    s.metallic_roughness_texture,
+                    s.emissive_texture,
+                    s.normal_texture,
+                    s.transmission_texture,
+                ]
+                .iter()
+                .any(|&t| t != NO_TEXTURE)
             }),
             cut_outs: surfaces.iter().any(|s| s.alpha_cutoff >= 0.0),
             glossy: surfaces.iter().any(|s| s.glossy != 0),
@@ -71,6 +80,7 @@ impl SceneFeatures {
             sky_image: lights.iter().any(|l| matches!(l, Light::Environment { map: Some(_), .. })),
             media,
             bent: bent_geometry || surfaces.iter().any(|s| s.kind == kind::DIFFUSE && s.normal_texture != NO_TEXTURE),
+            mixed: surfaces.iter().any(|s| s.transmission > 0.0),
         }
     }
 
@@ -86,6 +96,7 @@ impl SceneFeatures {
             sky_image: self.sky_image || other.sky_image,
             media: self.media || other.media,
             bent: self.bent || other.bent,
+            mixed: self.mixed || other.mixed,
         }
     }
 
@@ -110,6 +121,7 @@ impl SceneFeatures {
             ("SKY_IMAGE", self.sky_image),
             ("MEDIA", self.media),
             ("BENT", self.bent),
+            ("MIXED", self.mixed),
         ]
         .into_iter()
         .filter(|(name, _)| source.contains(&format!("override {name}: bool")))
@@ -151,6 +163,7 @@ mod tests {
             ("SKY_IMAGE", 1.0),
             ("MEDIA", 1.0),
             ("BENT", 1.0),
+            ("MIXED", 1.0),
         ];
         assert_eq!(constants, expected);
         assert!(features.constants("fn main() {}").is_empty());

@@ -2,7 +2,9 @@
 // emitted radiance. One fragment per pixel centre, like a primary ray. The
 // surface's textures are applied here (surface_point.wgsl, mip-mapped by
 // the pixel's footprint); MASK cut-outs discard their fragments, and BLEND
-// surfaces with probability 1 − alpha, afresh each pass.
+// surfaces with probability 1 − alpha, afresh each pass; where a material
+// mixes in glass (KHR_materials_transmission below 1) each pixel draws one
+// of the two per pass.
 
 struct GBufferParams {
     clip_from_world: mat4x4<f32>,
@@ -100,11 +102,19 @@ fn shade(in: VertexOut) -> GBufferOut {
         dx = dpdx(in.uv);
         dy = dpdy(in.uv);
     }
-    let point = fragment_point(in);
+    var point = fragment_point(in);
     let id = in.surface & ~HAS_UV;
-    let surface = surfaces.all[id];
+    var surface = surfaces.all[id];
     if (CUT_OUTS && !is_there_for_fragment(surface, point.alpha, in.clip, params.blend_seed)) {
         discard;
+    }
+    // Glass mixed into the material: the pixel draws one of the two afresh
+    // each pass, and stores it as drawn (its kind, its metallic), which every
+    // pass reading the pixel then shades.
+    if (MIXED && surface.transmission > 0.0) {
+        let drawn = draw_layer(surface, point, fragment_mix_threshold(in.clip, params.blend_seed));
+        surface = drawn.surface;
+        point = drawn.point;
     }
     let view = in.world - params.camera_position;
     let front = dot(in.geometric_normal, view) < 0.0;

@@ -22,23 +22,28 @@ use wgpu::util::DeviceExt;
 /// Workgroup side (the `WORKGROUP` override of the shader).
 const WORKGROUP: u32 = 8;
 
-/// Whether any surface is a mirror, glass, partly mirroring, or glossy
+/// Whether any surface is a mirror, glass, partly mirroring or transmissive, or glossy
 /// with a lobe the eye follows (smoother than `GATHER_ROUGHNESS`): the
 /// pass runs only then.
 pub fn has_specular_surfaces(scene: &Scene) -> bool {
-    scene.surfaces.iter().any(|s| match &scene.materials[s.material as usize] {
-        Material::Mirror { .. } | Material::Glass { .. } => true,
-        Material::Diffuse { specular, .. } => specular.max_element() > 0.0,
-        Material::Pbr(bsdf) => {
-            // A metallic–roughness texture may make it smoother somewhere.
-            let textured = scene
-                .texturing
-                .as_ref()
-                .and_then(|t| t.materials.get(s.material as usize).copied().flatten())
-                .is_some_and(|t| t.metallic_roughness.is_some());
-            bsdf.follows_any() || (bsdf.has_specular() && textured)
-        }
-        Material::Emitter => false,
+    // Glass mixed into a material (drawn per pixel and per hit).
+    let mixes = |material: u32| scene.texturing.as_ref().is_some_and(|t| t.mixes(material));
+    scene.surfaces.iter().any(|s| {
+        mixes(s.material)
+            || match &scene.materials[s.material as usize] {
+                Material::Mirror { .. } | Material::Glass { .. } => true,
+                Material::Diffuse { specular, .. } => specular.max_element() > 0.0,
+                Material::Pbr(bsdf) => {
+                    // A metallic–roughness texture may make it smoother somewhere.
+                    let textured = scene
+                        .texturing
+                        .as_ref()
+                        .and_then(|t| t.materials.get(s.material as usize).copied().flatten())
+                        .is_some_and(|t| t.metallic_roughness.is_some());
+                    bsdf.follows_any() || (bsdf.has_specular() && textured)
+                }
+                Material::Emitter => false,
+            }
     })
 }
 
@@ -301,6 +306,7 @@ struct Bindings {
     direct: wgpu::Buffer,
     maps: wgpu::TextureView,
     normal: wgpu::TextureView,
+    albedo: wgpu::TextureView,
     output: wgpu::TextureView,
     media: wgpu::Buffer,
     accum: wgpu::Buffer,
@@ -343,6 +349,7 @@ impl Bindings {
                     }),
                 },
                 buffer(17, &self.textures),
+                view(18, &self.albedo),
             ],
         })
     }
@@ -440,6 +447,7 @@ impl SpecularPass {
                 entry(15, storage(false)),
                 entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
                 entry(17, storage(true)),
+                entry(18, texture(D2)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
@@ -520,6 +528,7 @@ impl SpecularPass {
             direct,
             maps: maps_view,
             normal: gbuffer.normal.create_view(&Default::default()),
+            albedo: gbuffer.albedo.create_view(&Default::default()),
             output: output.create_view(&Default::default()),
             media: keep(&media.params_buffer),
             accum,

@@ -76,6 +76,8 @@ struct SpecularParams {
 @group(0) @binding(6) var<uniform> direct_params: DirectParams;
 @group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
+// Its albedo.a: the kind the pixel drew where its material mixes in glass.
+@group(0) @binding(18) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(13) var<uniform> media: MediaParams;
 // Running sum over slices per pixel; w > 0 once any slice ran over budget.
@@ -378,8 +380,15 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // w = 0 everywhere, so check coverage through the normal's length).
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let first = surfaces.all[u32(g.w)];
-    let mirror_part = first.kind == 0u && (any(first.specular > vec3<f32>(0.0)) || may_follow_lobe(first));
-    if (dot(g.xyz, g.xyz) == 0.0 || (first.kind != 1u && first.kind != 2u && !mirror_part)) {
+    // Where the material mixes in glass, the kind the G-buffer's pixel drew.
+    var first_kind = first.kind;
+    if (MIXED && first.transmission > 0.0) {
+        first_kind = u32(textureLoad(gbuffer_albedo, pixel, 0).a);
+    }
+    // (A mixed surface's base draws show its back face by a sampled bounce.)
+    let mirror_part = first_kind == 0u
+        && (any(first.specular > vec3<f32>(0.0)) || may_follow_lobe(first) || (MIXED && first.transmission > 0.0));
+    if (dot(g.xyz, g.xyz) == 0.0 || (first_kind != 1u && first_kind != 2u && !mirror_part)) {
         if (slice.index + 1u == slice.count) {
             textureStore(output, pixel, vec4<f32>(0.0));
         }
@@ -427,15 +436,28 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         // the smooth shading one, as the CPU renderers do.
         let normals = hit_normals(hit.prim, b.origin, b.dir, x);
         let ng = normals.geometric;
-        let s = surfaces.all[p.surface];
+        var s = surfaces.all[p.surface];
+        // The surface here with its textures (level 0, as the CPU reads).
+        let uv = primitive_uv(hit.prim, hit.b);
+        var point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
+        let front = dot(b.dir, ng) < 0.0;
+        // Glass mixed into the material: the eye's first hit is what the
+        // G-buffer's pixel drew, the others draw per hit as the CPU
+        // renderers do (Scene::material_at's hash).
+        let mixed = MIXED && s.transmission > 0.0;
+        if (mixed) {
+            var u = mix_threshold(p.source, x);
+            if (b.depth == 0u) {
+                u = select(1.0, 0.0, first_kind == 2u);
+            }
+            let drawn = draw_layer(s, point, u);
+            s = drawn.surface;
+            point = drawn.point;
+        }
         if (s.kind == 2u) {
             // Arriving from inside: what the glass absorbed on the way.
             weight *= glass_interior_transmittance(glass_absorption(s), b.dir, ng, hit.t);
         }
-        // The surface here with its textures (level 0, as the CPU reads).
-        let uv = primitive_uv(hit.prim, hit.b);
-        let point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
-        let front = dot(b.dir, ng) < 0.0;
         let n = select(-ng, ng, front);
         // Bent by a normal texture before it turns to the ray's side, as
         // Scene::shading_normal_at and the G-buffer bend it.
@@ -466,17 +488,31 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                         shaded_geometric_normal = select(vec3<f32>(0.0), n, is_bent(ns, n));
                         radiance += weight * direct_radiance(x, ns, r, &light_rng);
                     }
-                    var gathered: vec3<f32>;
-                    if (is_bent(ns, n)) {
-                        gathered = gather(x, ns, n, true, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
-                            + gather(x, ns, n, true, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
-                    } else {
-                        gathered = gather(x, ns, n, false, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
-                            + gather(x, ns, n, false, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                    // Behind a partly transmissive surface (inside its body)
+                    // no photon is stored (trace.wgsl): a sampled bounce below
+                    // shows the light there, as photon-cpu.
+                    var gathered = vec3<f32>(0.0);
+                    if (!mixed || front) {
+                        if (is_bent(ns, n)) {
+                            gathered = gather(x, ns, n, true, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
+                                + gather(x, ns, n, true, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                        } else {
+                            gathered = gather(x, ns, n, false, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
+                                + gather(x, ns, n, false, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                        }
                     }
                     radiance += weight * gathered;
                 }
-                if (follows_lobe(s, bsdf)) {
+                if (mixed && !front) {
+                    // One direction of the whole BRDF per pass.
+                    let u_lobe = stream_next_f32(&path_rng);
+                    let sample = bsdf_sample(bsdf, to_shading(eye, ns), u_lobe, stream_next_2d(&path_rng));
+                    if (sample.valid && can_bounce && top < STACK) {
+                        let dir = local_to_world(sample.wi, ns);
+                        stack[top] = Branch(x, b.depth + 1u, dir, select(0u, 1u, sample.is_delta), weight * sample.weight);
+                        top += 1u;
+                    }
+                } else if (follows_lobe(s, bsdf)) {
                     // One direction of the specular lobe per pass.
                     let sample = bsdf_sample_followed(bsdf, to_shading(eye, ns), stream_next_2d(&path_rng));
                     if (sample.valid && can_bounce && top < STACK) {

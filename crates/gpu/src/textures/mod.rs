@@ -84,7 +84,8 @@ impl TextureViews {
     pub fn of(texturing: &Texturing) -> TextureViews {
         let mut views = TextureViews { images: texturing.images.len() as u32, transformed: Vec::new() };
         for m in texturing.materials.iter().flatten() {
-            for t in [m.base_color, m.metallic_roughness, m.emissive, m.normal].into_iter().flatten() {
+            let transmission = m.transmission.and_then(|t| t.texture);
+            for t in [m.base_color, m.metallic_roughness, m.emissive, m.normal, transmission].into_iter().flatten() {
                 if t.transform != glam::Affine2::IDENTITY && !views.transformed.contains(&(t.image, t.transform)) {
                     views.transformed.push((t.image, t.transform));
                 }

@@ -13,6 +13,9 @@ struct SurfacePoint {
     roughness: f32,
     // The base colour's alpha (factor × texture), for `is_there`.
     alpha: f32,
+    // The share let through as glass (`Surface::transmission` × the
+    // texture's R; 0: none), which `draw_layer` draws.
+    transmission: f32,
 }
 
 struct TextureLookup {
@@ -32,9 +35,12 @@ fn texture_lookup(t: u32, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Textur
 
 // TEXTURED and CUT_OUTS (features.wgsl) leave out what no surface has.
 fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> SurfacePoint {
-    var p = SurfacePoint(s.albedo, s.metallic, s.emission, s.roughness, s.alpha_factor);
+    var p = SurfacePoint(s.albedo, s.metallic, s.emission, s.roughness, s.alpha_factor, s.transmission);
     if (!TEXTURED) {
         return p;
+    }
+    if (MIXED && s.transmission > 0.0) {
+        p.transmission *= texture_lookup(s.transmission_texture, uv, dx, dy).value.r;
     }
     let base = texture_lookup(s.base_color_texture, uv, dx, dy);
     p.base *= base.value.rgb;
@@ -314,4 +320,57 @@ fn bend_by_texel(s: Surface, texel: vec4<f32>, surface_axes: UvAxes, n: vec3<f32
 // others' come from `Surface` unrounded.
 fn pack_metal_rough(metallic: f32, roughness: f32) -> f32 {
     return f32(u32(round(metallic * 4095.0)) * 4096u + u32(round(roughness * 4095.0)));
+}
+
+// hikari_core::texture::Texturing::apply's draw where the file mixes glass
+// into a glTF material (`texture::Transmission`): with probability
+// p = T·(1 − m) the glass of the base's colour and roughness
+// (kind 2, IOR `transmission_ior`, no absorption), else the base with
+// metallic m / (1 − p). `u` is uniform in [0, 1); `probability` that of
+// the drawn one (a photon stored on the base weighs 1 / it).
+struct DrawnLayer {
+    surface: Surface,
+    point: SurfacePoint,
+    probability: f32,
+}
+
+fn draw_layer(s: Surface, point: SurfacePoint, u: f32) -> DrawnLayer {
+    var drawn = DrawnLayer(s, point, 1.0);
+    if (!MIXED || s.kind != 0u || point.transmission <= 0.0) {
+        return drawn;
+    }
+    let p_glass = clamp(point.transmission * (1.0 - point.metallic), 0.0, 1.0);
+    if (p_glass <= 0.0) {
+        return drawn;
+    }
+    if (u < p_glass) {
+        drawn.surface.kind = 2u;
+        drawn.surface.ior = s.transmission_ior;
+        drawn.surface.specular_color = vec3<f32>(0.0);
+        drawn.probability = p_glass;
+    } else {
+        if (p_glass < 1.0) {
+            drawn.point.metallic = min(point.metallic / (1.0 - p_glass), 1.0);
+        }
+        drawn.probability = 1.0 - p_glass;
+    }
+    return drawn;
+}
+
+// hikari_core::texture::mix_threshold: the uniform number that draws a
+// mixed material at a hit on primitive `prim` (Accel's index, FlatPrim's
+// `source`) at `x`, a hash of their bits.
+fn mix_threshold(prim: u32, x: vec3<f32>) -> f32 {
+    var h = hash_u32(prim ^ 0x6a09e667u);
+    h = hash_u32(h ^ bitcast<u32>(x.x));
+    h = hash_u32(h ^ bitcast<u32>(x.y));
+    h = hash_u32(h ^ bitcast<u32>(x.z));
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// The draw for a rasterized fragment at `position` (its
+// `@builtin(position)`) in a pass of seed `seed`: afresh each pass, as
+// `fragment_blend_threshold` (no CPU twin: the CPU draws per hit).
+fn fragment_mix_threshold(position: vec4<f32>, seed: u32) -> f32 {
+    return fragment_blend_threshold(position, seed ^ 0x3c6ef372u);
 }

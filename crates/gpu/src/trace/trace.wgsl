@@ -474,10 +474,10 @@ fn trace_one(rng: ptr<function, Rng>) {
         }
         let x = ray.origin + ray.dir * hit.t;
         let normals = hit_normals(hit.prim, ray.origin, ray.dir, x);
-        let s = surfaces.all[prims[hit.prim].surface];
+        var s = surfaces.all[prims[hit.prim].surface];
         // The surface here with its textures (Scene::material_at).
         let uv = primitive_uv(hit.prim, hit.b);
-        let point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
+        var point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
         // Normals on the side the photon arrives from; the shading one bent
         // by a normal texture first (Scene::bent, as the CPU tracer).
         let facing = select(-1.0, 1.0, dot(ray.dir, normals.geometric) < 0.0);
@@ -488,6 +488,17 @@ fn trace_one(rng: ptr<function, Rng>) {
             shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, shading, normals.geometric, ray.dir);
         }
         let ns = shading * facing;
+        // Glass mixed into the material, drawn per hit by the CPU tracer's
+        // hash (Scene::material_at): a photon stored on the base's draw
+        // stands for the glass's too (Drawn::store_weight), and none is
+        // stored behind the surface, inside its body (store_where_mixed).
+        var store_weight = 1.0;
+        if (MIXED && s.transmission > 0.0) {
+            let drawn = draw_layer(s, point, mix_threshold(prim.source, x));
+            s = drawn.surface;
+            point = drawn.point;
+            store_weight = select(0.0, 1.0 / drawn.probability, facing > 0.0);
+        }
         if (s.kind == 2u) {
             // Arriving from inside: what the glass absorbed on the way.
             power *= glass_interior_transmittance(glass_absorption(s), ray.dir, normals.geometric, hit.t);
@@ -542,8 +553,8 @@ fn trace_one(rng: ptr<function, Rng>) {
             // photon maps stand for some lobe, then a bounce sampling the
             // whole BRDF with roulette on the sample's weight.
             let b = point_bsdf(s, point.base, point.metallic, point.roughness);
-            if (bsdf_stores_photons(b)) {
-                store_surface(x, power, ray.dir, diffuse_bounces, specular_bounces);
+            if (bsdf_stores_photons(b) && store_weight > 0.0) {
+                store_surface(x, power * store_weight, ray.dir, diffuse_bounces, specular_bounces);
             }
             let u_lobe = rng_next_f32(rng);
             let u = rng_next_2d(rng);

@@ -39,9 +39,13 @@ struct Surface {
     dielectric_f0: f32,
     // The sheen over the glTF BRDF (bsdf.wgsl; black: none).
     sheen_roughness: f32,
-    _pad: array<u32, 2>,
+    // The share of a kind-0 surface's base let through as glass of IOR
+    // `transmission_ior` (0: none), times the R of `transmission_texture`
+    // (surface_point.wgsl's `draw_layer`).
+    transmission: f32,
+    transmission_texture: u32,
     sheen_color: vec3<f32>,
-    _pad2: u32,
+    transmission_ior: f32,
     // KHR_materials_specular's colour, scaling the dielectric's F0; for
     // glass, its inside's absorption (`glass_absorption`).
     specular_color: vec3<f32>,

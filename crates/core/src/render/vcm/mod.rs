@@ -364,8 +364,13 @@ impl Pass<'_> {
                 Event::Escaped => break,
                 Event::Surface(hit) => {
                     let scatter_of = |m: &Material| Scatter::at(*m, &hit, ray.dir, Transport::Importance);
-                    store_weight = self.scene.store_weight(&hit, |m| scatter_of(m).is_some_and(|s| !s.is_delta()));
-                    (hit.point, scatter_of(&self.scene.material_at(&hit)))
+                    if self.strategies.merge() && self.scene.mixes_at(&hit) {
+                        let drawn = self.scene.drawn_material_at(&hit);
+                        store_weight = drawn.store_weight(|m| scatter_of(m).is_some_and(|s| !s.is_delta()));
+                        (hit.point, scatter_of(&drawn.material))
+                    } else {
+                        (hit.point, scatter_of(&self.scene.material_at(&hit)))
+                    }
                 }
                 Event::Medium { point, mask } => (point, Scatter::medium(&self.scene.media, mask, ray.dir)),
             };

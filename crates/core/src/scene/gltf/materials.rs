@@ -49,7 +49,6 @@ pub struct Converted {
 pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -> Converted {
     let mut unread_maps = 0;
     let mut other_sets = 0;
-    let mut mixed = 0;
     let mut mixed_volumes = 0;
     let mut layer_textures = 0;
     let mut missing_layer_textures = 0;
@@ -129,7 +128,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 texture: transmission_texture,
                 ior: glass.ior,
             });
-            mixed += mix.is_some() as usize;
             mixed_volumes += mix.is_some_and(|_| absorption != Vec3::ZERO) as usize;
             coated_glass += (transmits && coat.factor > 0.0) as usize;
             sheened_glass += (transmits && sheen.color.max_element() > 0.0) as usize;
@@ -185,13 +183,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     if other_sets > 0 {
         notes.push(format!(
             "{other_sets} material(s) read textures through texCoord other than 0 (TEXCOORD_0): those textures are ignored"
-        ));
-    }
-    if mixed > 0 {
-        notes.push(format!(
-            "{mixed} material(s) let part of their light through as glass (KHR_materials_transmission below 1, a \
-             transmissionTexture or a metallic factor): the CPU renderers mix glass and the base at each point; the \
-             GPU renderer draws glass where the mean share is 0.5 or more, else the base alone"
         ));
     }
     if mixed_volumes > 0 {

@@ -288,7 +288,8 @@ fn a_partly_transmissive_pane_is_glass_and_base_in_proportion() {
     use crate::test_scenes::gltf_textures::mixed_pane_glb;
     let share = 0.3;
     let scene = load("mixed-pane", &mixed_pane_glb(share, 0.0));
-    assert!(scene.notes.iter().any(|n| n.contains("let part of their light through")), "{:?}", scene.notes);
+    // Every renderer draws the mix (the GPU's test: gpu/tests/textures.rs): nothing to note.
+    assert!(!scene.notes.iter().any(|n| n.contains("transmission")), "{:?}", scene.notes);
     assert!(matches!(scene.materials[1], Material::Pbr(_)), "{:?}", scene.materials[1]);
     let opaque = load("mixed-pane-0", &mixed_pane_glb(0.0, 0.0));
     assert!(opaque.texturing.is_none() && !opaque.notes.iter().any(|n| n.contains("light through")));
@@ -366,8 +367,7 @@ fn a_partly_transmissive_pane_is_glass_and_base_in_proportion() {
 /// `transmissionTexture`'s R (linear) multiplies the factor: over a
 /// texture of R = 128/255 the glass is drawn at half the hits (sRGB
 /// decoding would make it 21%), and over one of R = 0 never, though the
-/// factor is 1; the GPU's means draw the first as glass, the second as
-/// the base.
+/// factor is 1.
 #[test]
 fn a_transmission_texture_scales_the_share_per_point() {
     let mut b = GltfBuilder::new();
@@ -401,13 +401,6 @@ fn a_transmission_texture_scales_the_share_per_point() {
     eprintln!("glass drawn under R = 128/255: {half}; under R = 0: {none}");
     assert!((half - 128.0 / 255.0).abs() < 0.03, "{half}");
     assert_eq!(none, 0.0);
-    let texturing = scene.texturing.as_ref().unwrap();
-    let surfaces = [0, 1].map(|i| scene.surfaces[i].material);
-    assert!(matches!(
-        texturing.with_layer_means(scene.materials[surfaces[0] as usize], surfaces[0]),
-        Material::Glass(_)
-    ));
-    assert!(matches!(texturing.with_layer_means(scene.materials[surfaces[1] as usize], surfaces[1]), Material::Pbr(_)));
 }
 
 /// Drawing a transmission mix: glass with probability T·(1 − m), of the
@@ -449,16 +442,6 @@ fn a_transmission_mix_draws_glass_and_base_by_share() {
         assert!(drawn.other.is_some_and(|o| o != *drawn.material));
     }
     assert_eq!(glasses, (n as f32 * share * (1.0 - metallic)).round() as usize);
-    // The GPU draws the glass only where its mean share reaches a half.
-    assert_eq!(texturing.with_layer_means(base, 0), base);
-    let mostly = Texturing {
-        materials: vec![Some(MaterialTextures {
-            transmission: Some(Transmission { factor: 0.9, texture: None, ior: 1.4 }),
-            ..textures
-        })],
-        ..Default::default()
-    };
-    assert_eq!(mostly.with_layer_means(base, 0), Material::Glass(glass));
     // A photon stored on the base's draw stands for the glass's too.
     let drawn = texturing.apply(base, 0, 0, glam::Vec2::ZERO, || 0.99);
     let stores = |m: &Material| matches!(m, Material::Pbr(_));
