@@ -597,13 +597,20 @@ pub mod gltf_textures {
     /// floor); the floor under it receives transmission × (1 − F(0)) =
     /// transmission × 0.96 of the sun straight through.
     pub fn mixed_pane_glb(transmission: f32, floor: f32) -> Vec<u8> {
+        mixed_metal_pane_glb(transmission, 0.0, 0.0, floor)
+    }
+
+    /// `mixed_pane_glb` with the pane's base `metallic` and `roughness` (the
+    /// glass as rough).
+    pub fn mixed_metal_pane_glb(transmission: f32, metallic: f32, roughness: f32, floor: f32) -> Vec<u8> {
         let mut b = GltfBuilder::new();
         let floor = b.material(&PbrMaterial { base_color: Vec3::splat(floor), specular: 0.0, ..Default::default() });
         let floor = quad(&mut b, Vec3::new(-4.0, 0.0, -4.0), 8.0 * Vec3::Z, 8.0 * Vec3::X, 1.0, floor);
         let pane = b.material(&PbrMaterial {
             glass_ior: Some(1.5),
             transmission,
-            roughness: 0.0,
+            metallic,
+            roughness,
             specular: 0.0,
             ..Default::default()
         });

@@ -40,6 +40,9 @@ pub mod kind {
     pub const MIRROR: u32 = 1;
     pub const GLASS: u32 = 2;
     pub const EMITTER: u32 = 3;
+    /// Written by the G-buffer alone (surface.wgsl's `KIND_MIXED_INSIDE`):
+    /// the base drawn on the back face of a surface that mixes in glass.
+    pub const MIXED_INSIDE: u32 = 4;
 }
 
 /// Per-surface shading data. Mirrors `Surface` in gbuffer.wgsl.
@@ -391,6 +394,13 @@ mod tests {
         assert_eq!(glossy.sheen_color, mean.sheen_color.to_array());
         assert_eq!(glossy.specular_factor, mean.specular);
         assert_eq!(glossy.specular_color, mean.specular_color.to_array());
+    }
+
+    /// The kind only the G-buffer writes is surface.wgsl's constant.
+    #[test]
+    fn the_mixed_inside_kind_is_the_wgsl_constant() {
+        let wgsl = crate::wgsl::SURFACE.source;
+        assert!(wgsl.contains(&format!("const KIND_MIXED_INSIDE: u32 = {}u;", kind::MIXED_INSIDE)));
     }
 
     #[test]

@@ -21,7 +21,8 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<i32>(frag.xy);
     let position = textureLoad(gbuffer_position, pixel, 0);
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
-    if (position.w == 0.0 || albedo.a != 0.0) {
+    // Diffuse and glossy surfaces, and the inside of a glass mix.
+    if (position.w == 0.0 || (albedo.a != 0.0 && albedo.a != f32(KIND_MIXED_INSIDE))) {
         return vec4<f32>(0.0);
     }
     let x = position.xyz;

@@ -66,7 +66,8 @@ struct GBufferOut {
     @location(0) position: vec4<f32>,
     // xyz: unit shading normal turned toward the eye; w: surface id.
     @location(1) normal: vec4<f32>,
-    // rgb: diffuse albedo (mirror reflectance for mirrors); a: material kind.
+    // rgb: diffuse albedo (mirror reflectance for mirrors); a: material kind
+    // (as drawn where glass is mixed in; KIND_MIXED_INSIDE on its back faces).
     @location(2) albedo: vec4<f32>,
     // rgb: radiance emitted toward the eye (area lights, emissive meshes);
     // w: metallic and roughness with textures applied (`pack_metal_rough`).
@@ -111,13 +112,15 @@ fn shade(in: VertexOut) -> GBufferOut {
     // Glass mixed into the material: the pixel draws one of the two afresh
     // each pass, and stores it as drawn (its kind, its metallic), which every
     // pass reading the pixel then shades.
+    let view = in.world - params.camera_position;
+    let front = dot(in.geometric_normal, view) < 0.0;
+    var kind = surface.kind;
     if (MIXED && surface.transmission > 0.0) {
         let drawn = draw_layer(surface, point, fragment_mix_threshold(in.clip, params.blend_seed));
         surface = drawn.surface;
         point = drawn.point;
+        kind = select(surface.kind, KIND_MIXED_INSIDE, surface.kind == 0u && !front);
     }
-    let view = in.world - params.camera_position;
-    let front = dot(in.geometric_normal, view) < 0.0;
     let side = select(-1.0, 1.0, front);
     var out: GBufferOut;
     let uv = vec3<f32>(in.uv, select(0.0, 1.0, (in.surface & HAS_UV) != 0u));
@@ -134,7 +137,7 @@ fn shade(in: VertexOut) -> GBufferOut {
     }
     out.position = vec4<f32>(in.world, geometric);
     out.normal = vec4<f32>(n * side, f32(id));
-    out.albedo = vec4<f32>(point.base, f32(surface.kind));
+    out.albedo = vec4<f32>(point.base, f32(kind));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);
     out.emission = vec4<f32>(emitted, pack_metal_rough(point.metallic, point.roughness));
     return out;

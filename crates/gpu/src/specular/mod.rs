@@ -307,6 +307,7 @@ struct Bindings {
     maps: wgpu::TextureView,
     normal: wgpu::TextureView,
     albedo: wgpu::TextureView,
+    emission: wgpu::TextureView,
     output: wgpu::TextureView,
     media: wgpu::Buffer,
     accum: wgpu::Buffer,
@@ -350,6 +351,7 @@ impl Bindings {
                 },
                 buffer(17, &self.textures),
                 view(18, &self.albedo),
+                view(19, &self.emission),
             ],
         })
     }
@@ -448,6 +450,7 @@ impl SpecularPass {
                 entry(16, crate::binding::dynamic_uniform(std::mem::size_of::<SliceParams>() as u64)),
                 entry(17, storage(true)),
                 entry(18, texture(D2)),
+                entry(19, texture(D2)),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "specular", &layout);
@@ -529,6 +532,7 @@ impl SpecularPass {
             maps: maps_view,
             normal: gbuffer.normal.create_view(&Default::default()),
             albedo: gbuffer.albedo.create_view(&Default::default()),
+            emission: gbuffer.emission.create_view(&Default::default()),
             output: output.create_view(&Default::default()),
             media: keep(&media.params_buffer),
             accum,
@@ -685,11 +689,31 @@ impl SpecularPass {
     /// Records the pass for progressive pass `pass`: one dispatch per slice,
     /// after clearing the status.
     pub fn record(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, pass: u32) {
+        self.record_slices(queue, encoder, pass, self.slices(), self.slices());
+    }
+
+    /// Records only the first of `MAX_SLICES` slices, the one that does
+    /// the most (the direct light, and the most photons of each cell): its
+    /// status says whether any split of the gathers can fit the budget,
+    /// for the cost of one dispatch. Leaves no image (the last slice
+    /// stores it); the next `record` clears what it wrote.
+    pub fn record_probe(&self, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, pass: u32) {
+        self.record_slices(queue, encoder, pass, MAX_SLICES, 1);
+    }
+
+    /// The first `dispatched` of `count` slices.
+    fn record_slices(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: u32,
+        count: u32,
+        dispatched: u32,
+    ) {
         if !self.enabled {
             return;
         }
-        let count = self.slices();
-        let params: Vec<u8> = (0..count)
+        let params: Vec<u8> = (0..dispatched)
             .flat_map(|index| {
                 let p = SliceParams { index, count, iteration_budget: self.iteration_budget, pass_index: pass };
                 let mut bytes = bytemuck::bytes_of(&p).to_vec();
@@ -703,7 +727,7 @@ impl SpecularPass {
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("specular"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
-        for index in 0..count {
+        for index in 0..dispatched {
             pass.set_bind_group(0, &self.bind_group, &[index * SLICE_STRIDE as u32]);
             pass.dispatch_workgroups(self.width.div_ceil(WORKGROUP), self.height.div_ceil(WORKGROUP), 1);
         }

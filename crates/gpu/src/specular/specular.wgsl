@@ -76,8 +76,10 @@ struct SpecularParams {
 @group(0) @binding(6) var<uniform> direct_params: DirectParams;
 @group(0) @binding(10) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(11) var gbuffer_normal: texture_2d<f32>;
-// Its albedo.a: the kind the pixel drew where its material mixes in glass.
+// Its albedo.a and emission.w: the kind and metallic the pixel drew where
+// its material mixes in glass.
 @group(0) @binding(18) var gbuffer_albedo: texture_2d<f32>;
+@group(0) @binding(19) var gbuffer_emission: texture_2d<f32>;
 @group(0) @binding(12) var output: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(13) var<uniform> media: MediaParams;
 // Running sum over slices per pixel; w > 0 once any slice ran over budget.
@@ -386,7 +388,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         first_kind = u32(textureLoad(gbuffer_albedo, pixel, 0).a);
     }
     // (A mixed surface's base draws show its back face by a sampled bounce.)
-    let mirror_part = first_kind == 0u
+    let base = first_kind == 0u || first_kind == KIND_MIXED_INSIDE;
+    let mirror_part = base
         && (any(first.specular > vec3<f32>(0.0)) || may_follow_lobe(first) || (MIXED && first.transmission > 0.0));
     if (dot(g.xyz, g.xyz) == 0.0 || (first_kind != 1u && first_kind != 2u && !mirror_part)) {
         if (slice.index + 1u == slice.count) {
@@ -446,13 +449,19 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         // renderers do (Scene::material_at's hash).
         let mixed = MIXED && s.transmission > 0.0;
         if (mixed) {
-            var u = mix_threshold(p.source, x);
-            if (b.depth == 0u) {
-                u = select(1.0, 0.0, first_kind == 2u);
+            if (b.depth == 0u && p.surface == u32(g.w)) {
+                // The pixel's own draw, as the G-buffer made it (at the
+                // pixel's footprint), which the raster passes shade.
+                if (first_kind == 2u) {
+                    s = mixed_glass(s);
+                } else {
+                    point.metallic = unpack_metal_rough(textureLoad(gbuffer_emission, pixel, 0).w).x;
+                }
+            } else {
+                let drawn = draw_layer(s, point, mix_threshold(p.source, x));
+                s = drawn.surface;
+                point = drawn.point;
             }
-            let drawn = draw_layer(s, point, u);
-            s = drawn.surface;
-            point = drawn.point;
         }
         if (s.kind == 2u) {
             // Arriving from inside: what the glass absorbed on the way.

@@ -314,13 +314,6 @@ fn bend_by_texel(s: Surface, texel: vec4<f32>, surface_axes: UvAxes, n: vec3<f32
     return bent * b_recip;
 }
 
-// Metallic and roughness in one f32 of the G-buffer (emission.w), 12 bits
-// each, exact as an integer-valued float. Read back (bsdf.wgsl's
-// `pixel_bsdf`) only for surfaces with a metallic–roughness texture: the
-// others' come from `Surface` unrounded.
-fn pack_metal_rough(metallic: f32, roughness: f32) -> f32 {
-    return f32(u32(round(metallic * 4095.0)) * 4096u + u32(round(roughness * 4095.0)));
-}
 
 // hikari_core::texture::Texturing::apply's draw where the file mixes glass
 // into a glTF material (`texture::Transmission`): with probability
@@ -344,9 +337,7 @@ fn draw_layer(s: Surface, point: SurfacePoint, u: f32) -> DrawnLayer {
         return drawn;
     }
     if (u < p_glass) {
-        drawn.surface.kind = 2u;
-        drawn.surface.ior = s.transmission_ior;
-        drawn.surface.specular_color = vec3<f32>(0.0);
+        drawn.surface = mixed_glass(s);
         drawn.probability = p_glass;
     } else {
         if (p_glass < 1.0) {
@@ -355,6 +346,16 @@ fn draw_layer(s: Surface, point: SurfacePoint, u: f32) -> DrawnLayer {
         drawn.probability = 1.0 - p_glass;
     }
     return drawn;
+}
+
+// The glass mixed into surface `s` (`Transmission::glass`): its colour and
+// roughness are the point's base's.
+fn mixed_glass(s: Surface) -> Surface {
+    var glass = s;
+    glass.kind = 2u;
+    glass.ior = s.transmission_ior;
+    glass.specular_color = vec3<f32>(0.0);
+    return glass;
 }
 
 // hikari_core::texture::mix_threshold: the uniform number that draws a

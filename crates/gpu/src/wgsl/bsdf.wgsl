@@ -647,10 +647,25 @@ fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsd
 // surface_point.wgsl's `pack_metal_rough`) where a texture varies them.
 fn pixel_bsdf(s: Surface, base: vec3<f32>, packed: f32) -> Bsdf {
     var b = surface_bsdf(s, base);
-    if (s.metallic_roughness_texture != 0xffffffffu) {
-        let bits = u32(packed);
-        b.metallic = f32(bits / 4096u) / 4095.0;
-        b.roughness = f32(bits % 4096u) / 4095.0;
+    // A texture, or a glass mix's draw (its base's metallic raised), varies them.
+    if (s.metallic_roughness_texture != 0xffffffffu || (MIXED && s.transmission > 0.0)) {
+        let metal_rough = unpack_metal_rough(packed);
+        b.metallic = metal_rough.x;
+        b.roughness = metal_rough.y;
     }
     return b;
+}
+
+// Metallic and roughness in one f32 of the G-buffer (emission.w), 12 bits
+// each, exact as an integer-valued float. Read back (`pixel_bsdf`) only
+// where a metallic–roughness texture or a glass mix's draw varies them:
+// the others' come from `Surface` unrounded.
+fn pack_metal_rough(metallic: f32, roughness: f32) -> f32 {
+    return f32(u32(round(metallic * 4095.0)) * 4096u + u32(round(roughness * 4095.0)));
+}
+
+// `pack_metal_rough`'s (metallic, roughness).
+fn unpack_metal_rough(packed: f32) -> vec2<f32> {
+    let bits = u32(packed);
+    return vec2<f32>(f32(bits / 4096u), f32(bits % 4096u)) / 4095.0;
 }

@@ -8,6 +8,12 @@
 // `roughness`, `specular_factor`, `clearcoat` (with its roughness) and
 // `sheen_color` (with its roughness); otherwise it is Lambertian.
 
+// The G-buffer's kind for the base drawn on the back face of a surface
+// that mixes in glass (inside its body): direct light as kind 0's, no
+// photon gathers (no photon is stored there), a sampled bounce in the
+// specular pass (scene_upload::kind::MIXED_INSIDE).
+const KIND_MIXED_INSIDE: u32 = 4u;
+
 struct Surface {
     albedo: vec3<f32>,
     kind: u32,
