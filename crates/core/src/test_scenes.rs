@@ -381,6 +381,42 @@ pub mod gltf_textures {
         scene
     }
 
+    /// Two normal-mapped floors side by side in the plane z = 0 (a texel
+    /// tilting the normal 45°), a Lambertian one (x < 0) and a glossy one,
+    /// lit by a point light 0.25 above them at a grazing angle to much of
+    /// them, and a white wall at y = 1 that the light and the floors light;
+    /// the camera at `size`² looking down at the floors.
+    pub fn normal_mapped_floors(tag: &str, size: u32) -> Scene {
+        use json::extensions::scene::khr_lights_punctual::Type;
+        let mut b = GltfBuilder::new();
+        let image = b.image(&png(1, 1, &[218, 128, 218, 255]), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let lambert = b.material(&PbrMaterial {
+            base_color: Vec3::splat(0.7),
+            specular: 0.0,
+            normal_texture: Some((t, 1.0)),
+            ..Default::default()
+        });
+        let glossy = b.material(&PbrMaterial {
+            base_color: Vec3::new(0.7, 0.6, 0.5),
+            roughness: 0.6,
+            normal_texture: Some((t, 1.0)),
+            ..Default::default()
+        });
+        let white = b.material(&PbrMaterial { base_color: Vec3::splat(0.8), specular: 0.0, ..Default::default() });
+        let (x, y) = (Vec3::X, 2.0 * Vec3::Y);
+        let left = quad(&mut b, Vec3::new(-1.0, -1.0, 0.0), x, y, 1.0, lambert);
+        let right = quad(&mut b, Vec3::new(0.0, -1.0, 0.0), x, y, 1.0, glossy);
+        let wall = quad(&mut b, Vec3::new(-1.0, 1.0, 0.0), 2.0 * Vec3::X, 1.5 * Vec3::Z, 1.0, white);
+        let light = b.light(Type::Point, Vec3::ONE, 4.0 * 683.0, None);
+        let light = b.node(GltfBuilder::light_node(light, Vec3::new(0.0, -0.6, 0.25), glam::Quat::IDENTITY));
+        let mut scene = load(tag, &b.to_glb(vec![left, right, wall, light]));
+        scene.camera =
+            crate::camera::Camera::new(Vec3::new(0.0, -0.6, 3.0), Vec3::new(0.0, 0.1, 0.0), Vec3::Y, 45.0, size, size)
+                .unwrap();
+        scene
+    }
+
     /// 2×2 greys, sRGB-encoded, rows from the top: 255, 0 / 128, 64.
     pub const GREYS: [u8; 4] = [255, 0, 128, 64];
 

@@ -527,6 +527,12 @@ impl Texturing {
         Some(self.images[texture.image as usize].sample(texture.image_uv(uv), texture.sampler))
     }
 
+    /// Does any material have a normal texture (whose bend the diffuse
+    /// lobes' bump shadowing follows, `bsdf::bump`)?
+    pub fn has_normal_textures(&self) -> bool {
+        self.materials.iter().flatten().any(|m| m.normal.is_some())
+    }
+
     /// Does any material let a share through as glass ([`Transmission`])?
     pub fn has_mixes(&self) -> bool {
         self.materials.iter().flatten().any(|m| m.transmission.is_some())

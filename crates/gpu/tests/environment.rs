@@ -8,6 +8,7 @@ use hikari_core::photon::{TraceSettings, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
+use hikari_gpu::gbuffer::geometric_normal::pixel_kind;
 use hikari_gpu::test_support::{open_floor, test_context};
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
@@ -65,7 +66,7 @@ fn a_sky_image_lights_and_shows_on_the_gpu() {
             let relative = (g - c).abs().max_element() / c.max_element().max(1e-3);
             match scene.accel.intersect(&ray) {
                 None => sky.push(relative),
-                Some(_) if albedo[i].w == 1.0 => mirror.push(relative),
+                Some(_) if pixel_kind(albedo[i].w) == 1 => mirror.push(relative),
                 Some(_) => floor.push(((g - c).element_sum() / c.element_sum().max(1e-6)) as f64),
             }
         }

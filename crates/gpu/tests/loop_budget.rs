@@ -7,6 +7,7 @@ use hikari_core::photon::{TraceSettings, TracedPhotons, trace_photons};
 use hikari_core::progress::Silent;
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
+use hikari_gpu::gbuffer::geometric_normal::pixel_kind;
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuError, GpuRenderer, GpuSettings};
 
@@ -40,7 +41,7 @@ fn gpu_frame(
 
 /// Pixels whose first surface is glass or a mirror (G-buffer kind 1 or 2).
 fn specular_pixels(albedo: &[glam::Vec4]) -> Vec<usize> {
-    (0..albedo.len()).filter(|&i| albedo[i].w == 1.0 || albedo[i].w == 2.0).collect()
+    (0..albedo.len()).filter(|&i| pixel_kind(albedo[i].w) == 1 || pixel_kind(albedo[i].w) == 2).collect()
 }
 
 /// The regression of issue #9: at 1,000,000 photons the glass ball of

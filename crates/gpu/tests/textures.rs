@@ -6,6 +6,7 @@
 use glam::{Vec2, Vec4};
 use hikari_core::sampling::Rng;
 use hikari_core::texture::{ColorSpace, Image, MaterialTextures, Sampler, TextureRef, Texturing, Wrap, uv_transform};
+use hikari_gpu::gbuffer::geometric_normal::pixel_kind;
 use hikari_gpu::test_support::{run_kernel_on, test_context};
 use hikari_gpu::textures::{TEXTURES, TextureViews, mip_chain, pack};
 
@@ -454,7 +455,9 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
 /// faces the light, but the light is under the surface, where `path` and
 /// `photon-cpu` take none; the GPU's direct pass takes none either (it
 /// did before the G-buffer kept the geometric normal). The same light a
-/// little above the plane lights it, on the CPU and the GPU alike.
+/// little above the plane lights it, on the CPU and the GPU alike, through
+/// the bump shadowing of a 45° bend at 7.5° above the smooth surface
+/// (about 0.52: a GPU without it would show 1.9× path's light).
 #[test]
 fn no_direct_light_comes_from_below_a_bent_surface() {
     use glam::Vec3;
@@ -510,7 +513,7 @@ fn no_direct_light_comes_from_below_a_bent_surface() {
     let [(below, path_below), (above, path_above)] = [means[0], means[1]];
     assert_eq!(path_below, 0.0, "path: light from below the quad");
     assert_eq!(below, 0.0, "GPU: light from below the quad");
-    assert!(above > 0.01 && path_above > 0.01, "light from above the quad: {above}, path {path_above}");
+    assert!(above > 0.005 && path_above > 0.005, "light from above the quad: {above}, path {path_above}");
     assert!((above / path_above - 1.0).abs() < 0.05, "above: GPU {above}, path {path_above}");
 }
 
@@ -587,6 +590,11 @@ fn a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu() {
     let ctx = test_context("a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu");
     // The mean of `passes` passes' pixels, and each pass's share of pixels
     // above `bright`.
+    // photon-cpu's mean over the image, 8 samples a pixel.
+    let photon_cpu_mean = |scene: &Scene, traced: &TracedPhotons| {
+        let renderer = PhotonCpuRenderer::new(scene, traced, &PhotonCpuSettings { spp: 8, ..Default::default() });
+        renderer.render(&Silent).0.mean() as f64
+    };
     let passes_mean = |scene: &Scene, traced: &TracedPhotons, passes: u32, bright: f32| {
         let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
         let settings =
@@ -646,8 +654,7 @@ fn a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu() {
     below.camera = Camera::new(Vec3::new(0.0, 0.5, 0.0), Vec3::new(0.0, 1.0, 0.0), Vec3::Z, 10.0, size, size).unwrap();
     let traced = trace_photons(&below, &TraceSettings { photons: 200_000, ..Default::default() }, &Silent);
     let (gpu_mean, _) = passes_mean(&below, &traced, 32, f32::INFINITY);
-    let renderer = PhotonCpuRenderer::new(&below, &traced, &PhotonCpuSettings { spp: 8, ..Default::default() });
-    let cpu_mean = renderer.render(&Silent).0.mean() as f64;
+    let cpu_mean = photon_cpu_mean(&below, &traced);
     eprintln!("the pane from below: GPU {gpu_mean:.5}, photon-cpu {cpu_mean:.5}");
     assert!((gpu_mean / cpu_mean - 1.0).abs() < 0.08, "{gpu_mean} against {cpu_mean}");
     // There the G-buffer marks the base's draws as the inside of a mix,
@@ -657,9 +664,9 @@ fn a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu() {
         .expect("GPU renderer");
     gpu.render().unwrap();
     let kinds = gpu.read(&gpu.targets.gbuffer.albedo).unwrap();
-    let inside = hikari_gpu::scene_upload::kind::MIXED_INSIDE as f32;
-    let count = |k: f32| kinds.iter().filter(|v| v.w == k).count() as f32 / kinds.len() as f32;
-    let (glass, base) = (count(hikari_gpu::scene_upload::kind::GLASS as f32), count(inside));
+    let inside = hikari_gpu::scene_upload::kind::MIXED_INSIDE;
+    let count = |k: u32| kinds.iter().filter(|v| pixel_kind(v.w) == k).count() as f32 / kinds.len() as f32;
+    let (glass, base) = (count(hikari_gpu::scene_upload::kind::GLASS), count(inside));
     eprintln!("from below, G-buffer kinds: glass {glass:.3}, the mix's inside {base:.3}");
     assert_eq!(glass + base, 1.0);
     assert!((base - (1.0 - share)).abs() < 0.05, "{base}");
@@ -674,8 +681,7 @@ fn a_partly_transmissive_pane_draws_glass_per_pixel_on_the_gpu() {
     metal.camera = Camera::new(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO, Vec3::Z, 20.0, size, size).unwrap();
     let traced = trace_photons(&metal, &TraceSettings { photons: 100_000, ..Default::default() }, &Silent);
     let (gpu_mean, _) = passes_mean(&metal, &traced, 16, f32::INFINITY);
-    let renderer = PhotonCpuRenderer::new(&metal, &traced, &PhotonCpuSettings { spp: 8, ..Default::default() });
-    let cpu_mean = renderer.render(&Silent).0.mean() as f64;
+    let cpu_mean = photon_cpu_mean(&metal, &traced);
     eprintln!("a metallic mixed pane from above: GPU {gpu_mean:.5}, photon-cpu {cpu_mean:.5}");
     assert!((gpu_mean / cpu_mean - 1.0).abs() < 0.04, "{gpu_mean} against {cpu_mean}");
 }

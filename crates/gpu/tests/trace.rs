@@ -329,6 +329,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("textured cut-out", gltf_textures::load("trace-cutout", &gltf_textures::cutout_glb())),
         ("rough tinted glass", rough_caustic("")),
         ("normal map before a mirror", gltf_textures::normal_map_before_a_mirror("trace-normal-map", 16)),
+        ("normal-mapped floors", gltf_textures::normal_mapped_floors("trace-normal-floors", 16)),
     ]
 }
 
@@ -388,6 +389,13 @@ fn gpu_tracer_stores_the_cpu_photons() {
             let size_ratio = g.len() as f64 / c.len() as f64;
             assert!((size_ratio - 1.0).abs() < 0.01, "{name} {map}: {} vs {}", g.len(), c.len());
             assert!(near > 0.97, "{name} {map}: only {:.2}% within rounding", 100.0 * near);
+            // Without media every path is the CPU's to rounding (100% of
+            // the photons on lavapipe, over 99.5% on Mesa's GL): a power off by a
+            // factor on a few per cent of paths (a bounce's bump shadowing
+            // left out: 97.1% of the normal-mapped floors' photons) shows.
+            if scene.media.is_empty() {
+                assert!(near > 0.995, "{name} {map}: only {:.2}% within rounding", 100.0 * near);
+            }
             // Without media and normal textures every operation is mirrored
             // exactly, and lavapipe (Vulkan) keeps the CPU's bits for > 99.99%
             // of photons. A normal texture's bend goes through cross products

@@ -5,6 +5,7 @@
 
 use glam::Vec3;
 use hikari_core::bsdf::ShadingFrame;
+use hikari_core::bsdf::bump::BumpShadow;
 use hikari_core::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf, shading_normal_factor};
 use hikari_core::material::Material;
 use hikari_core::photon::{TraceSettings, trace_photons};
@@ -12,7 +13,7 @@ use hikari_core::progress::Silent;
 use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_seed};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
-use hikari_gpu::gbuffer::geometric_normal::unpack_geometric_normal;
+use hikari_gpu::gbuffer::geometric_normal::{pixel_kind, pixel_smooth_normal, unpack_geometric_normal};
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuRenderer, GpuSettings};
@@ -28,6 +29,9 @@ struct TwinStats {
     /// Surface pixels whose shading normal is bent (the G-buffer's
     /// position.w < 0): their photons weigh shading_normal_factor.
     bent: usize,
+    /// Lit pixels a normal texture bends whose estimate the bump shadowing
+    /// changes by more than 1%.
+    shadowed: usize,
 }
 
 fn twin(scene_name: &str, photons: u64, normal_test: bool, estimator: Estimator) -> Option<(TwinStats, TwinStats)> {
@@ -84,9 +88,9 @@ fn twin_pass(
     let caustic = gpu.read(&t.caustic).unwrap();
 
     let compare = |gpu_image: &[glam::Vec4], map, params: &FixedRadius| {
-        let mut stats = TwinStats { lit: 0, within: 0, worst: 0.0, tolerance, bent: 0 };
+        let mut stats = TwinStats { lit: 0, within: 0, worst: 0.0, tolerance, bent: 0, shadowed: 0 };
         for i in 0..position.len() {
-            if position[i].w == 0.0 || albedo[i].w != 0.0 {
+            if position[i].w == 0.0 || pixel_kind(albedo[i].w) != 0 {
                 continue; // no surface, or not diffuse
             }
             let (x, n) = (position[i].truncate(), normal[i].truncate());
@@ -97,23 +101,34 @@ fn twin_pass(
             stats.bent += bent as usize;
             let ng = unpack_geometric_normal(position[i].w, n);
             let across = |wi: Vec3| if bent { shading_normal_factor(wi, n, ng) } else { 1.0 };
+            // Where a normal texture bent the normal, the diffuse lobes'
+            // bump shadowing of the photon's side, from the smooth normal
+            // the G-buffer keeps (as photon-cpu's gathers weigh it).
+            let bump = pixel_smooth_normal(albedo[i].w).and_then(|unbent| BumpShadow::new(unbent, n));
             // The glTF BRDF weights each photon by f at its own direction
             // (the lobes the maps stand for); Lambertian surfaces by ρ/π.
             let material = scene.materials[scene.surfaces[normal[i].w as usize].material as usize];
             let frame = ShadingFrame::new(n);
-            let want = match material {
-                Material::Pbr(bsdf) if bsdf.is_glossy() => {
-                    let wo = frame.to_local((scene.camera.position - x).normalize());
-                    fixed_radius_radiance_brdf(map, x, n, params, |wi| {
-                        bsdf.f_gathered(wo, frame.to_local(wi)) * across(wi)
-                    })
+            let estimate = |bump: Option<BumpShadow>| {
+                let k = |wi: Vec3| bump.map_or(1.0, |b| b.term(wi));
+                match material {
+                    Material::Pbr(bsdf) if bsdf.is_glossy() => {
+                        let wo = frame.to_local((scene.camera.position - x).normalize());
+                        fixed_radius_radiance_brdf(map, x, n, params, |wi| {
+                            bsdf.f_gathered_bumped(wo, frame.to_local(wi), k(wi)) * across(wi)
+                        })
+                    }
+                    _ if bent => {
+                        let lambert = albedo[i].truncate() / std::f32::consts::PI;
+                        fixed_radius_radiance_brdf(map, x, n, params, |wi| lambert * across(wi) * k(wi))
+                    }
+                    _ => fixed_radius_radiance(map, None, x, n, albedo[i].truncate(), params),
                 }
-                _ if bent => {
-                    let lambert = albedo[i].truncate() / std::f32::consts::PI;
-                    fixed_radius_radiance_brdf(map, x, n, params, |wi| lambert * across(wi))
-                }
-                _ => fixed_radius_radiance(map, None, x, n, albedo[i].truncate(), params),
             };
+            let want = estimate(bump);
+            if bump.is_some() && (want - estimate(None)).abs().max_element() > 0.01 * want.max_element() {
+                stats.shadowed += 1;
+            }
             let got: Vec3 = gpu_image[i].truncate();
             if want.max_element() == 0.0 && got.max_element() == 0.0 {
                 continue;
@@ -134,8 +149,8 @@ fn twin_pass(
 
 fn assert_twin(name: &str, stats: &TwinStats, min_lit: usize) {
     eprintln!(
-        "{name}: {} lit pixels ({} bent), {} within {:e}, worst relative error {:e}",
-        stats.lit, stats.bent, stats.within, stats.tolerance, stats.worst
+        "{name}: {} lit pixels ({} bent, {} bump-shadowed), {} within {:e}, worst relative error {:e}",
+        stats.lit, stats.bent, stats.shadowed, stats.within, stats.tolerance, stats.worst
     );
     assert!(stats.lit >= min_lit, "{name}: only {} lit pixels", stats.lit);
     assert!(
@@ -244,6 +259,22 @@ fn gpu_estimates_on_bent_normals_equal_cpu_estimates() {
     }
 }
 
+/// Normal-mapped floors (a texel tilting the normal 45°), one Lambertian
+/// and one glossy, lit by a point light at a grazing angle and a white wall
+/// it lights: each photon gathered there also weighs the bump shadowing of
+/// its side, from the smooth normal the G-buffer keeps beside the kind, in
+/// both estimators, as photon-cpu's gathers.
+#[test]
+fn gpu_estimates_on_normal_mapped_floors_equal_cpu_estimates() {
+    let scene = hikari_core::test_scenes::gltf_textures::normal_mapped_floors("twin-normal-map", 64);
+    for estimator in ESTIMATORS {
+        let (indirect, _) = twin_scene(scene.clone(), 20_000, false, estimator).expect("a twin");
+        let name = format!("normal-mapped floors indirect ({estimator:?})");
+        assert_twin(&name, &indirect, 1500);
+        assert!(indirect.shadowed > 300, "{name}: only {} pixels the bump shadowing changes", indirect.shadowed);
+    }
+}
+
 /// The glTF BRDF: photons weighted by f for their own directions, on a box
 /// of metals and dielectrics from roughness 0.1 to 1 (the smoother ones
 /// gathering their diffuse lobe only), both estimators, with and without
@@ -329,4 +360,45 @@ fn wgsl_geometric_normal_packing_matches_the_cpu() {
         bent += (want < 0.0) as usize;
     }
     assert!(bent > 2000, "{bent} bent of {}", cases.len());
+}
+
+/// geometric_normal.wgsl's albedo.a, the kind and a normal-mapped point's
+/// smooth normal, bit for bit as its Rust twin packs it, and read back the
+/// same (to an ulp of the decode's normalize).
+#[test]
+fn wgsl_kind_packing_matches_the_cpu() {
+    use hikari_core::sampling::{Rng, uniform_sphere};
+    use hikari_gpu::gbuffer::geometric_normal::{GEOMETRIC_NORMAL, pack_kind};
+    let ctx = test_context("wgsl_kind_packing_matches_the_cpu");
+    let mut rng = Rng::for_item(31, 0);
+    let mut cases = Vec::new();
+    let mut input = vec![0u32; 4096 * 9];
+    for (k, item) in input.chunks_mut(9).enumerate() {
+        let n = uniform_sphere(rng.next_2d());
+        let (kind, bumped) = (k as u32 % 5, k % 3 != 0);
+        for (j, v) in n.to_array().iter().enumerate() {
+            item[j] = v.to_bits();
+        }
+        item[3] = kind;
+        item[4] = bumped as u32;
+        cases.push((n, kind, bumped));
+    }
+    let main = "let o = 9u * id.x; if (o >= arrayLength(&io)) { return; }\n\
+                let n = vec3<f32>(bitcast<f32>(io[o]), bitcast<f32>(io[o + 1u]), bitcast<f32>(io[o + 2u]));\n\
+                let packed = pack_kind(io[o + 3u], n, io[o + 4u] != 0u);\n\
+                let back = pixel_smooth_normal(packed);\n\
+                io[o + 5u] = bitcast<u32>(packed);\n\
+                io[o + 6u] = pixel_kind(packed);\n\
+                io[o + 7u] = bitcast<u32>(back.x);\n\
+                io[o + 8u] = bitcast<u32>(back.z);";
+    let gpu = hikari_gpu::test_support::run_kernel(&ctx, &[&GEOMETRIC_NORMAL], main, &input);
+    for (out, (n, kind, bumped)) in gpu.chunks(9).zip(&cases) {
+        let packed = f32::from_bits(out[5]);
+        assert_eq!(packed, pack_kind(*kind, *n, *bumped), "{n} kind {kind} bumped {bumped}");
+        assert_eq!(out[6], *kind);
+        let back = pixel_smooth_normal(packed).unwrap_or(Vec3::ZERO);
+        // The decode's normalize may round differently by an ulp.
+        let got = Vec3::new(f32::from_bits(out[7]), 0.0, f32::from_bits(out[8]));
+        assert!((got - Vec3::new(back.x, 0.0, back.z)).abs().max_element() < 1e-6, "{n}: {got} vs {back}");
+    }
 }

@@ -8,6 +8,7 @@ use hikari_core::progressive::{DEFAULT_ALPHA, ImageMean, Schedules, pass_jitter,
 use hikari_core::render::photon_cpu::PhotonCpuSettings;
 use hikari_core::sampling::Rng;
 use hikari_core::scene::Scene;
+use hikari_gpu::gbuffer::geometric_normal::pixel_kind;
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
@@ -54,7 +55,7 @@ fn comparison_mask(scene: &Scene, gpu_albedo: &[glam::Vec4]) -> Vec<bool> {
         for x in 0..size {
             let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             if let Some(hit) = scene.accel.intersect(&ray) {
-                if scene.material(&hit).is_diffuse() && gpu_albedo[(y * size + x) as usize].w == 0.0 {
+                if scene.material(&hit).is_diffuse() && pixel_kind(gpu_albedo[(y * size + x) as usize].w) == 0 {
                     vis[(y * size + x) as usize] = Some(visibility(scene, hit.point, hit.geometric_normal));
                 }
             }
@@ -205,7 +206,7 @@ fn specular_difference(
 ) -> Option<(f64, usize)> {
     let (mut sum, mut count) = (0.0f64, 0usize);
     for i in 0..albedo.len() {
-        if albedo[i].w == 1.0 || albedo[i].w == 2.0 {
+        if pixel_kind(albedo[i].w) == 1 || pixel_kind(albedo[i].w) == 2 {
             let (g, c) = (gpu.pixels[i], cpu.pixels[i]);
             let (gl, cl) = ((g.x + g.y + g.z) / 3.0, (c.x + c.y + c.z) / 3.0);
             if cl > 1e-6 {
@@ -348,7 +349,7 @@ fn gpu_image_matches_photon_cpu_under_a_sky() {
             let i = (y * size + x) as usize;
             let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let Some(hit) = scene.accel.intersect(&ray) else { continue };
-            if !scene.material(&hit).is_diffuse() || frames.albedo[i].w != 0.0 {
+            if !scene.material(&hit).is_diffuse() || pixel_kind(frames.albedo[i].w) != 0 {
                 continue;
             }
             let normal = if ray.dir.dot(hit.geometric_normal) < 0.0 { hit.shading_normal } else { -hit.shading_normal };
@@ -500,7 +501,7 @@ fn an_emissive_mesh_shows_in_a_mirror() {
     let (mirror_mean, mirror_count) =
         specular_difference(&frames.gpu, &frames.cpu, &frames.albedo).expect("the mirror is in view");
     // The light itself in the mirror: radiance 12 × 0.9.
-    let mirror = |i: &usize| frames.albedo[*i].w == 1.0;
+    let mirror = |i: &usize| pixel_kind(frames.albedo[*i].w) == 1;
     let brightest = (0..frames.albedo.len()).filter(mirror).map(|i| frames.gpu.pixels[i].x).fold(0.0f32, f32::max);
     eprintln!(
         "mesh light in a mirror: {mirror_count} mirror pixels, mean relative difference {:.2}%, brightest {brightest}",
@@ -560,7 +561,8 @@ fn a_smooth_mesh_shows_smooth_in_a_mirror() {
     let off: Vec<(u32, u32)> = (0..frames.albedo.len() as u32)
         .filter(|&i| {
             let (g, c) = (frames.gpu.pixels[i as usize], frames.cpu.pixels[i as usize]);
-            frames.albedo[i as usize].w == 1.0 && ((g - c).element_sum().abs() > 0.01 * c.element_sum().max(1e-6))
+            pixel_kind(frames.albedo[i as usize].w) == 1
+                && ((g - c).element_sum().abs() > 0.01 * c.element_sum().max(1e-6))
         })
         .map(|i| (i % SIZE, i / SIZE))
         .collect();
@@ -714,7 +716,7 @@ fn gpu_image_matches_photon_cpu_through_a_frosted_pane() {
 fn glass_sums(frames: &Frames) -> (f64, f64, usize) {
     let (mut gpu_sum, mut cpu_sum, mut glass) = (0.0f64, 0.0f64, 0);
     for i in 0..frames.albedo.len() {
-        if frames.albedo[i].w == 2.0 {
+        if pixel_kind(frames.albedo[i].w) == 2 {
             let (g, c) = (frames.gpu.pixels[i], frames.cpu.pixels[i]);
             gpu_sum += (g.x + g.y + g.z) as f64;
             cpu_sum += (c.x + c.y + c.z) as f64;

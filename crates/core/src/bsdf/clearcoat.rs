@@ -117,11 +117,11 @@ impl Bsdf {
         if coat + base <= 0.0 { 0.0 } else { coat / (coat + base) }
     }
 
-    pub(super) fn coated_f(&self, wo: Vec3, wi: Vec3) -> Rgb {
+    pub(super) fn coated_f(&self, wo: Vec3, wi: Vec3, k: f32) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
         }
-        self.under_coat(wo, wi, self.f_lobes(wo, wi)) + Rgb::splat(self.coat_lobe(wo, wi))
+        self.under_coat(wo, wi, self.f_lobes(wo, wi, k)) + Rgb::splat(self.coat_lobe(wo, wi))
     }
 
     /// The base's lobes as the coat leaves them (the sheen dimmed like the
@@ -196,7 +196,7 @@ impl Bsdf {
         if pdf <= 0.0 {
             return None;
         }
-        let f = self.coated_f(wo, wi);
+        let f = self.coated_f(wo, wi, 1.0);
         Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed })
     }
 
@@ -282,7 +282,7 @@ mod tests {
         // Under a coat of factor 1, a white Lambertian base seen and lit at
         // normal incidence keeps (1 − 0.04)²/(1 − E) of f, E = 0.04 + 0.96/21.
         let white = coated(Bsdf::diffuse(Rgb::ONE), 1.0, 0.5);
-        let ratio = white.base_f(Vec3::Z, Vec3::Z).x;
+        let ratio = white.base_f(Vec3::Z, Vec3::Z, 1.0).x;
         let coated_diffuse = white.f(Vec3::Z, Vec3::Z).x - white.coat_lobe(Vec3::Z, Vec3::Z);
         let e = 0.04 + 0.96 / 21.0;
         assert!((coated_diffuse / ratio - 0.96 * 0.96 / (1.0 - e)).abs() < 1e-5);
@@ -298,7 +298,7 @@ mod tests {
         for deg in [0.0, 40.0, 75.0] {
             let wo = direction_at(deg);
             let under = integrate_about(Vec3::Z, |wi| {
-                (mean(lambert.under_coat(wo, wi, lambert.f_lobes(wo, wi))) * wi.z.max(0.0)) as f64
+                (mean(lambert.under_coat(wo, wi, lambert.f_lobes(wo, wi, 1.0))) * wi.z.max(0.0)) as f64
             });
             let want = 0.5 * lambert.coat_transmission(wo.z) as f64;
             assert!((under - want).abs() < 1e-3, "{deg}°: {under} against {want}");

@@ -63,6 +63,7 @@
 //! `sampling::unit_circle`, and the one table (the sheen's albedo) uploaded
 //! as it is here.
 
+pub mod bump;
 pub mod clearcoat;
 pub mod dielectric;
 pub mod ggx;
@@ -314,7 +315,10 @@ impl Bsdf {
     /// The parts of f: the diffuse and specular (microfacet) lobes as the
     /// sheen leaves them, and the sheen; the specular one is zero on smooth
     /// surfaces, whose mirror is a delta.
-    fn f_lobes(&self, wo: Vec3, wi: Vec3) -> Lobes {
+    /// `k` weighs the diffuse and sheen lobes (Cycles' diffuse closures):
+    /// a normal-mapped point's bump shadowing for the light's direction
+    /// ([`bump::BumpShadow`]); 1 elsewhere, which leaves f bit for bit.
+    fn f_lobes(&self, wo: Vec3, wi: Vec3, k: f32) -> Lobes {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Lobes::default();
         }
@@ -331,14 +335,33 @@ impl Bsdf {
             let (scaling, sheen) = self.sheen_parts(wo, wi);
             lobes.diffuse *= scaling;
             lobes.specular *= scaling;
-            lobes.sheen = sheen;
+            lobes.sheen = sheen * k;
         }
+        lobes.diffuse *= k;
         lobes
     }
 
     /// f(wo, wi) per steradian, without the mirrors of smooth lobes.
     pub fn f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if self.has_coat() { self.coated_f(wo, wi) } else { self.base_f(wo, wi) }
+        self.f_bumped(wo, wi, 1.0)
+    }
+
+    /// `f` with the diffuse and sheen lobes weighed by `k`, the bump
+    /// shadowing ([`bump::BumpShadow::term`]) of the direction the light
+    /// comes from.
+    pub fn f_bumped(&self, wo: Vec3, wi: Vec3, k: f32) -> Rgb {
+        if self.has_coat() { self.coated_f(wo, wi, k) } else { self.base_f(wo, wi, k) }
+    }
+
+    /// `sample`'s sample `s` at `wo` with the diffuse and sheen lobes
+    /// weighed by `k` (the bump shadowing of the light's side of it): f and
+    /// the weight change, the density not (as Cycles').
+    pub fn reweigh(&self, wo: Vec3, s: BsdfSample, k: f32) -> BsdfSample {
+        if k == 1.0 || s.is_delta {
+            return s;
+        }
+        let f = self.f_bumped(wo, s.wi, k);
+        BsdfSample { f, weight: f * (s.wi.z / s.pdf), ..s }
     }
 
     /// Density per steradian with which `sample` returns the non-delta
@@ -357,8 +380,8 @@ impl Bsdf {
     }
 
     /// The base lobes' f (diffuse and specular, no coat).
-    pub(crate) fn base_f(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let lobes = self.f_lobes(wo, wi);
+    pub(crate) fn base_f(&self, wo: Vec3, wi: Vec3, k: f32) -> Rgb {
+        let lobes = self.f_lobes(wo, wi, k);
         lobes.diffuse + lobes.specular + lobes.sheen
     }
 
@@ -413,7 +436,7 @@ impl Bsdf {
         if pdf <= 0.0 {
             return None;
         }
-        let f = self.base_f(wo, wi);
+        let f = self.base_f(wo, wi, 1.0);
         let followed = specular && !self.gathers_specular();
         Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed })
     }
@@ -432,7 +455,13 @@ impl Bsdf {
     /// GPU's splat): every lobe at least `GATHER_ROUGHNESS` rough and the
     /// diffuse one. The rest is followed by the eye ([`Bsdf::sample_followed`]).
     pub fn f_gathered(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        let mut lobes = self.f_lobes(wo, wi);
+        self.f_gathered_bumped(wo, wi, 1.0)
+    }
+
+    /// `f_gathered` with the diffuse and sheen lobes weighed by `k` (as
+    /// [`Bsdf::f_bumped`]).
+    pub fn f_gathered_bumped(&self, wo: Vec3, wi: Vec3, k: f32) -> Rgb {
+        let mut lobes = self.f_lobes(wo, wi, k);
         if !self.gathers_specular() {
             lobes.specular = Rgb::ZERO;
         }
@@ -503,7 +532,7 @@ impl Bsdf {
         if wi.z <= 0.0 || pdf <= 0.0 {
             return None;
         }
-        let f = self.f_lobes(wo, wi).specular;
+        let f = self.f_lobes(wo, wi, 1.0).specular;
         let followed = !self.gathers_specular();
         Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed })
     }
@@ -566,6 +595,37 @@ pub(crate) mod tests {
     use crate::sampling::{Rng, local_to_world, uniform_sphere};
     use std::cell::RefCell;
     use std::f64::consts::PI as PI64;
+
+    /// The bump weight k scales the diffuse and sheen lobes and nothing
+    /// else: f_bumped − f = (k − 1)·(diffuse + sheen), the specular lobe
+    /// and the coat untouched; `reweigh` keeps the density and gives the
+    /// weight f_bumped·cos/pdf; k = 1 changes nothing, bit for bit.
+    #[test]
+    fn the_bump_weight_scales_the_diffuse_lobes_alone() {
+        let base = Bsdf::new(Rgb::new(0.7, 0.5, 0.3), 0.2, 0.4, 1.0);
+        let sheened = Bsdf { sheen_color: Rgb::splat(0.5), sheen_roughness: 0.5, ..base };
+        let coated = base.with_clearcoat(0.8, 0.3);
+        let wo = Vec3::new(0.3, -0.2, 0.93).normalize();
+        let wi = Vec3::new(-0.5, 0.1, 0.86).normalize();
+        for bsdf in [base, sheened, coated] {
+            let k = 0.6;
+            assert_eq!(bsdf.f_bumped(wo, wi, 1.0), bsdf.f(wo, wi));
+            let lobes = bsdf.f_lobes(wo, wi, 1.0);
+            let scaled = bsdf.f_lobes(wo, wi, k);
+            assert!(scaled.diffuse.abs_diff_eq(lobes.diffuse * k, 1e-6));
+            assert!(scaled.sheen.abs_diff_eq(lobes.sheen * k, 1e-6));
+            assert_eq!(scaled.specular, lobes.specular);
+            if !bsdf.has_coat() {
+                let expected = bsdf.f(wo, wi) - (lobes.diffuse + lobes.sheen) * (1.0 - k);
+                assert!(bsdf.f_bumped(wo, wi, k).abs_diff_eq(expected, 1e-6));
+            }
+            let s = bsdf.sample(wo, 0.9, Vec2::new(0.3, 0.6)).expect("a sample");
+            let r = bsdf.reweigh(wo, s, k);
+            assert_eq!((r.wi, r.pdf), (s.wi, s.pdf));
+            assert!(r.weight.abs_diff_eq(bsdf.f_bumped(wo, s.wi, k) * (s.wi.z / s.pdf), 1e-6));
+            assert_eq!(bsdf.reweigh(wo, s, 1.0).weight, s.weight);
+        }
+    }
 
     fn white(metallic: f32, roughness: f32) -> Bsdf {
         Bsdf::new(Rgb::ONE, metallic, roughness, 1.0)

@@ -8,6 +8,7 @@
 
 use super::{Image, LitSides, direct_diffuse, direct_reflected, direct_scattered, render_pixels};
 use crate::bsdf::ShadingFrame;
+use crate::bsdf::bump::BumpShadow;
 use crate::bsdf::dielectric::Transport;
 use crate::estimate::{FixedRadius, fixed_radius_radiance, fixed_radius_radiance_brdf, is_bent, shading_normal_factor};
 use crate::geometry::Ray;
@@ -255,6 +256,7 @@ impl<'a> PhotonCpuRenderer<'a> {
         depth: u32,
         rng: &mut Rng,
     ) -> Rgb {
+        let smooth = hit.shading_normal;
         let hit = self.scene.bent(*hit, ray.dir);
         let can_recurse = depth < self.settings.max_specular_depth;
         let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
@@ -306,13 +308,22 @@ impl<'a> PhotonCpuRenderer<'a> {
             Material::Pbr(bsdf) => {
                 let frame = ShadingFrame::new(ns);
                 let wo = frame.to_local(-ray.dir);
+                // A normal-mapped point's diffuse lobes: Cycles' bump
+                // shadowing of the light's direction (`wi` local here).
+                let bump = (smooth != hit.shading_normal)
+                    .then(|| BumpShadow::new(frame.to_local(smooth * facing), glam::Vec3::Z))
+                    .flatten();
+                let k = |wi: glam::Vec3| bump.map_or(1.0, |b| b.term(wi));
                 // The lobes the photon maps stand for: the diffuse one and
                 // every lobe at least GATHER_ROUGHNESS rough.
-                let part = |wi: glam::Vec3| bsdf.f_gathered(wo, wi);
+                let part = |wi: glam::Vec3| bsdf.f_gathered_bumped(wo, wi, k(wi));
                 let mut l = Rgb::ZERO;
                 if self.settings.components.direct {
                     // Direct light through every non-delta lobe, by shadow rays.
-                    let f = |wi: glam::Vec3| bsdf.f(wo, frame.to_local(wi));
+                    let f = |wi: glam::Vec3| {
+                        let wi = frame.to_local(wi);
+                        bsdf.f_bumped(wo, wi, k(wi))
+                    };
                     l += direct_reflected(self.scene, hit.point, ns, ng, f, self.settings.area_light_samples, rng);
                 }
                 // Behind a partly transmissive surface (inside its body) no
@@ -321,6 +332,7 @@ impl<'a> PhotonCpuRenderer<'a> {
                 // emitted left to the shadow rays but through a mirror lobe.
                 if facing < 0.0 && self.scene.mixes_at(&hit) {
                     if can_recurse && let Some(s) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) {
+                        let s = bsdf.reweigh(wo, s, k(s.wi));
                         let next = Ray::new(hit.point, frame.to_world(s.wi));
                         l += s.weight * self.radiance_seen(&next, depth + 1, s.is_delta, rng);
                     }
@@ -342,7 +354,19 @@ impl<'a> PhotonCpuRenderer<'a> {
             Material::Diffuse { .. } | Material::Mirror { .. } => {
                 let mut l = Rgb::ZERO;
                 let albedo = material.diffuse_albedo();
-                if albedo.max_element() > 0.0 {
+                // A normal-mapped exactly Lambertian glTF material: the bump
+                // shadowing of the light's direction, as the Pbr arm's.
+                let bump = (smooth != hit.shading_normal).then(|| BumpShadow::new(smooth * facing, ns)).flatten();
+                if let Some(bump) = bump.filter(|_| albedo.max_element() > 0.0) {
+                    let samples = self.settings.area_light_samples;
+                    if self.settings.components.direct {
+                        let f = |wi: glam::Vec3| albedo / std::f32::consts::PI * bump.term(wi);
+                        l += direct_reflected(self.scene, hit.point, ns, ng, f, samples, rng);
+                    }
+                    let frame = ShadingFrame::new(ns);
+                    let f = |wi: glam::Vec3| albedo / std::f32::consts::PI * bump.term(frame.to_world(wi));
+                    l += self.photon_radiance_brdf(hit.point, &frame, ng, f);
+                } else if albedo.max_element() > 0.0 {
                     if self.settings.components.direct {
                         l += direct_diffuse(
                             self.scene,

@@ -22,7 +22,8 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let position = textureLoad(gbuffer_position, pixel, 0);
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     // Diffuse and glossy surfaces, and the inside of a glass mix.
-    if (position.w == 0.0 || (albedo.a != 0.0 && albedo.a != f32(KIND_MIXED_INSIDE))) {
+    let kind = pixel_kind(albedo.a);
+    if (position.w == 0.0 || (kind != 0u && kind != KIND_MIXED_INSIDE)) {
         return vec4<f32>(0.0);
     }
     let x = position.xyz;
@@ -30,9 +31,13 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let n = g.xyz;
     let s = surfaces.all[u32(g.w)];
     let b = pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
-    let r = surface_reflector(s, b, unit(media.camera_position - x), n);
+    var r = surface_reflector(s, b, unit(media.camera_position - x), n);
     if (BENT && position.w < 0.0) {
         shaded_geometric_normal = unpack_geometric_normal(position.w, n);
+        let unbent = pixel_smooth_normal(albedo.a);
+        if (bump_mapped() && any(unbent != vec3<f32>(0.0))) {
+            r.bump = bump_shadow(unbent, n);
+        }
     }
     // Glossy points sample their lobe and area lights: a new stream each pass.
     var rng = pixel_stream(vec2<u32>(pixel), direct_params.pass_index, 1u);

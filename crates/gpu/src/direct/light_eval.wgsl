@@ -185,26 +185,44 @@ fn visible(s: LightSample, x: vec3<f32>, n: vec3<f32>) -> bool {
 }
 
 // How the shaded point reflects toward the viewer: Lambertian `albedo`, or
-// (glossy) the glTF BRDF `bsdf` seen from `wo` (shading frame of the normal).
+// (glossy) the glTF BRDF `bsdf` seen from `wo` (shading frame of the normal);
+// at a point a normal texture bends, its diffuse lobes shadowed by `bump`
+// (world frame; none elsewhere), as Cycles' bump map correction.
 struct Reflector {
     albedo: vec3<f32>,
     glossy: bool,
     bsdf: Bsdf,
     wo: vec3<f32>,
+    bump: BumpShadow,
 }
 
 // Surface `s` at a point where its BRDF is `b` (textures applied), of
-// shading normal `n`, seen from `eye` (world, toward the viewer).
+// shading normal `n`, seen from `eye` (world, toward the viewer); the
+// caller sets `bump` where a normal texture bent `n`.
 fn surface_reflector(s: Surface, b: Bsdf, eye: vec3<f32>, n: vec3<f32>) -> Reflector {
-    return Reflector(b.base_color, GLOSSY && s.glossy != 0u, b, to_shading(eye, n));
+    return Reflector(b.base_color, GLOSSY && s.glossy != 0u, b, to_shading(eye, n), no_bump());
+}
+
+// The diffuse lobes' bump shadowing for light from the world direction `wi`.
+fn reflector_bump(r: Reflector, wi: vec3<f32>) -> f32 {
+    if (!bump_mapped()) {
+        return 1.0;
+    }
+    return bump_term(r.bump, wi);
 }
 
 // f toward the world direction `wi` (every non-delta lobe).
 fn reflector_f(r: Reflector, n: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let k = reflector_bump(r, wi);
     if (!r.glossy) {
-        return r.albedo / PI;
+        return r.albedo / PI * k;
     }
-    return bsdf_f(r.bsdf, r.wo, to_shading(wi, n));
+    return bsdf_f_bumped(r.bsdf, r.wo, to_shading(wi, n), k);
+}
+
+// f toward `wi` (world), given as `local` in the shading frame, at a glossy point.
+fn glossy_f(r: Reflector, wi: vec3<f32>, local: vec3<f32>) -> vec3<f32> {
+    return bsdf_f_bumped(r.bsdf, r.wo, local, reflector_bump(r, wi));
 }
 
 // Light and BRDF samples per sphere or quad light and glossy point.
@@ -220,13 +238,17 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     return 1.0 / (1.0 + ratio * ratio);
 }
 
-// A BRDF sample for the area-light and sky estimates: a non-delta direction
-// (the mirror of smooth lobes is the specular pass's), or `valid` false.
-fn glossy_sample(r: Reflector, rng: ptr<function, u32>) -> BsdfSample {
+// A BRDF sample for the area-light and sky estimates at a glossy point of
+// normal `n`: a non-delta direction (the mirror of smooth lobes is the
+// specular pass's), or `valid` false; weighed by the bump shadowing.
+fn glossy_sample(r: Reflector, n: vec3<f32>, rng: ptr<function, u32>) -> BsdfSample {
     let u_lobe = stream_next_f32(rng);
     let s = bsdf_sample(r.bsdf, r.wo, u_lobe, stream_next_2d(rng));
     if (s.is_delta) {
         return no_bsdf_sample();
+    }
+    if (bump_mapped() && r.bump.alpha >= 0.0 && s.valid) {
+        return bsdf_reweigh(r.bsdf, r.wo, s, bump_term(r.bump, local_to_world(s.wi, n)));
     }
     return s;
 }
@@ -255,10 +277,10 @@ fn area_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
             let wi = local_to_world(uniform_cone(stream_next_2d(rng), cos_max), axis);
             let local = to_shading(wi, n);
             if (local.z > 0.0) {
-                let f = bsdf_f(r.bsdf, r.wo, local);
+                let f = glossy_f(r, wi, local);
                 sum += f * (local.z / pdf_cone * power_heuristic(pdf_cone, bsdf_pdf(r.bsdf, r.wo, local)));
             }
-            let s = glossy_sample(r, rng);
+            let s = glossy_sample(r, n, rng);
             if (s.valid && dot(local_to_world(s.wi, n), axis) >= cos_max) {
                 sum += s.weight * power_heuristic(s.pdf, pdf_cone);
             }
@@ -284,10 +306,10 @@ fn area_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
             let local = to_shading(wi, n);
             if (cos_l > 0.0 && local.z > 0.0) {
                 let pdf_light = d2 / (area * cos_l);
-                let f = bsdf_f(r.bsdf, r.wo, local);
+                let f = glossy_f(r, wi, local);
                 sum += f * (local.z / pdf_light * power_heuristic(pdf_light, bsdf_pdf(r.bsdf, r.wo, local)));
             }
-            let s = glossy_sample(r, rng);
+            let s = glossy_sample(r, n, rng);
             if (!s.valid) {
                 continue;
             }
@@ -324,7 +346,7 @@ fn sky_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<funct
         if (!loop_iteration()) {
             break;
         }
-        let b = glossy_sample(r, rng);
+        let b = glossy_sample(r, n, rng);
         if (!b.valid) {
             continue;
         }
@@ -468,13 +490,13 @@ fn mesh_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
                 if (brdf_samples) {
                     weight = power_heuristic(pdf_light, bsdf_pdf(r.bsdf, r.wo, local));
                 }
-                sum += bsdf_f(r.bsdf, r.wo, local) * (local.z / pdf_light * weight);
+                sum += glossy_f(r, wi, local) * (local.z / pdf_light * weight);
             }
         }
         if (!brdf_samples) {
             continue;
         }
-        let s = glossy_sample(r, rng);
+        let s = glossy_sample(r, n, rng);
         if (!s.valid) {
             continue;
         }
@@ -534,7 +556,8 @@ fn mesh_glossy(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<func
 //   πL·ρ/π, what the upper hemisphere gives, times the cosine-weighted
 //   fraction of its K fixed directions that see x. Exact where all or none
 //   see it; in between a sky seen through K hard shadows, as an area light
-//   is N hard shadows. A glossy point: `sky_glossy`.
+//   is N hard shadows (each weighed by the bump shadowing of its direction
+//   at a normal-mapped point). A glossy point: `sky_glossy`.
 // * an emissive mesh at a Lambertian point: Σ_k ρ/π·L·a·cos_l·cos_x/(d² + a/π)
 //   over its N points, each standing for its share a = A/N of the area (the
 //   small-disc form of a/d²), one-sided unless two-sided. A glossy point:
@@ -577,7 +600,7 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
             weight = max(dot(n, wi), 0.0) * cos_l / (d2 + l.sample_area / PI);
         }
         if (weight > 0.0 && above_surface(wi) && visible(s, x, n)) {
-            seen += weight * light_transmittance(x, end);
+            seen += weight * reflector_bump(r, wi) * light_transmittance(x, end);
         }
     }
     if (l.kind == KIND_SKY) {
@@ -589,10 +612,12 @@ fn sampled_radiance(l: Light, x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr
     return r.albedo / PI * l.emission * l.sample_area * seen;
 }
 
-// Direct radiance leaving x (normal n toward the viewer) toward the viewer.
 // The fraction of light `l`'s shadow-mapped samples seen from x (normal
-// `n`, the side they are seen from), each attenuated by the media between.
-fn shadowed_fraction(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// `n`, the side they are seen from), each attenuated by the media between
+// and weighed by the bump shadowing `bump` of its direction (a normal-mapped
+// Lambertian point's closed form: exact for point, spot and sun, the
+// samples' mean over a sphere or quad; `no_bump()` elsewhere).
+fn shadowed_fraction(l: Light, x: vec3<f32>, n: vec3<f32>, bump: BumpShadow) -> vec3<f32> {
     var seen = vec3<f32>(0.0);
     for (var k = 0u; k < l.sample_count; k++) {
         if (!loop_iteration()) {
@@ -608,7 +633,11 @@ fn shadowed_fraction(l: Light, x: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             if (l.kind == KIND_SUN) {
                 end = distant_start(l, x, l.axis);
             }
-            seen += light_transmittance(x, end);
+            var shadowing = 1.0;
+            if (bump_mapped() && bump.alpha >= 0.0) {
+                shadowing = bump_term(bump, unit(toward));
+            }
+            seen += light_transmittance(x, end) * shadowing;
         }
     }
     return seen / f32(l.sample_count);
@@ -629,10 +658,12 @@ fn direct_radiance(x: vec3<f32>, n: vec3<f32>, r: Reflector, rng: ptr<function, 
         if (all(e == vec3<f32>(0.0))) {
             continue;
         }
-        let fraction = shadowed_fraction(l, x, n);
         if (!r.glossy) {
-            sum += r.albedo / PI * e * fraction;
-        } else if (l.kind == 2u || l.kind == 3u) {
+            sum += r.albedo / PI * e * shadowed_fraction(l, x, n, r.bump);
+            continue;
+        }
+        let fraction = shadowed_fraction(l, x, n, no_bump());
+        if (l.kind == 2u || l.kind == 3u) {
             sum += area_glossy(l, x, n, r, rng) * fraction;
         } else {
             // Point, spot, sun: one direction, f exact.

@@ -30,3 +30,9 @@ override MIXED: bool = true;
 // normal and the photon gathers weigh shading_normal_factor
 // (gbuffer/geometric_normal.wgsl).
 override BENT: bool = true;
+
+// Some diffuse surface has a normal texture: only then is the diffuse
+// lobes' bump shadowing (bsdf.wgsl's `bump_term`) compiled in.
+fn bump_mapped() -> bool {
+    return TEXTURED && BENT;
+}

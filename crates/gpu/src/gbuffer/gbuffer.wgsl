@@ -67,7 +67,8 @@ struct GBufferOut {
     // xyz: unit shading normal turned toward the eye; w: surface id.
     @location(1) normal: vec4<f32>,
     // rgb: diffuse albedo (mirror reflectance for mirrors); a: material kind
-    // (as drawn where glass is mixed in; KIND_MIXED_INSIDE on its back faces).
+    // (as drawn where glass is mixed in; KIND_MIXED_INSIDE on its back faces)
+    // and a normal-mapped point's smooth normal (`pack_kind`).
     @location(2) albedo: vec4<f32>,
     // rgb: radiance emitted toward the eye (area lights, emissive meshes);
     // w: metallic and roughness with textures applied (`pack_metal_rough`).
@@ -109,11 +110,12 @@ fn shade(in: VertexOut) -> GBufferOut {
     if (CUT_OUTS && !is_there_for_fragment(surface, point.alpha, in.clip, params.blend_seed)) {
         discard;
     }
+    // Which face of the triangle the eye sees.
+    let view = in.world - params.camera_position;
+    let front = dot(in.geometric_normal, view) < 0.0;
     // Glass mixed into the material: the pixel draws one of the two afresh
     // each pass, and stores it as drawn (its kind, its metallic), which every
     // pass reading the pixel then shades.
-    let view = in.world - params.camera_position;
-    let front = dot(in.geometric_normal, view) < 0.0;
     var kind = surface.kind;
     if (MIXED && surface.transmission > 0.0) {
         let drawn = draw_layer(surface, point, fragment_mix_threshold(in.clip, params.blend_seed));
@@ -137,7 +139,10 @@ fn shade(in: VertexOut) -> GBufferOut {
     }
     out.position = vec4<f32>(in.world, geometric);
     out.normal = vec4<f32>(n * side, f32(id));
-    out.albedo = vec4<f32>(point.base, f32(kind));
+    // Where a normal texture bent the normal, the smooth one beside the
+    // kind (pack_kind): the diffuse lobes' bump shadowing reads it.
+    let bumped = BENT && reads_normal_texture(surface, uv) && any(n != shading);
+    out.albedo = vec4<f32>(point.base, pack_kind(kind, shading * side, bumped));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);
     out.emission = vec4<f32>(emitted, pack_metal_rough(point.metallic, point.roughness));
     return out;

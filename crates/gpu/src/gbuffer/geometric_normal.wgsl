@@ -29,3 +29,33 @@ fn unpack_geometric_normal(packed: f32, ns: vec3<f32>) -> vec3<f32> {
     }
     return decode_octahedral(u32(-packed) - 1u, 12u);
 }
+
+// The G-buffer's albedo.a (geometric_normal.rs, its twin): the material
+// kind, and at a point a normal texture bends, the smooth (interpolated)
+// normal it was bent from, whose bump shadowing the diffuse lobes take:
+// kind + KIND_CODES · (1 + its octahedral code of 10 + 10 bits), an
+// integer below 2^24 (exact in f32); the kind alone elsewhere.
+const KIND_CODES: u32 = 8u;
+
+// What albedo.a stores for `kind` at a point of smooth normal `unbent`
+// (unit) that a normal texture bent where `bumped`.
+fn pack_kind(kind: u32, unbent: vec3<f32>, bumped: bool) -> f32 {
+    if (!bumped) {
+        return f32(kind);
+    }
+    return f32(kind + KIND_CODES * (1u + encode_octahedral(unbent, 10u)));
+}
+
+// The kind from albedo.a.
+fn pixel_kind(packed: f32) -> u32 {
+    return u32(packed) % KIND_CODES;
+}
+
+// The smooth normal from albedo.a; zero where no normal texture bent it.
+fn pixel_smooth_normal(packed: f32) -> vec3<f32> {
+    let code = u32(packed) / KIND_CODES;
+    if (code == 0u) {
+        return vec3<f32>(0.0);
+    }
+    return decode_octahedral(code - 1u, 10u);
+}

@@ -158,11 +158,13 @@ fn bucket_of(cell: vec3<i32>, buckets: u32) -> u32 {
 // surface weights each photon by its BRDF `bsdf` seen from `eye`; a
 // Lambertian one takes its base colour as its albedo. With `bent` (the
 // shading normal `n` is not the geometric `ng`), each photon also weighs
-// shading_normal_factor (photon-cpu's gathers). Callers pass `bent` as a
+// shading_normal_factor (photon-cpu's gathers) and, at a normal-mapped
+// point, the bump shadowing `bump` of its side (the diffuse and sheen lobes
+// alone at a glossy one). Callers pass `bent` as a
 // literal in each branch of an `if`: drivers inline the call and fold the
 // test out of the loop, where a per-photon test of a run-time flag cost the
 // pass 13-16% on lavapipe (BENCHMARKS.md).
-fn gather(x: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, bent: bool, glossy: bool, bsdf: Bsdf, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
+fn gather(x: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, bent: bool, bump: BumpShadow, glossy: bool, bsdf: Bsdf, eye: vec3<f32>, radius: f32, buckets: u32, start_offset: u32, photon_offset: u32) -> vec3<f32> {
     let centre = vec3<i32>(floor(x / radius));
     var power = vec3<f32>(0.0);
     for (var k = 0u; k < 27u; k++) {
@@ -185,14 +187,7 @@ fn gather(x: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, bent: bool, glossy: bool, b
             let d = p - x;
             let dir = decode_octahedral_15(grid[base + 4u] & 0x3fffffffu);
             if (photon_accepted(dot(d, d), dir, n, radius, params.normal_test != 0u)) {
-                var p_power = decode_rgb9e5(grid[base + 3u]);
-                if (glossy) {
-                    p_power *= photon_brdf(bsdf, eye, n, dir);
-                }
-                if (bent) {
-                    p_power *= shading_normal_factor(-dir, n, ng);
-                }
-                power += p_power;
+                power += gathered_power(decode_rgb9e5(grid[base + 3u]), dir, n, ng, bent, bump, glossy, bsdf, eye);
             }
         }
     }
@@ -362,7 +357,7 @@ fn delta_light_through_glass(x: vec3<f32>, ng: vec3<f32>, g: Dielectric, wo: vec
         if (all(e == vec3<f32>(0.0))) {
             continue;
         }
-        sum += glass_f(g, wo, to_shading(wi, ng), true) * e * shadowed_fraction(l, x, side);
+        sum += glass_f(g, wo, to_shading(wi, ng), true) * e * shadowed_fraction(l, x, side, no_bump());
     }
     return sum;
 }
@@ -385,7 +380,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     // Where the material mixes in glass, the kind the G-buffer's pixel drew.
     var first_kind = first.kind;
     if (MIXED && first.transmission > 0.0) {
-        first_kind = u32(textureLoad(gbuffer_albedo, pixel, 0).a);
+        first_kind = pixel_kind(textureLoad(gbuffer_albedo, pixel, 0).a);
     }
     // (A mixed surface's base draws show its back face by a sampled bounce.)
     let base = first_kind == 0u || first_kind == KIND_MIXED_INSIDE;
@@ -475,6 +470,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, p.b, p.c, shading, ng, b.dir);
         }
         let ns = select(-shading, shading, front);
+        // A normal-mapped point's diffuse lobes: the bump shadowing.
+        var bump = no_bump();
+        if (bump_mapped() && any(shading != normals.shading)) {
+            bump = bump_shadow(normals.shading, shading);
+        }
         let can_bounce = b.depth < params.max_depth;
         // Emitted light (Light::emitted_radiance), besides what the surface
         // reflects; a primary hit's is the G-buffer's.
@@ -492,7 +492,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     if (slice.index == 0u) {
                         // Its own stream, so slice 0's draws leave the path's alone.
                         var light_rng = hash_u32(path_rng ^ 0x68bc21ebu);
-                        let r = surface_reflector(s, bsdf, eye, ns);
+                        var r = surface_reflector(s, bsdf, eye, ns);
+                        r.bump = bump;
                         // No light from below the geometric surface (light_eval.wgsl).
                         shaded_geometric_normal = select(vec3<f32>(0.0), n, is_bent(ns, n));
                         radiance += weight * direct_radiance(x, ns, r, &light_rng);
@@ -503,11 +504,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                     var gathered = vec3<f32>(0.0);
                     if (!mixed || front) {
                         if (is_bent(ns, n)) {
-                            gathered = gather(x, ns, n, true, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
-                                + gather(x, ns, n, true, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                            gathered = gather(x, ns, n, true, bump, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
+                                + gather(x, ns, n, true, bump, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
                         } else {
-                            gathered = gather(x, ns, n, false, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
-                                + gather(x, ns, n, false, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
+                            gathered = gather(x, ns, n, false, bump, glossy, bsdf, eye, params.global_radius, params.global_buckets, params.global_start_offset, params.global_photon_offset)
+                                + gather(x, ns, n, false, bump, glossy, bsdf, eye, params.caustic_radius, params.caustic_buckets, params.caustic_start_offset, params.caustic_photon_offset);
                         }
                     }
                     radiance += weight * gathered;
@@ -515,7 +516,11 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 if (mixed && !front) {
                     // One direction of the whole BRDF per pass.
                     let u_lobe = stream_next_f32(&path_rng);
-                    let sample = bsdf_sample(bsdf, to_shading(eye, ns), u_lobe, stream_next_2d(&path_rng));
+                    let wo = to_shading(eye, ns);
+                    var sample = bsdf_sample(bsdf, wo, u_lobe, stream_next_2d(&path_rng));
+                    if (bump_mapped() && bump.alpha >= 0.0) {
+                        sample = bsdf_reweigh(bsdf, wo, sample, bump_term(bump, local_to_world(sample.wi, ns)));
+                    }
                     if (sample.valid && can_bounce && top < STACK) {
                         let dir = local_to_world(sample.wi, ns);
                         stack[top] = Branch(x, b.depth + 1u, dir, select(0u, 1u, sample.is_delta), weight * sample.weight);

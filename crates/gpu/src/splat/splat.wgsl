@@ -73,7 +73,7 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     let position = textureLoad(gbuffer_position, pixel, 0);
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     // Only visible diffuse surfaces (kind 0) take photon light.
-    if (position.w == 0.0 || albedo.a != 0.0) {
+    if (position.w == 0.0 || pixel_kind(albedo.a) != 0u) {
         discard;
     }
     let g = textureLoad(gbuffer_normal, pixel, 0);
@@ -86,18 +86,25 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     // ρ/(π² r²) on a Lambertian surface; on a glossy one (the only ones
     // that pay for the eye, the BRDF and the G-buffer's metal-roughness)
     // the BRDF for the photon's own direction over π r².
-    var weight = radiance_per_power(albedo.rgb, params.radius);
+    // At a bent point (position.w < 0: smooth-shaded and normal-mapped
+    // meshes) the photon weighs as photon-cpu weighs it: shading_normal_factor,
+    // and where a normal texture bent it the bump shadowing of its side.
+    var bent_factor = 1.0;
+    var k = 1.0;
+    if (BENT && position.w < 0.0) {
+        bent_factor = shading_normal_factor(-direction, normal, unpack_geometric_normal(position.w, normal));
+        if (bump_mapped()) {
+            k = bump_term(pixel_bump(albedo.a, normal), -direction);
+        }
+    }
+    var weight = radiance_per_power(albedo.rgb, params.radius) * k;
     let surface = surfaces.all[u32(g.w)];
     if (GLOSSY && surface.glossy != 0u) {
         let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
         let eye = unit(params.camera_position - position.xyz);
-        weight = photon_brdf(b, eye, normal, direction) * radiance_per_weighted_power(params.radius);
+        weight = photon_brdf(b, eye, normal, direction, k) * radiance_per_weighted_power(params.radius);
     }
-    // At a bent point (position.w < 0: smooth-shaded and normal-mapped
-    // meshes) the photon weighs as photon-cpu weighs it.
-    if (BENT && position.w < 0.0) {
-        weight *= shading_normal_factor(-direction, normal, unpack_geometric_normal(position.w, normal));
-    }
+    weight *= bent_factor;
     let radiance = weight * in.power * (params.power_unit * in.scale);
     // Alpha counts the photons that reached the pixel.
     return vec4<f32>(radiance, 1.0);

@@ -229,21 +229,16 @@ fn slice_slots(t: u32) -> vec2<u32> {
 
 // The photons of `slots` within reach of x (shading normal n): their
 // powers, weighted by the BRDF at a glossy point and, where `bent`, by
-// shading_normal_factor across the geometric normal ng (as photon-cpu).
-fn gather_slots(sum: ptr<function, FixedSum>, slots: vec2<u32>, x: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, bent: bool, glossy: bool, b: Bsdf, eye: vec3<f32>) {
+// shading_normal_factor across the geometric normal ng (as photon-cpu) and
+// the bump shadowing `bump` of the photon's side at a normal-mapped point.
+fn gather_slots(sum: ptr<function, FixedSum>, slots: vec2<u32>, x: vec3<f32>, n: vec3<f32>, ng: vec3<f32>, bent: bool, bump: BumpShadow, glossy: bool, b: Bsdf, eye: vec3<f32>) {
     for (var slot = slots.x; slot < slots.y; slot++) {
         let p = survivors[tile_lists[slot]];
         let d = x - vec3<f32>(p.position_x, p.position_y, p.position_z);
         let direction = decode_octahedral_15(p.direction_and_class & 0x3fffffffu);
         if (photon_accepted(dot(d, d), direction, n, params.radius, params.normal_test != 0u)) {
-            var power = decode_rgb9e5(p.power_rgb9e5) * p.scale;
-            if (glossy) {
-                power *= photon_brdf(b, eye, n, direction);
-            }
-            if (bent) {
-                power *= shading_normal_factor(-direction, n, ng);
-            }
-            add_to_sum(sum, power);
+            let power = decode_rgb9e5(p.power_rgb9e5) * p.scale;
+            add_to_sum(sum, gathered_power(power, direction, n, ng, bent, bump, glossy, b, eye));
         }
     }
 }
@@ -268,14 +263,15 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let eye = unit(media.camera_position - position.xyz);
     // Only visible diffuse surfaces (kind 0) take photon light.
-    if (position.w != 0.0 && albedo.a == 0.0) {
+    if (position.w != 0.0 && pixel_kind(albedo.a) == 0u) {
         let slots = slice_slots(wid.y * params.tiles_x + wid.x);
         // `bent` a literal in each call, so the test folds out of the loop.
         if (BENT && position.w < 0.0) {
             let ng = unpack_geometric_normal(position.w, normal);
-            gather_slots(&sum, slots, position.xyz, normal, ng, true, glossy, b, eye);
+            let bump = pixel_bump(albedo.a, normal);
+            gather_slots(&sum, slots, position.xyz, normal, ng, true, bump, glossy, b, eye);
         } else {
-            gather_slots(&sum, slots, position.xyz, normal, normal, false, glossy, b, eye);
+            gather_slots(&sum, slots, position.xyz, normal, normal, false, no_bump(), glossy, b, eye);
         }
     }
     var factor = radiance_per_power(albedo.rgb, params.radius);

@@ -488,6 +488,12 @@ fn trace_one(rng: ptr<function, Rng>) {
             shading = bent_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, shading, normals.geometric, ray.dir);
         }
         let ns = shading * facing;
+        // A normal-mapped point's diffuse lobes: the bump shadowing of the
+        // side the photon comes from (as the CPU tracer).
+        var bump = 1.0;
+        if (bump_mapped() && any(shading != normals.shading)) {
+            bump = bump_term(bump_shadow(normals.shading, shading), -ray.dir);
+        }
         // Glass mixed into the material, drawn per hit by the CPU tracer's
         // hash (Scene::material_at): a photon stored on the base's draw
         // stands for the glass's too (Drawn::store_weight), and none is
@@ -558,7 +564,11 @@ fn trace_one(rng: ptr<function, Rng>) {
             }
             let u_lobe = rng_next_f32(rng);
             let u = rng_next_2d(rng);
-            let sample = bsdf_sample(b, to_shading(-ray.dir, ns), u_lobe, u);
+            let wo = to_shading(-ray.dir, ns);
+            var sample = bsdf_sample(b, wo, u_lobe, u);
+            if (bump_mapped() && bump != 1.0) {
+                sample = bsdf_reweigh(b, wo, sample, bump);
+            }
             if (!sample.valid) {
                 return;
             }
@@ -584,7 +594,7 @@ fn trace_one(rng: ptr<function, Rng>) {
             let p_d = rgb_mean(rho_d);
             let p_s = rgb_mean(rho_s);
             if (xi < p_d) {
-                power *= rho_d / p_d;
+                power *= rho_d / p_d * bump;
                 diffuse_bounces += 1u;
                 next_dir = local_to_world(cosine_hemisphere(rng_next_2d(rng)), ns);
             } else if (xi < p_d + p_s) {

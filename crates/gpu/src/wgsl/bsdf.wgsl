@@ -267,7 +267,9 @@ struct Lobes {
     sheen: vec3<f32>,
 }
 
-fn bsdf_f_lobes(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> Lobes {
+// `k` weighs the diffuse and sheen lobes: a normal-mapped point's bump
+// shadowing of the light's direction (`bump_term`), 1 elsewhere.
+fn bsdf_f_lobes(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> Lobes {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return Lobes(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     }
@@ -282,13 +284,14 @@ fn bsdf_f_lobes(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> Lobes {
         let parts = sheen_parts(b, wo, wi);
         lobes.diffuse *= parts.x;
         lobes.specular *= parts.x;
-        lobes.sheen = parts.yzw;
+        lobes.sheen = parts.yzw * k;
     }
+    lobes.diffuse *= k;
     return lobes;
 }
 
-fn bsdf_base_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    let lobes = bsdf_f_lobes(b, wo, wi);
+fn bsdf_base_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3<f32> {
+    let lobes = bsdf_f_lobes(b, wo, wi, k);
     return lobes.diffuse + lobes.specular + lobes.sheen;
 }
 
@@ -354,7 +357,7 @@ fn bsdf_base_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSa
     if (pdf <= 0.0) {
         return no_bsdf_sample();
     }
-    let f = bsdf_base_f(b, wo, wi);
+    let f = bsdf_base_f(b, wo, wi, 1.0);
     return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), specular && !bsdf_gathers_specular(b), true);
 }
 
@@ -374,7 +377,7 @@ fn bsdf_sample_specular_lobe(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample
     if (wi.z <= 0.0 || pdf <= 0.0) {
         return no_bsdf_sample();
     }
-    let f = bsdf_f_lobes(b, wo, wi).specular;
+    let f = bsdf_f_lobes(b, wo, wi, 1.0).specular;
     return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), !bsdf_gathers_specular(b), true);
 }
 
@@ -455,11 +458,11 @@ fn coat_probability(b: Bsdf, cos_o: f32) -> f32 {
     return coat / (coat + base);
 }
 
-fn coated_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+fn coated_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3<f32> {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    return under_coat(b, wo, wi, bsdf_f_lobes(b, wo, wi)) + vec3<f32>(coat_lobe(b, wo, wi));
+    return under_coat(b, wo, wi, bsdf_f_lobes(b, wo, wi, k)) + vec3<f32>(coat_lobe(b, wo, wi));
 }
 
 fn coated_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
@@ -488,7 +491,7 @@ fn coated_finish(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, followed: bool) -> BsdfS
     if (pdf <= 0.0) {
         return no_bsdf_sample();
     }
-    let f = coated_f(b, wo, wi);
+    let f = coated_f(b, wo, wi, 1.0);
     return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), followed, true);
 }
 
@@ -559,10 +562,27 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
 // ---- the whole BSDF: the base, under the coat where there is one ----
 
 fn bsdf_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    return bsdf_f_bumped(b, wo, wi, 1.0);
+}
+
+// `bsdf_f` with the diffuse and sheen lobes weighed by `k` (Bsdf::f_bumped).
+fn bsdf_f_bumped(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3<f32> {
     if (bsdf_has_coat(b)) {
-        return coated_f(b, wo, wi);
+        return coated_f(b, wo, wi, k);
     }
-    return bsdf_base_f(b, wo, wi);
+    return bsdf_base_f(b, wo, wi, k);
+}
+
+// Sample `s` at `wo` with the diffuse and sheen lobes weighed by `k`: f and
+// the weight change, the density not (Bsdf::reweigh).
+fn bsdf_reweigh(b: Bsdf, wo: vec3<f32>, s: BsdfSample, k: f32) -> BsdfSample {
+    if (k == 1.0 || s.is_delta || !s.valid) {
+        return s;
+    }
+    var r = s;
+    r.f = bsdf_f_bumped(b, wo, s.wi, k);
+    r.weight = r.f * (s.wi.z / s.pdf);
+    return r;
 }
 
 fn bsdf_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
@@ -582,7 +602,12 @@ fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSample 
 // What the photon maps stand for at this surface (Bsdf::f_gathered): the
 // diffuse lobe and every lobe at least GATHER_ROUGHNESS rough.
 fn bsdf_f_gathered(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    var lobes = bsdf_f_lobes(b, wo, wi);
+    return bsdf_f_gathered_bumped(b, wo, wi, 1.0);
+}
+
+// `bsdf_f_gathered` with the diffuse and sheen lobes weighed by `k`.
+fn bsdf_f_gathered_bumped(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3<f32> {
+    var lobes = bsdf_f_lobes(b, wo, wi, k);
     if (!bsdf_gathers_specular(b)) {
         lobes.specular = vec3<f32>(0.0);
     }
@@ -619,6 +644,47 @@ fn bsdf_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
         return no_bsdf_sample();
     }
     return bsdf_sample_specular_lobe(b, wo, u);
+}
+
+// ---- Cycles' bump map correction (hikari_core::bsdf::bump) ----
+
+// A normal-mapped point's shadowing of its diffuse lobes: its smooth
+// normal and the roughness α of its bend; α < 0 where nothing bends (the
+// term is 1 there).
+struct BumpShadow {
+    unbent: vec3<f32>,
+    alpha: f32,
+}
+
+fn no_bump() -> BumpShadow {
+    return BumpShadow(vec3<f32>(0.0), -1.0);
+}
+
+// BumpShadow::new: smooth (interpolated) normal `unbent` bent to `bent`,
+// both unit in one frame; α² = clamp(tan²θd / 8).
+fn bump_shadow(unbent: vec3<f32>, bent: vec3<f32>) -> BumpShadow {
+    let cos_d = abs(dot(unbent, bent));
+    if (cos_d >= 1.0 || all(unbent == bent)) {
+        return no_bump();
+    }
+    let alpha2 = clamp(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0, 1.0);
+    return BumpShadow(unbent, sqrt(alpha2));
+}
+
+// BumpShadow::term: Smith's GGX masking of |unbent·wi| (`wi` unit, in the
+// normals' frame); 1 where nothing bends, 0 in the smooth surface's plane.
+fn bump_term(b: BumpShadow, wi: vec3<f32>) -> f32 {
+    if (b.alpha < 0.0) {
+        return 1.0;
+    }
+    let cos_i = abs(dot(b.unbent, wi));
+    if (cos_i >= 1.0) {
+        return 1.0;
+    }
+    if (cos_i < 1.0e-6) {
+        return 0.0;
+    }
+    return ggx_g1(vec3<f32>(sqrt(1.0 - cos_i * cos_i), 0.0, cos_i), b.alpha);
 }
 
 // World direction `w` in the shading frame around unit `n`

@@ -17,6 +17,7 @@ mod lanes;
 
 use super::{Image, LitSides, finite_mean, render_row_batches};
 use crate::bsdf::ShadingFrame;
+use crate::bsdf::bump::BumpShadow;
 use crate::bsdf::dielectric::Transport;
 use crate::geometry::Ray;
 use crate::geometry::packet::LANES;
@@ -192,13 +193,18 @@ fn advance(
         Material::Pbr(bsdf) => {
             let frame = ShadingFrame::new(ns);
             let wo = frame.to_local(-path.ray.dir);
+            // A normal-mapped point's diffuse lobes: Cycles' bump shadowing
+            // of the light's direction (none where nothing bends).
+            let bump = BumpShadow::new(hit.shading_normal * facing, ns);
+            let k = |wi: Vec3| bump.map_or(1.0, |b| b.term(wi));
             // Light sampling finds nothing through a mirror alone.
             if bsdf.has_non_delta_lobe() {
-                let brdf = |wi: Vec3| bsdf.f(wo, frame.to_local(wi));
+                let brdf = |wi: Vec3| bsdf.f_bumped(wo, frame.to_local(wi), k(wi));
                 let pdf = |wi: Vec3| bsdf.pdf(wo, frame.to_local(wi));
                 path.l += path.beta * next_event(scene, hit.point, ns, ng, LitSides::Front, brdf, pdf, sampler);
             }
             let Some(s) = bsdf.sample(wo, sampler.next_f32(), sampler.next_2d()) else { return false };
+            let s = bsdf.reweigh(wo, s, k(frame.to_world(s.wi)));
             path.beta *= s.weight;
             path.previous =
                 if s.is_delta { Previous::Specular } else { Previous::Diffuse { point: hit.point, pdf: s.pdf } };
@@ -215,14 +221,18 @@ fn advance(
             // ends 30–75% of paths at their first bounce); the
             // throughput's roulette below ends paths instead.
             let p_diffuse = p_d / (p_d + p_s);
+            // A normal-mapped exactly Lambertian glTF material: the bump
+            // shadowing of the light's direction, as the Pbr arm's.
+            let bump = BumpShadow::new(hit.shading_normal * facing, ns);
+            let k = |wi: Vec3| bump.map_or(1.0, |b| b.term(wi));
             if p_d > 0.0 {
                 let pdf = |wi: Vec3| p_diffuse * wi.dot(ns).max(0.0) / PI;
-                path.l +=
-                    path.beta * next_event(scene, hit.point, ns, ng, LitSides::Front, |_| albedo / PI, pdf, sampler);
+                let f = |wi: Vec3| albedo / PI * k(wi);
+                path.l += path.beta * next_event(scene, hit.point, ns, ng, LitSides::Front, f, pdf, sampler);
             }
             if p_s == 0.0 || sampler.next_f32() < p_diffuse {
-                path.beta *= albedo / p_diffuse;
                 let dir = local_to_world(cosine_hemisphere(sampler.next_2d()), ns);
+                path.beta *= albedo / p_diffuse * k(dir);
                 path.previous = Previous::Diffuse { point: hit.point, pdf: p_diffuse * dir.dot(ns).max(0.0) / PI };
                 dir
             } else {

@@ -14,7 +14,12 @@ use crate::scene::Scene;
 use glam::Vec3;
 
 pub enum Event {
-    Surface(Hit),
+    /// A surface hit, its shading normal bent by any normal texture, and
+    /// the smooth (interpolated) normal before it (the bump shadowing's).
+    Surface {
+        hit: Hit,
+        unbent: Vec3,
+    },
     /// A scattering event at `point` in the media of `mask`.
     Medium {
         point: Vec3,
@@ -35,7 +40,9 @@ pub struct Step {
 
 pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
     // Surfaces shade with their normal textures' normals.
-    let hit = scene.accel.intersect(ray).map(|hit| scene.bent(hit, ray.dir));
+    let unbent_hit = scene.accel.intersect(ray);
+    let unbent = unbent_hit.map_or(Vec3::ZERO, |h| h.shading_normal);
+    let hit = unbent_hit.map(|hit| scene.bent(hit, ray.dir));
     // Arriving at glass from inside: what it absorbed on the way (a
     // deterministic factor: no density changes).
     let absorbed = hit.as_ref().map_or(Rgb::ONE, |h| match scene.material(h) {
@@ -45,7 +52,7 @@ pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
     let media = &scene.media;
     if media.is_empty() {
         return match hit {
-            Some(hit) => Step { distance: hit.t, event: Event::Surface(hit), weight: absorbed, passes: 1.0 },
+            Some(hit) => Step { distance: hit.t, event: Event::Surface { hit, unbent }, weight: absorbed, passes: 1.0 },
             None => Step { event: Event::Escaped, distance: f32::INFINITY, weight: Rgb::ONE, passes: 1.0 },
         };
     }
@@ -64,7 +71,7 @@ pub fn step(scene: &Scene, ray: &Ray, rng: &mut Rng) -> Step {
             }
         }
         Flight::Passed { weight, tau_bar } => Step {
-            event: hit.map_or(Event::Escaped, Event::Surface),
+            event: hit.map_or(Event::Escaped, |hit| Event::Surface { hit, unbent }),
             distance: t_max,
             weight: weight * absorbed,
             passes: (-tau_bar).exp(),

@@ -362,8 +362,8 @@ impl Pass<'_> {
             let mut store_weight = 1.0;
             let (point, scatter) = match step.event {
                 Event::Escaped => break,
-                Event::Surface(hit) => {
-                    let scatter_of = |m: &Material| Scatter::at(*m, &hit, ray.dir, Transport::Importance);
+                Event::Surface { hit, unbent } => {
+                    let scatter_of = |m: &Material| Scatter::at(*m, &hit, unbent, ray.dir, Transport::Importance);
                     if self.strategies.merge() && self.scene.mixes_at(&hit) {
                         let drawn = self.scene.drawn_material_at(&hit);
                         store_weight = drawn.store_weight(|m| scatter_of(m).is_some_and(|s| !s.is_delta()));
@@ -505,7 +505,7 @@ impl Pass<'_> {
                     }
                     break;
                 }
-                Event::Surface(hit) => {
+                Event::Surface { hit, unbent } => {
                     let cos = ray.dir.dot(hit.shading_normal);
                     state.arrive(step.distance * step.distance, cos * step.passes, departure, true);
                     if let Some(found) = self.emitters.at_surface(&hit, from, ray.dir) {
@@ -513,7 +513,8 @@ impl Pass<'_> {
                             self.emitter_weight(&state, length, specular_path, found.direct_pdf, found.emission_pdf_w);
                         color += throughput * found.radiance * weight;
                     }
-                    (hit.point, Scatter::at(*self.scene.material_at(&hit), &hit, ray.dir, Transport::Radiance))
+                    let material = *self.scene.material_at(&hit);
+                    (hit.point, Scatter::at(material, &hit, unbent, ray.dir, Transport::Radiance))
                 }
                 Event::Medium { point, mask } => {
                     let scatter = Scatter::medium(&self.scene.media, mask, ray.dir);

@@ -11,6 +11,7 @@
 //! carry radiance (1/η'² per crossing), light subpaths power, and each
 //! evaluates glass in its own mode (`Transport`), the adjoint of the other.
 
+use crate::bsdf::bump::BumpShadow;
 use crate::bsdf::dielectric::{Dielectric, Transport};
 use crate::bsdf::{Bsdf, ShadingFrame};
 use crate::geometry::Hit;
@@ -114,6 +115,11 @@ pub struct Scatter {
     wo: Vec3,
     wo_local: Vec3,
     continuation: f32,
+    /// At a point a normal texture bends, the diffuse lobes' bump
+    /// shadowing, of the side the light comes from: `wi` on an eye
+    /// subpath, `wo` on a light subpath (`carries`).
+    bump: Option<BumpShadow>,
+    carries: Transport,
 }
 
 /// f toward a direction and the two sampling densities (per steradian,
@@ -144,9 +150,11 @@ pub struct Sampled {
 impl Scatter {
     /// The vertex at `hit`, reached along `dir`; None where nothing
     /// scatters (the black bodies of area lights, black materials).
-    /// `mode` says what the subpath carries: radiance (from the eye) or
-    /// power (from a light), which differ across glass.
-    pub fn at(material: Material, hit: &Hit, dir: Vec3, mode: Transport) -> Option<Scatter> {
+    /// `unbent` is the smooth normal a normal texture bent `hit`'s shading
+    /// normal from (equal to it where none did). `mode` says what the
+    /// subpath carries: radiance (from the eye) or power (from a light),
+    /// which differ across glass and in the bump shadowing's side.
+    pub fn at(material: Material, hit: &Hit, unbent: Vec3, dir: Vec3, mode: Transport) -> Option<Scatter> {
         let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let (lobes, continuation) = match material {
             Material::Emitter => return None,
@@ -167,6 +175,7 @@ impl Scatter {
         let normal = hit.shading_normal * facing;
         let frame = ShadingFrame::new(normal);
         let wo = -dir;
+        let bent = unbent != hit.shading_normal && !matches!(lobes, Lobes::Glass(..));
         Some(Scatter {
             lobes,
             frame,
@@ -176,6 +185,8 @@ impl Scatter {
             wo,
             wo_local: frame.to_local(wo),
             continuation: continuation.min(1.0),
+            bump: if bent { BumpShadow::new(unbent * facing, normal) } else { None },
+            carries: mode,
         })
     }
 
@@ -194,6 +205,8 @@ impl Scatter {
             wo: -dir,
             wo_local: frame.to_local(-dir),
             continuation: lambda.min(1.0),
+            bump: None,
+            carries: Transport::Radiance,
         })
     }
 
@@ -236,6 +249,12 @@ impl Scatter {
     /// Toward where the subpath came from.
     pub fn wo(&self) -> Vec3 {
         self.wo
+    }
+
+    /// The bump shadowing's weight of the diffuse lobes for a subpath
+    /// going on along the world direction `wi` (1 where nothing bends).
+    fn bump_weight(&self, wi: Vec3) -> f32 {
+        self.bump.map_or(1.0, |b| b.term(if self.carries == Transport::Radiance { wi } else { self.wo }))
     }
 
     /// What a light vertex merged here, arriving from `wi`, weighs beyond f:
@@ -287,11 +306,13 @@ impl Scatter {
             return None;
         }
         let (f, pdf_dir, pdf_rev) = match self.lobes {
-            Lobes::Pbr(bsdf) => {
-                (bsdf.f(self.wo_local, wi_local), bsdf.pdf(self.wo_local, wi_local), bsdf.pdf(wi_local, self.wo_local))
-            }
+            Lobes::Pbr(bsdf) => (
+                bsdf.f_bumped(self.wo_local, wi_local, self.bump_weight(wi)),
+                bsdf.pdf(self.wo_local, wi_local),
+                bsdf.pdf(wi_local, self.wo_local),
+            ),
             Lobes::Lambert { albedo, p_diffuse, .. } => {
-                (albedo / PI, p_diffuse * wi_local.z / PI, p_diffuse * self.wo_local.z / PI)
+                (albedo / PI * self.bump_weight(wi), p_diffuse * wi_local.z / PI, p_diffuse * self.wo_local.z / PI)
             }
             Lobes::Glass(..) | Lobes::Medium(_) => return None,
         };
@@ -304,6 +325,7 @@ impl Scatter {
         let sampled = match self.lobes {
             Lobes::Pbr(bsdf) => {
                 let s = bsdf.sample(self.wo_local, u_lobe, u)?;
+                let s = bsdf.reweigh(self.wo_local, s, self.bump_weight(self.frame.to_world(s.wi)));
                 let pdf_rev = if s.is_delta { s.pdf } else { bsdf.pdf(s.wi, self.wo_local) };
                 Sampled {
                     wi: self.frame.to_world(s.wi),
@@ -317,9 +339,10 @@ impl Scatter {
             Lobes::Lambert { albedo, mirror, p_diffuse } => {
                 if u_lobe < p_diffuse {
                     let local = cosine_hemisphere(u);
+                    let wi = self.frame.to_world(local);
                     Sampled {
-                        wi: self.frame.to_world(local),
-                        weight: albedo / p_diffuse,
+                        wi,
+                        weight: albedo / p_diffuse * self.bump_weight(wi),
                         pdf_dir: p_diffuse * local.z / PI,
                         pdf_rev: p_diffuse * self.wo_local.z / PI,
                         cos: local.z,
@@ -401,11 +424,44 @@ mod tests {
         let bent = Vec3::new(0.5f32.sin(), 0.0, 0.5f32.cos());
         let down = Vec3::new(0.0, 0.3, -1.0).normalize();
         let wi = Vec3::new(0.6, 0.0, 0.8);
-        let at = |n: Vec3, m: Material| Scatter::at(m, &hit(n), down, Transport::Radiance).unwrap();
+        let at = |n: Vec3, m: Material| Scatter::at(m, &hit(n), n, down, Transport::Radiance).unwrap();
         let weight = at(bent, diffuse).merge_weight(wi);
         assert!((weight - crate::estimate::shading_normal_factor(wi, bent, Vec3::Z)).abs() < 1e-6);
         assert!((weight - wi.dot(bent) / 0.8).abs() < 1e-5, "{weight}");
         assert_eq!(at(Vec3::Z, diffuse).merge_weight(wi), 1.0);
         assert_eq!(at(bent, Material::Glass(Dielectric::clear(1.5))).merge_weight(wi), 1.0);
+    }
+
+    /// At a normal-mapped point the diffuse lobes take the bump shadowing
+    /// of the light's side: the direction an eye subpath goes on along,
+    /// the one a light subpath came from; the densities stay; nothing
+    /// changes where no normal texture bent the normal.
+    #[test]
+    fn the_bump_shadowing_weighs_the_lights_side() {
+        let unbent = Vec3::Z;
+        let bent = Vec3::new(0.6f32.sin(), 0.0, 0.6f32.cos());
+        let down = Vec3::new(-0.9, 0.2, -0.35).normalize();
+        let wi = Vec3::new(0.9, 0.1, 0.25).normalize();
+        let bump = BumpShadow::new(unbent, bent).unwrap();
+        let diffuse = Material::Diffuse { albedo: Rgb::splat(0.5), specular: Rgb::ZERO };
+        let pbr = Material::Pbr(Bsdf::new(Rgb::new(0.7, 0.5, 0.3), 0.0, 0.6, 1.0));
+        for m in [diffuse, pbr] {
+            let plain = Scatter::at(m, &hit(bent), bent, down, Transport::Radiance).unwrap().evaluate(wi).unwrap();
+            for (mode, side) in [(Transport::Radiance, wi), (Transport::Importance, -down)] {
+                let s = Scatter::at(m, &hit(bent), unbent, down, mode).unwrap();
+                let e = s.evaluate(wi).unwrap();
+                let k = bump.term(side);
+                assert!(k < 0.99, "{k}");
+                let want = match m {
+                    Material::Pbr(b) => {
+                        let frame = ShadingFrame::new(bent);
+                        b.f_bumped(frame.to_local(-down), frame.to_local(wi), k)
+                    }
+                    _ => plain.f * k,
+                };
+                assert!(e.f.abs_diff_eq(want, 1e-6), "{mode:?}: {} against {want}", e.f);
+                assert_eq!((e.pdf_dir, e.pdf_rev), (plain.pdf_dir, plain.pdf_rev));
+            }
+        }
     }
 }
