@@ -41,7 +41,7 @@ pub struct BenchArgs {
     pub no_tracing: bool,
     /// Pipelines made as if every scene also used these features
     /// (comma-separated: textured, cut-outs, glossy, coated, sheened,
-    /// sampled-lights, sky-image, media, bent, mixed, or all): what each costs a scene without it.
+    /// sampled-lights, sky-image, media, bent, mixed, layered, or all): what each costs a scene without it.
     #[arg(long, value_delimiter = ',', value_parser = parse_feature)]
     pub with_features: Vec<SceneFeatures>,
     /// Also run 1920×1080 with 1,000,000 photons (meant for real GPUs).
@@ -66,10 +66,11 @@ fn parse_feature(name: &str) -> Result<SceneFeatures, String> {
         "media" => SceneFeatures { media: true, ..none },
         "bent" => SceneFeatures { bent: true, ..none },
         "mixed" => SceneFeatures { glossy: true, mixed: true, ..none },
+        "layered" => SceneFeatures { textured: true, glossy: true, layered: true, ..none },
         "all" => SceneFeatures::ALL,
         _ => {
             return Err(format!(
-                "{name:?} is none of textured, cut-outs, glossy, coated, sheened, sampled-lights, sky-image, media, bent, mixed, all"
+                "{name:?} is none of textured, cut-outs, glossy, coated, sheened, sampled-lights, sky-image, media, bent, mixed, layered, all"
             ));
         }
     })

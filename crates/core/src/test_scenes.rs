@@ -501,11 +501,41 @@ pub mod gltf_textures {
         let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
         let m = b.material(&PbrMaterial { roughness: 0.4, ..Default::default() });
         let root = quad(&mut b, Vec3::Y, Vec3::X, -Vec3::Y, 1.0, m);
-        let (root, bin) = b.finish(vec![root]);
+        with_layers(b.finish(vec![root]), t.value())
+    }
+
+    /// `layered_glb`'s material (its base a darker orange) on a floor
+    /// (x, y ∈ [−1, 1], z = 0, the checker four times over) before a white
+    /// wall at y = 1, lit by a point light 0.4 above the floor: light
+    /// bounces off the layers onto the wall and back; the camera at
+    /// `size`² looking down at both.
+    pub fn layered_floor(tag: &str, size: u32) -> Scene {
+        use json::extensions::scene::khr_lights_punctual::Type;
+        let mut b = GltfBuilder::new();
+        let image = b.image(&grey_checker(LAYER_ALPHA), "image/png");
+        let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let m = b.material(&PbrMaterial { base_color: Vec3::new(0.5, 0.3, 0.1), roughness: 0.4, ..Default::default() });
+        let white = b.material(&PbrMaterial { base_color: Vec3::splat(0.8), specular: 0.0, ..Default::default() });
+        let floor = quad(&mut b, Vec3::new(-1.0, -1.0, 0.0), 2.0 * Vec3::X, 2.0 * Vec3::Y, 2.0, m);
+        let wall = quad(&mut b, Vec3::new(-1.0, 1.0, 0.0), 2.0 * Vec3::X, 1.5 * Vec3::Z, 1.0, white);
+        let light = b.light(Type::Point, Vec3::ONE, 4.0 * 683.0, None);
+        let light = b.node(GltfBuilder::light_node(light, Vec3::new(0.0, -0.3, 0.4), glam::Quat::IDENTITY));
+        let glb = with_layers(b.finish(vec![floor, wall, light]), t.value());
+        let mut scene = load(tag, &glb);
+        scene.camera =
+            crate::camera::Camera::new(Vec3::new(0.0, -1.6, 2.2), Vec3::new(0.0, 0.2, 0.0), Vec3::Y, 50.0, size, size)
+                .unwrap();
+        scene
+    }
+
+    /// The document `(root, bin)` with its material 0 under a clear coat,
+    /// a sheen and `KHR_materials_specular` (`LAYER_FACTORS`), all six
+    /// textures texture `texture`.
+    fn with_layers((root, bin): (json::Root, Vec<u8>), texture: usize) -> Vec<u8> {
         let (coat, coat_roughness, sheen, sheen_roughness, specular, specular_color) = LAYER_FACTORS;
         let [sr, sg, sb] = sheen;
         let [cr, cg, cb] = specular_color;
-        let info = format!(r#"{{"index": {}}}"#, t.value());
+        let info = format!(r#"{{"index": {texture}}}"#);
         let extensions = format!(
             r#"{{
                 "KHR_materials_clearcoat": {{
@@ -524,10 +554,10 @@ pub mod gltf_textures {
         );
         let mut value = json::serialize::to_value(&root).unwrap();
         value["materials"][0]["extensions"] = json::deserialize::from_str(&extensions).unwrap();
-        value["extensionsUsed"] = json::deserialize::from_str(
-            r#"["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular"]"#,
-        )
-        .unwrap();
+        let used = value["extensionsUsed"].as_array().cloned().unwrap_or_default();
+        let mut used: Vec<String> = used.iter().filter_map(|v| v.as_str().map(String::from)).collect();
+        used.extend(["KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_specular"].map(String::from));
+        value["extensionsUsed"] = json::serialize::to_value(&used).unwrap();
         let root: json::Root = json::deserialize::from_value(value).unwrap();
         crate::scene::gltf::export::glb(&root, bin)
     }

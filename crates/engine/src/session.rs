@@ -531,6 +531,9 @@ fn open_gpu(scene: &Scene, settings: &GpuSettings, expected: [u64; 3], log: &Log
         log.note(&format!("gpu {}: {e}: rendering with photon-cpu instead", ctx.describe()));
         return None;
     }
+    for note in hikari_gpu::renderer::adapter_notes(&ctx, scene) {
+        log.note(&note);
+    }
     Some(ctx)
 }
 

@@ -39,6 +39,16 @@ pub fn texture(view_dimension: wgpu::TextureViewDimension) -> wgpu::BindingType 
     }
 }
 
+/// A 2D unsigned-integer texture read with `textureLoad` (the G-buffer's
+/// layer texels).
+pub fn texture_uint() -> wgpu::BindingType {
+    wgpu::BindingType::Texture {
+        sample_type: wgpu::TextureSampleType::Uint,
+        view_dimension: wgpu::TextureViewDimension::D2,
+        multisampled: false,
+    }
+}
+
 /// A write-only `Rgba32Float` storage texture.
 pub fn storage_texture_rgba32f() -> wgpu::BindingType {
     wgpu::BindingType::StorageTexture {

@@ -52,8 +52,8 @@ pub fn required_limits() -> wgpu::Limits {
         // adapter has fewer (`TILED_STORAGE_BUFFERS`).
         max_storage_buffers_per_shader_stage: 8,
         max_storage_textures_per_shader_stage: 1,
-        // The tiled estimator's bindings 0–17 and the specular pass's.
-        max_bindings_per_bind_group: 18,
+        // The specular pass's bindings 0–19 and the tiled estimator's 0–18.
+        max_bindings_per_bind_group: 20,
         max_compute_invocations_per_workgroup: 256,
         max_compute_workgroup_size_x: 256,
         max_compute_workgroup_storage_size: 1024,
@@ -110,6 +110,24 @@ pub struct Capabilities {
     pub gbuffer_storage: bool,
     /// R32Float is renderable: shadow maps use it (else R16Float).
     pub r32_renderable: bool,
+    /// The G-buffer can keep a fifth target, the layer textures' texels
+    /// (`gbuffer::LAYERS_FORMAT`; `layer_texels`).
+    pub layer_texels: bool,
+}
+
+/// Whether an adapter of `limits` can keep the layer textures' texels in a
+/// fifth G-buffer target of `format_usages` (Rgba32Uint's): as a render
+/// target, 80 bytes of colour attachments a sample (Vulkan, DX12, GL and
+/// lavapipe offer 128; Apple's Metal GPUs 64, where the layers are drawn
+/// as their means); on the storage path, a fifth storage texture.
+pub fn layer_texels(limits: &wgpu::Limits, format_usages: U, gbuffer_storage: bool) -> bool {
+    if gbuffer_storage {
+        limits.max_storage_textures_per_shader_stage >= 5 && format_usages.contains(U::STORAGE_BINDING)
+    } else {
+        limits.max_color_attachments >= 5
+            && limits.max_color_attachment_bytes_per_sample >= 80
+            && format_usages.contains(U::RENDER_ATTACHMENT)
+    }
 }
 
 /// What the storage G-buffer needs beyond the common requirements.
@@ -170,7 +188,9 @@ impl Capabilities {
             return Err(format!("lacks {}", missing.join("; ")));
         }
         let timestamps = adapter.features().contains(timestamp_features());
-        Ok(Capabilities { float32_blend, float16_blend, timestamps, gbuffer_storage, r32_renderable })
+        let layer_usages = adapter.get_texture_format_features(TextureFormat::Rgba32Uint).allowed_usages;
+        let layer_texels = layer_texels(&adapter.limits(), layer_usages, gbuffer_storage);
+        Ok(Capabilities { float32_blend, float16_blend, timestamps, gbuffer_storage, r32_renderable, layer_texels })
     }
 
     /// The features to request for a device.
@@ -305,6 +325,25 @@ mod tests {
                 (DeviceType::Cpu, Backend::Gl),
             ]
         );
+    }
+
+    /// Apple's 64 bytes a sample hold the four G-buffer targets, not the
+    /// fifth; the storage path needs a fifth storage texture.
+    #[test]
+    fn the_layer_texels_need_a_fifth_target() {
+        let both = U::RENDER_ATTACHMENT | U::STORAGE_BINDING;
+        let roomy = wgpu::Limits {
+            max_color_attachments: 8,
+            max_color_attachment_bytes_per_sample: 128,
+            max_storage_textures_per_shader_stage: 8,
+            ..wgpu::Limits::default()
+        };
+        assert!(layer_texels(&roomy, both, false) && layer_texels(&roomy, both, true));
+        let apple = wgpu::Limits { max_color_attachment_bytes_per_sample: 64, ..roomy.clone() };
+        assert!(!layer_texels(&apple, both, false) && layer_texels(&apple, both, true));
+        let four = wgpu::Limits { max_storage_textures_per_shader_stage: 4, ..roomy.clone() };
+        assert!(layer_texels(&four, both, false) && !layer_texels(&four, both, true));
+        assert!(!layer_texels(&roomy, U::STORAGE_BINDING, false) && !layer_texels(&roomy, U::RENDER_ATTACHMENT, true));
     }
 
     #[test]

@@ -54,6 +54,9 @@ pub struct GpuContext {
     pub r32_renderable: bool,
     /// The G-buffer is stored from fragment shaders (`Capabilities::gbuffer_storage`).
     pub gbuffer_storage: bool,
+    /// The G-buffer can keep the layer textures' texels (`Capabilities::layer_texels`):
+    /// else clear-coat, sheen and specular textures are drawn as their means.
+    pub layer_texels: bool,
     /// Loop iterations one shader invocation may run (`capabilities::loop_budget`).
     pub loop_budget: u32,
     /// Longest wait for submitted work before giving up.
@@ -199,6 +202,7 @@ impl GpuContext {
             float32_blend: caps.float32_blend,
             timestamps: caps.timestamps,
             gbuffer_storage: caps.gbuffer_storage,
+            layer_texels: caps.layer_texels,
             r32_renderable: caps.r32_renderable,
             wait_timeout: WAIT_TIMEOUT,
             fault,

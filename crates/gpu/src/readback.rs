@@ -26,6 +26,16 @@ pub fn read_rgba_layers(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec
     (0..texture.depth_or_array_layers()).map(|layer| read_rgba_layer(ctx, texture, layer)).collect()
 }
 
+/// A 2D `Rgba32Uint` texture's words (the G-buffer's layer texels),
+/// row-major, row 0 at the top.
+pub fn read_rgba32uint(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[u32; 4]>, GpuError> {
+    if texture.format() != wgpu::TextureFormat::Rgba32Uint {
+        return Err(GpuError::Readback(format!("not Rgba32Uint: {:?}", texture.format())));
+    }
+    let bytes = wait_for(read_rows(ctx, texture, 0, 16))?;
+    Ok(bytemuck::cast_slice::<u8, [u32; 4]>(&bytes).to_vec())
+}
+
 /// A 2D `Rgba8Unorm` (or `Rgba8UnormSrgb`) texture's bytes, row-major,
 /// row 0 at the top.
 pub fn read_rgba8(ctx: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>, GpuError> {

@@ -230,6 +230,35 @@ fn specular_inputs<'a>(
 }
 
 /// The rasterizing passes' projection for `camera` in a scene within `bounds`.
+/// What `ctx`'s adapter draws of `scene` otherwise than the CPU renderers,
+/// one line each (the front ends print them with the scene's notes).
+pub fn adapter_notes(ctx: &GpuContext, scene: &Scene) -> Vec<String> {
+    let mut notes = Vec::new();
+    if SceneFeatures::of_scene(scene).layered && !ctx.layer_texels {
+        let lacks = if ctx.gbuffer_storage {
+            format!("{} storage textures a shader stage, 5 needed", ctx.limits.max_storage_textures_per_shader_stage)
+        } else {
+            format!(
+                "{} bytes of colour attachments a sample, 80 needed",
+                ctx.limits.max_color_attachment_bytes_per_sample
+            )
+        };
+        notes.push(format!(
+            "note: {} has no room for the G-buffer's layer texels ({lacks}): the GPU renderer draws clear-coat, sheen \
+             and specular textures with their means over the image",
+            ctx.describe()
+        ));
+    }
+    notes
+}
+
+/// `features` as this adapter draws them: layer textures per point only
+/// where its G-buffer can keep their texels (`GpuContext::layer_texels`),
+/// else as their means (`scene_upload::scene_surfaces`).
+fn within_adapter(ctx: &GpuContext, features: SceneFeatures) -> SceneFeatures {
+    SceneFeatures { layered: features.layered && ctx.layer_texels, ..features }
+}
+
 fn clip_from_world(camera: &hikari_core::camera::Camera, bounds: (Vec3, Vec3)) -> glam::Mat4 {
     let (near, far) = depth_range(bounds, camera.position);
     camera.clip_from_view(near, far) * camera.view_from_world()
@@ -326,6 +355,7 @@ impl GpuRenderer {
     ) -> Result<Self, GpuError> {
         let photons = [traced.indirect().len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
         Self::check_fits(&ctx, scene, &settings, photons)?;
+        let features = within_adapter(&ctx, features);
         let scopes = ctx.error_scopes();
         let renderer = Self::create(ctx, scene, traced, settings, features);
         scopes.finish()?;
@@ -361,14 +391,14 @@ impl GpuRenderer {
         let lod_pass = LodPass::new(device);
         let lights = GpuLights::new(scene, settings.area_light_samples);
         let targets = FrameTargets {
-            gbuffer: GBuffer::new(device, w, h, ctx.gbuffer_storage),
+            gbuffer: GBuffer::new(device, w, h, ctx.gbuffer_storage, features.layered),
             direct: radiance_target("direct radiance"),
             indirect: radiance_target("indirect radiance"),
             caustic: radiance_target("caustic radiance"),
             volume: radiance_target("volume radiance"),
             shadow_maps: shadow_pass.create_maps(device, &lights, settings.shadow_map_size, scene.accel.bounds()),
         };
-        let scene_buffers = SceneBuffers::upload(device, scene);
+        let scene_buffers = SceneBuffers::upload(device, scene, features.layered);
         let global_photons = traced.indirect();
         let bounds = scene.accel.bounds();
         let clip_from_world = clip_from_world(&scene.camera, bounds);
@@ -534,7 +564,7 @@ impl GpuRenderer {
     pub fn set_scene(&mut self, scene: &Scene, traced: &TracedPhotons) -> Result<(), GpuError> {
         let counts = [traced.indirect().len() as u64, traced.caustic.len() as u64, traced.volume.len() as u64];
         Self::check_fits(&self.ctx, scene, &self.settings, counts)?;
-        let features = SceneFeatures::of_scene(scene);
+        let features = within_adapter(&self.ctx, SceneFeatures::of_scene(scene));
         if features.union(self.features) != self.features {
             let mut posed = scene.clone();
             posed.camera = self.camera.clone();
@@ -543,7 +573,7 @@ impl GpuRenderer {
         }
         let scopes = self.ctx.error_scopes();
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
-        self.scene = SceneBuffers::upload(device, scene);
+        self.scene = SceneBuffers::upload(device, scene, self.features.layered);
         self.gbuffer_binding = self.gbuffer_pass.bind(device, &self.scene, &self.targets.gbuffer);
         self.shadow_scene = self.shadow_pass.bind_scene(device, &self.scene);
         self.global_splat =

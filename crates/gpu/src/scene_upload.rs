@@ -111,7 +111,13 @@ pub struct GpuSurface {
     /// rather than a field of its own: 16 more bytes a surface cost every
     /// pass that reads surfaces (the splat passes 5–7% on llvmpipe).
     pub specular_color: [f32; 3],
-    pub _pad3: u32,
+    /// Where the surface's clear-coat, sheen and specular textures'
+    /// references start in the texture buffer (`TextureViews::layer_table`;
+    /// `NO_TEXTURE`: none, or drawn as their means): those textures
+    /// multiply `clearcoat`, `clearcoat_roughness`, `sheen_color`,
+    /// `sheen_roughness`, `specular_factor` and `specular_color` per point
+    /// (surface_point.wgsl's `layer_texels`).
+    pub layer_textures: u32,
 }
 
 /// The surfaces buffer's contents, as surface.wgsl's `Surfaces` reads it:
@@ -240,18 +246,20 @@ fn tessellate_sphere(center: Vec3, radius: f32, surface: u32, out: &mut Vec<GpuV
     }
 }
 
-pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
+/// The scene's surfaces. With `layers_per_point`, clear-coat, sheen and
+/// specular textures are read per point (`GpuSurface::layer_textures`);
+/// without (an adapter whose G-buffer cannot keep them:
+/// `GpuContext::layer_texels`), as their means over the image.
+pub fn scene_surfaces(scene: &Scene, layers_per_point: bool) -> Vec<GpuSurface> {
     let views = scene.texturing.as_deref().map(crate::textures::TextureViews::of).unwrap_or_default();
     scene
         .surfaces
         .iter()
         .map(|s| {
-            // Clear-coat, sheen and specular textures as their means (the
-            // GPU reads them nowhere per point yet; the scene's notes say so);
-            // a transmission mix as its base, with `transmission` below.
+            // A transmission mix as its base, with `transmission` below.
             let material = &match &scene.texturing {
-                Some(t) => t.with_layer_means(scene.materials[s.material as usize], s.material),
-                None => scene.materials[s.material as usize],
+                Some(t) if !layers_per_point => t.with_layer_means(scene.materials[s.material as usize], s.material),
+                _ => scene.materials[s.material as usize],
             };
             let (kind, albedo, ior) = match material {
                 Material::Diffuse { albedo, .. } => (kind::DIFFUSE, *albedo, 1.0),
@@ -329,16 +337,21 @@ pub fn scene_surfaces(scene: &Scene) -> Vec<GpuSurface> {
                     Material::Glass(glass) => glass.absorption.to_array(),
                     _ => glossy.map_or([1.0; 3], |b| b.specular_color.to_array()),
                 },
-                _pad3: 0,
+                layer_textures: match (material, layers_per_point) {
+                    (Material::Pbr(_), true) => views.layer_table(s.material),
+                    _ => crate::textures::NO_TEXTURE,
+                },
             }
         })
         .collect()
 }
 
 impl SceneBuffers {
-    pub fn upload(device: &wgpu::Device, scene: &Scene) -> Self {
+    /// The scene's buffers, its layer textures read per point where
+    /// `layers_per_point` (`scene_surfaces`).
+    pub fn upload(device: &wgpu::Device, scene: &Scene, layers_per_point: bool) -> Self {
         let (vertices, occluder_count) = scene_vertices(scene);
-        let surfaces = scene_surfaces(scene);
+        let surfaces = scene_surfaces(scene, layers_per_point);
         let bvh = FlatBvh::new(&scene.accel);
         let textures = crate::textures::pack_scene(scene, Some(&bvh));
         SceneBuffers {
@@ -374,26 +387,49 @@ impl SceneBuffers {
 mod tests {
     use super::*;
 
-    /// The record of a surface with clear-coat, sheen and specular
-    /// textures holds each factor times its texture's mean
-    /// (`Texturing::with_layer_means`, which hikari-core's tests pin).
+    /// A surface with clear-coat, sheen and specular textures: read per
+    /// point, its record holds the factors and where its six textures'
+    /// references lie in the packed texture words (each the view
+    /// `TextureViews::reference` names); drawn as their means, each factor
+    /// times its texture's mean (`Texturing::with_layer_means`, which
+    /// hikari-core's tests pin) and no table.
     #[test]
-    fn layer_textures_upload_as_their_means() {
+    fn layer_textures_upload_per_point_or_as_their_means() {
+        use crate::textures::{NO_TEXTURE, TextureViews, pack};
         use hikari_core::test_scenes::gltf_textures::{LAYER_FACTORS, layered_glb, load};
         let scene = load("gpu-layers", &layered_glb());
-        let surfaces = scene_surfaces(&scene);
-        let glossy = surfaces.iter().find(|s| s.glossy == 1).expect("the layered quad");
         let texturing = scene.texturing.as_ref().unwrap();
         let index = scene.surfaces.iter().position(|s| texturing.materials[s.material as usize].is_some()).unwrap();
         let material = scene.surfaces[index].material;
+
+        let means = scene_surfaces(&scene, false)[index];
         let Material::Pbr(mean) = texturing.with_layer_means(scene.materials[material as usize], material) else {
             panic!()
         };
-        assert_eq!(glossy.clearcoat, mean.clearcoat);
-        assert!(glossy.clearcoat < LAYER_FACTORS.0 * 0.99, "the texture's mean (below 1) applied");
-        assert_eq!(glossy.sheen_color, mean.sheen_color.to_array());
-        assert_eq!(glossy.specular_factor, mean.specular);
-        assert_eq!(glossy.specular_color, mean.specular_color.to_array());
+        assert_eq!(means.clearcoat, mean.clearcoat);
+        assert!(means.clearcoat < LAYER_FACTORS.0 * 0.99, "the texture's mean (below 1) applied");
+        assert_eq!(means.sheen_color, mean.sheen_color.to_array());
+        assert_eq!(means.specular_factor, mean.specular);
+        assert_eq!(means.specular_color, mean.specular_color.to_array());
+        assert_eq!(means.layer_textures, NO_TEXTURE);
+
+        let per_point = scene_surfaces(&scene, true)[index];
+        let (coat, coat_roughness, sheen, sheen_roughness, specular, specular_color) = LAYER_FACTORS;
+        assert_eq!(per_point.clearcoat, coat);
+        assert_eq!(per_point.clearcoat_roughness, coat_roughness);
+        assert_eq!(per_point.sheen_color, sheen);
+        assert_eq!(per_point.sheen_roughness, sheen_roughness);
+        assert_eq!(per_point.specular_factor, specular);
+        assert_eq!(per_point.specular_color, specular_color);
+        let table = per_point.layer_textures as usize;
+        let words = pack(texturing, None);
+        let views = TextureViews::of(texturing);
+        let layers = texturing.materials[material as usize].unwrap().layers;
+        for (k, texture) in layers.all().into_iter().enumerate() {
+            assert!(texture.is_some(), "layered_glb has all six");
+            assert_eq!(words[table + k], views.reference(texture), "table word {k}");
+        }
+        assert!(scene_surfaces(&scene, true).iter().filter(|s| s.glossy == 0).all(|s| s.layer_textures == NO_TEXTURE));
     }
 
     /// The kind only the G-buffer writes is surface.wgsl's constant.

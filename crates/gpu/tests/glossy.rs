@@ -11,12 +11,24 @@ use hikari_core::render::photon_cpu::{PhotonCpuSettings, default_radius};
 use hikari_core::render::{Image, path};
 use hikari_core::scene::Scene;
 use hikari_core::test_scenes::{coated_box, glossy_box, glossy_lights, quad_lights_as_meshes, sheen_box};
+use hikari_gpu::features::SceneFeatures;
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::{GpuRenderer, GpuSettings};
 
 /// The means of passes 1..=n of `photons` paths each for each n in
 /// `checkpoints`, as `render --renderer gpu --passes n` draws them.
 fn gpu_progressive(scene: &Scene, photons: u64, checkpoints: &[u32], area_light_samples: u32) -> Vec<Image> {
+    gpu_progressive_with(scene, photons, checkpoints, area_light_samples, SceneFeatures::of_scene(scene))
+}
+
+/// `gpu_progressive` with pipelines for `features`.
+fn gpu_progressive_with(
+    scene: &Scene,
+    photons: u64,
+    checkpoints: &[u32],
+    area_light_samples: u32,
+    features: SceneFeatures,
+) -> Vec<Image> {
     let ctx = test_context("gpu_progressive");
     let (global, caustic) = PhotonCpuSettings::default().estimate_params(scene);
     let schedules = Schedules::new([global.radius, caustic.radius, default_radius(scene)], DEFAULT_ALPHA);
@@ -25,7 +37,7 @@ fn gpu_progressive(scene: &Scene, photons: u64, checkpoints: &[u32], area_light_
         trace_photons(scene, &settings, &Silent)
     };
     let settings = GpuSettings { area_light_samples, ..GpuSettings::new(global, caustic) };
-    let mut gpu = GpuRenderer::new(ctx, scene, &trace(1), settings).expect("GPU renderer");
+    let mut gpu = GpuRenderer::with_features(ctx, scene, &trace(1), settings, features).expect("GPU renderer");
     let (width, height) = (scene.camera.width, scene.camera.height);
     let mut mean = ImageMean::new(width, height);
     let mut images = Vec::new();
@@ -144,4 +156,41 @@ fn sheen_box_on_the_gpu_under_a_quad_light() {
 #[test]
 fn sheen_box_on_the_gpu_under_a_point_light() {
     converges("sheen, point", sheen_box(glossy_lights::POINT, 32), 4);
+}
+
+/// Clear-coat, sheen and specular textures per point (the G-buffer's layer
+/// texels in the raster passes, the tracer's and the specular pass's hits):
+/// the layered quad (every factor times the grey checker; its base black,
+/// so that the layers are what it shows) seen at 45° under its white sky
+/// converges to the path tracer, and much closer than
+/// the same renderer drawing each texture as its mean (what an adapter
+/// without room for the fifth target does).
+#[test]
+fn layer_textures_on_the_gpu_converge_to_the_path_tracer() {
+    use glam::Vec3;
+    use hikari_core::test_scenes::gltf_textures::{layered_glb, load};
+    let mut scene = load("gpu-layers-converge", &layered_glb());
+    for material in &mut scene.materials {
+        if let hikari_core::material::Material::Pbr(bsdf) = material {
+            bsdf.base_color = Vec3::ZERO;
+        }
+    }
+    scene.camera =
+        hikari_core::camera::Camera::new(Vec3::new(0.5, -0.2, 0.7), Vec3::new(0.5, 0.5, 0.0), Vec3::Z, 35.0, 32, 32)
+            .unwrap();
+    let (reference, nonfinite) =
+        path::render(&scene, &path::PathSettings { spp: 2048, seed: 99, ..Default::default() }, &Silent);
+    assert_eq!(nonfinite, 0);
+    let own = SceneFeatures::of_scene(&scene);
+    assert!(own.layered);
+    let error = |features| {
+        let image = gpu_progressive_with(&scene, 5_000, &[16], 4, features).pop().unwrap();
+        compare(&image, &reference).unwrap()
+    };
+    let (per_point, means) = (error(own), error(SceneFeatures { layered: false, ..own }));
+    eprintln!("layered quad, 16 GPU passes against path: per point {per_point:?}; as means {means:?}");
+    assert!((per_point.mean_ratio - 1.0).abs() < 0.03, "mean ratio {}", per_point.mean_ratio);
+    // The 16×16 blocks' error: the pixels' own is mostly the passes' noise.
+    let blocks = |e: &hikari_core::progressive::ImageError| e.block_relative_to_mean.unwrap();
+    assert!(blocks(&per_point) < 0.6 * blocks(&means), "per point {per_point:?}, means {means:?}");
 }

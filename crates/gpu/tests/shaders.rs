@@ -118,7 +118,7 @@ fn shared_structs_match_wgsl_layouts() {
             sheen_color,
             transmission_ior,
             specular_color,
-            _pad3
+            layer_textures
         ]
     );
     let splat = hikari_gpu::splat::shader_source();

@@ -346,6 +346,74 @@ fn metallic_roughness_textures_reach_the_gbuffer() {
     assert!(checked > 500, "{checked} pixels see the quad");
 }
 
+/// Clear-coat, sheen and specular textures on the GPU: at every pixel the
+/// G-buffer's fifth target holds the texels the CPU multiplies each factor
+/// by where its ray hits (`Scene::material_at`), within the packing's
+/// half step (16 bits a factor, 10 a colour channel); they are the
+/// checker's, not its mean, over much of the quad.
+#[test]
+fn layer_textures_reach_the_gbuffer() {
+    use glam::Vec3;
+    use hikari_core::material::Material;
+    use hikari_core::photon::{TraceSettings, trace_photons};
+    use hikari_core::progress::Silent;
+    use hikari_core::render::photon_cpu::PhotonCpuSettings;
+    use hikari_core::test_scenes::gltf_textures::{LAYER_FACTORS, layered_glb, load};
+    use hikari_gpu::gbuffer::layer_texels::LayerTexels;
+    let mut scene = load("gpu-layers-gbuffer", &layered_glb());
+    let size = 32;
+    scene.camera =
+        hikari_core::camera::Camera::new(Vec3::new(0.5, 0.5, 2.0), Vec3::new(0.5, 0.5, 0.0), Vec3::Y, 20.0, size, size)
+            .unwrap();
+    let ctx = test_context("layer_textures_reach_the_gbuffer");
+    assert!(ctx.layer_texels, "{}: lavapipe and llvmpipe keep the layer texels", ctx.describe());
+    let traced = trace_photons(&scene, &TraceSettings { photons: 1_000, ..Default::default() }, &Silent);
+    let (global, caustic) = PhotonCpuSettings::default().estimate_params(&scene);
+    let gpu = hikari_gpu::GpuRenderer::new(ctx, &scene, &traced, hikari_gpu::GpuSettings::new(global, caustic))
+        .expect("GPU renderer");
+    gpu.render().unwrap();
+    let words = hikari_gpu::readback::read_rgba32uint(&gpu.ctx, &gpu.targets.gbuffer.layers).unwrap();
+    let (coat, coat_roughness, sheen, sheen_roughness, specular, specular_color) = LAYER_FACTORS;
+    let (sheen, specular_color) = (Vec3::from(sheen), Vec3::from(specular_color));
+    let texturing = scene.texturing.as_ref().unwrap();
+    let mut checked = 0;
+    let mut off_the_mean = 0;
+    for y in 0..size {
+        for x in 0..size {
+            let ray = scene.camera.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let Some(hit) = scene.accel.intersect(&ray) else { continue };
+            let Material::Pbr(want) = *scene.material_at(&hit) else { panic!("a glossy quad") };
+            let t = LayerTexels::unpack(words[(y * size + x) as usize]);
+            let factor_step = 0.5 / 65535.0 + 2e-6;
+            let colour_step = 0.5 / 1023.0 + 2e-6;
+            let scalars = [
+                ("clear coat", coat * t.clearcoat, want.clearcoat),
+                ("its roughness", coat_roughness * t.clearcoat_roughness, want.clearcoat_roughness),
+                ("sheen roughness", sheen_roughness * t.sheen_roughness, want.sheen_roughness),
+                ("specular", specular * t.specular, want.specular),
+            ];
+            for (what, got, want) in scalars {
+                assert!((got - want).abs() <= factor_step, "({x}, {y}): {what} {got} vs {want}");
+            }
+            let colours = [
+                ("sheen", sheen * t.sheen_color, want.sheen_color),
+                ("specular colour", specular_color * t.specular_color, want.specular_color),
+            ];
+            for (what, got, want) in colours {
+                assert!((got - want).abs().max_element() <= colour_step, "({x}, {y}): {what} {got} vs {want}");
+            }
+            let material = scene.surfaces[hit.surface as usize].material;
+            let Material::Pbr(mean) = texturing.with_layer_means(scene.materials[material as usize], material) else {
+                panic!()
+            };
+            off_the_mean += ((want.clearcoat - mean.clearcoat).abs() > 0.05) as usize;
+            checked += 1;
+        }
+    }
+    assert!(checked > 500, "{checked} pixels see the quad");
+    assert!(off_the_mean > checked / 2, "{off_the_mean} of {checked} pixels away from the texture's mean");
+}
+
 /// A normal texture on the GPU: the G-buffer's normal is the CPU's bent
 /// normal (`Scene::shading_normal_at`, turned toward the eye) at every
 /// pixel. The quad is a tilted parallelogram whose coordinates run askew,

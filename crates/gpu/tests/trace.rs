@@ -330,6 +330,7 @@ fn scenes() -> Vec<(&'static str, Scene)> {
         ("rough tinted glass", rough_caustic("")),
         ("normal map before a mirror", gltf_textures::normal_map_before_a_mirror("trace-normal-map", 16)),
         ("normal-mapped floors", gltf_textures::normal_mapped_floors("trace-normal-floors", 16)),
+        ("layered floor", gltf_textures::layered_floor("trace-layered-floor", 16)),
     ]
 }
 

@@ -14,6 +14,8 @@ use hikari_core::progressive::{DEFAULT_ALPHA, Schedules, pass_seed};
 use hikari_core::render::photon_cpu::{PhotonCpuRenderer, PhotonCpuSettings};
 use hikari_core::scene::Scene;
 use hikari_gpu::gbuffer::geometric_normal::{pixel_kind, pixel_smooth_normal, unpack_geometric_normal};
+use hikari_gpu::gbuffer::layer_texels::LayerTexels;
+use hikari_gpu::readback::read_rgba32uint;
 use hikari_gpu::test_support::test_context;
 use hikari_gpu::tiled::Estimator;
 use hikari_gpu::{GpuRenderer, GpuSettings};
@@ -85,6 +87,11 @@ fn twin_pass(
     let normal = gpu.read(&t.gbuffer.normal).unwrap();
     let albedo = gpu.read(&t.gbuffer.albedo).unwrap();
     let indirect = gpu.read(&t.indirect).unwrap();
+    // Where clear-coat, sheen or specular textures vary the material, the
+    // pixel's texels as the G-buffer keeps them (layer_textures_reach_the_gbuffer
+    // pins those to the CPU's): the gathers must weigh by that material.
+    let layered = scene.texturing.as_ref().is_some_and(|t| t.materials.iter().flatten().any(|m| m.layers.any()));
+    let layers = layered.then(|| read_rgba32uint(&gpu.ctx, &t.gbuffer.layers).unwrap());
     let caustic = gpu.read(&t.caustic).unwrap();
 
     let compare = |gpu_image: &[glam::Vec4], map, params: &FixedRadius| {
@@ -107,7 +114,15 @@ fn twin_pass(
             let bump = pixel_smooth_normal(albedo[i].w).and_then(|unbent| BumpShadow::new(unbent, n));
             // The glTF BRDF weights each photon by f at its own direction
             // (the lobes the maps stand for); Lambertian surfaces by ρ/π.
-            let material = scene.materials[scene.surfaces[normal[i].w as usize].material as usize];
+            let index = scene.surfaces[normal[i].w as usize].material;
+            let material = match (scene.materials[index as usize], &layers) {
+                (Material::Pbr(bsdf), Some(words))
+                    if scene.texturing.as_ref().unwrap().materials[index as usize].is_some_and(|t| t.layers.any()) =>
+                {
+                    Material::Pbr(LayerTexels::unpack(words[i]).apply(bsdf))
+                }
+                (material, _) => material,
+            };
             let frame = ShadingFrame::new(n);
             let estimate = |bump: Option<BumpShadow>| {
                 let k = |wi: Vec3| bump.map_or(1.0, |b| b.term(wi));
@@ -292,6 +307,19 @@ fn gpu_glossy_estimates_equal_cpu_estimates() {
     }
 }
 
+/// Clear-coat, sheen and specular textures: the splat and the tiled
+/// estimator weigh each photon by the material the pixel's layer texels
+/// make (the G-buffer's fifth target), as photon-cpu's gathers do with it.
+#[test]
+fn gpu_estimates_on_layer_textures_equal_cpu_estimates() {
+    use hikari_core::test_scenes::gltf_textures::layered_floor;
+    for (estimator, normal_test) in [(Estimator::Raster, false), (Estimator::Tiled, true)] {
+        let scene = layered_floor("twin-layered-floor", 64);
+        let (indirect, _) = twin_scene(scene, 20_000, normal_test, estimator).expect("a twin");
+        assert_twin(&format!("layered floor ({estimator:?}) indirect"), &indirect, 1500);
+    }
+}
+
 /// estimate.wgsl's `shading_normal_factor` against the CPU's, on random
 /// directions and normals bent up to 60° (the cap and the zeros included).
 #[test]
@@ -401,4 +429,56 @@ fn wgsl_kind_packing_matches_the_cpu() {
         let got = Vec3::new(f32::from_bits(out[7]), 0.0, f32::from_bits(out[8]));
         assert!((got - Vec3::new(back.x, 0.0, back.z)).abs().max_element() < 1e-6, "{n}: {got} vs {back}");
     }
+}
+
+/// layer_texels.wgsl's packing of the G-buffer's fifth target against its
+/// Rust twin: the same four words (a field may differ by one step where
+/// the two round a tie apart), and the same texels read back.
+#[test]
+fn wgsl_layer_texel_packing_matches_the_cpu() {
+    use hikari_core::sampling::Rng;
+    use hikari_gpu::gbuffer::layer_texels::{LAYER_TEXELS, LayerTexels};
+    let ctx = test_context("wgsl_layer_texel_packing_matches_the_cpu");
+    let mut rng = Rng::for_item(37, 0);
+    let mut cases = Vec::new();
+    let mut input = vec![0u32; 4096 * 24];
+    for item in input.chunks_mut(24) {
+        let t = LayerTexels::from_array(std::array::from_fn(|_| rng.next_f32()));
+        for (slot, v) in item.iter_mut().zip(t.to_array()) {
+            *slot = v.to_bits();
+        }
+        cases.push(t);
+    }
+    let main = "let o = 24u * id.x; if (o >= arrayLength(&io)) { return; }\n\
+                var v: array<f32, 10>;\n\
+                for (var i = 0u; i < 10u; i++) { v[i] = bitcast<f32>(io[o + i]); }\n\
+                let t = LayerTexels(v[0], v[1], v[2], v[3], vec3<f32>(v[4], v[5], v[6]), vec3<f32>(v[7], v[8], v[9]));\n\
+                let words = pack_layer_texels(t);\n\
+                for (var i = 0u; i < 4u; i++) { io[o + 10u + i] = words[i]; }\n\
+                let b = unpack_layer_texels(words);\n\
+                let back = array<f32, 10>(b.clearcoat, b.clearcoat_roughness, b.sheen_roughness, b.specular,\n\
+                    b.sheen_color.x, b.sheen_color.y, b.sheen_color.z, b.specular_color.x, b.specular_color.y,\n\
+                    b.specular_color.z);\n\
+                for (var i = 0u; i < 10u; i++) { io[o + 14u + i] = bitcast<u32>(back[i]); }";
+    let gpu = hikari_gpu::test_support::run_kernel(&ctx, &[&LAYER_TEXELS], main, &input);
+    let fields = |w: [u32; 4]| {
+        [w[0] & 0xffff, w[0] >> 16, w[1] & 0xffff, w[1] >> 16]
+            .into_iter()
+            .chain([w[2], w[3]].into_iter().flat_map(|c| [c & 1023, c >> 10 & 1023, c >> 20 & 1023]))
+            .collect::<Vec<u32>>()
+    };
+    let mut exact = 0;
+    for (out, t) in gpu.chunks(24).zip(&cases) {
+        let words = [out[10], out[11], out[12], out[13]];
+        let want = t.pack();
+        exact += (words == want) as usize;
+        for (got, want) in fields(words).into_iter().zip(fields(want)) {
+            assert!(got.abs_diff(want) <= 1, "{t:?}: field {got} vs {want}");
+        }
+        for (k, want) in LayerTexels::unpack(words).to_array().into_iter().enumerate() {
+            let got = f32::from_bits(out[14 + k]);
+            assert!((got - want).abs() <= 1e-6, "{t:?}: texel {k} read back {got} vs {want}");
+        }
+    }
+    assert!(exact >= cases.len() * 99 / 100, "{exact} of {} packed alike", cases.len());
 }

@@ -355,6 +355,9 @@ impl Viewer {
         self.clock.tick(Instant::now());
         let first = self.start_tracing()?;
         eprintln!("view: {} on {}", self.args.scene, ctx.describe());
+        for note in hikari_gpu::renderer::adapter_notes(&ctx, &self.base) {
+            eprintln!("view: {note}");
+        }
         let present = PresentPass::new(&ctx.device, format);
         let panel = Panel::new(&window, &ctx.device, format);
         self.readouts.adapter = ctx.describe();

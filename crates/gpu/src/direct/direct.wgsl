@@ -13,6 +13,8 @@
 @group(0) @binding(9) var<storage, read> regions: array<RegionTriangle>;
 @group(0) @binding(10) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(11) var gbuffer_emission: texture_2d<f32>;
+// The layer textures' texels (read where LAYERED; layer_texels.wgsl).
+@group(0) @binding(12) var gbuffer_layers: texture_2d<u32>;
 
 
 
@@ -29,7 +31,10 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let x = position.xyz;
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let n = g.xyz;
-    let s = surfaces.all[u32(g.w)];
+    var s = surfaces.all[u32(g.w)];
+    if (LAYERED) {
+        s = pixel_surface(s, textureLoad(gbuffer_layers, pixel, 0));
+    }
     let b = pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     var r = surface_reflector(s, b, unit(media.camera_position - x), n);
     if (BENT && position.w < 0.0) {

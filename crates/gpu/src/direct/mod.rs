@@ -45,6 +45,7 @@ pub fn shader_source() -> String {
         &LIGHT_EVAL,
         &LIGHT_ARRAYS,
         &crate::gbuffer::geometric_normal::GEOMETRIC_NORMAL,
+        &crate::gbuffer::layer_texels::LAYER_TEXELS,
         &DIRECT,
     ])
 }
@@ -133,6 +134,7 @@ impl DirectPass {
                 entry(9, storage(true)),
                 entry(10, storage(true)),
                 entry(11, texture(D2)),
+                entry(12, crate::binding::texture_uint()),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "direct", &layout);
@@ -186,7 +188,7 @@ impl DirectPass {
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
-        let emission = view(&gbuffer.emission);
+        let (emission, layers) = (view(&gbuffer.emission), view(&gbuffer.layers));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("direct"),
             layout: &self.layout,
@@ -203,6 +205,7 @@ impl DirectPass {
                 wgpu::BindGroupEntry { binding: 9, resource: media.regions.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 10, resource: surfaces.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 11, resource: wgpu::BindingResource::TextureView(&emission) },
+                wgpu::BindGroupEntry { binding: 12, resource: wgpu::BindingResource::TextureView(&layers) },
             ],
         });
         DirectBinding { bind_group, uniforms, params, samples: samples_buffer }

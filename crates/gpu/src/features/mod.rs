@@ -27,6 +27,10 @@ pub struct SceneFeatures {
     pub media: bool,
     pub bent: bool,
     pub mixed: bool,
+    /// Some surface reads clear-coat, sheen or specular textures per point
+    /// (`GpuSurface::layer_textures`), which the G-buffer keeps in a fifth
+    /// target (`GBuffer::layers`).
+    pub layered: bool,
 }
 
 impl SceneFeatures {
@@ -42,6 +46,7 @@ impl SceneFeatures {
         media: false,
         bent: false,
         mixed: false,
+        layered: false,
     };
     pub const ALL: SceneFeatures = SceneFeatures {
         textured: true,
@@ -54,6 +59,7 @@ impl SceneFeatures {
         media: true,
         bent: true,
         mixed: true,
+        layered: true,
     };
 
     /// What `surfaces` (scene_upload::scene_surfaces) and `lights` use, in
@@ -71,6 +77,7 @@ impl SceneFeatures {
                 ]
                 .iter()
                 .any(|&t| t != NO_TEXTURE)
+                    || s.layer_textures != NO_TEXTURE
             }),
             cut_outs: surfaces.iter().any(|s| s.alpha_cutoff >= 0.0),
             glossy: surfaces.iter().any(|s| s.glossy != 0),
@@ -81,6 +88,7 @@ impl SceneFeatures {
             media,
             bent: bent_geometry || surfaces.iter().any(|s| s.kind == kind::DIFFUSE && s.normal_texture != NO_TEXTURE),
             mixed: surfaces.iter().any(|s| s.transmission > 0.0),
+            layered: surfaces.iter().any(|s| s.layer_textures != NO_TEXTURE),
         }
     }
 
@@ -97,12 +105,14 @@ impl SceneFeatures {
             media: self.media || other.media,
             bent: self.bent || other.bent,
             mixed: self.mixed || other.mixed,
+            layered: self.layered || other.layered,
         }
     }
 
-    /// What `scene`'s surfaces and lights use.
+    /// What `scene`'s surfaces and lights use, its layer textures read per
+    /// point.
     pub fn of_scene(scene: &hikari_core::scene::Scene) -> Self {
-        let surfaces = crate::scene_upload::scene_surfaces(scene);
+        let surfaces = crate::scene_upload::scene_surfaces(scene, true);
         let bent = bent_geometry(scene, &surfaces);
         Self::of(&surfaces, &scene.lights, !scene.media.is_empty(), bent)
     }
@@ -122,6 +132,7 @@ impl SceneFeatures {
             ("MEDIA", self.media),
             ("BENT", self.bent),
             ("MIXED", self.mixed),
+            ("LAYERED", self.layered),
         ]
         .into_iter()
         .filter(|(name, _)| source.contains(&format!("override {name}: bool")))
@@ -164,6 +175,7 @@ mod tests {
             ("MEDIA", 1.0),
             ("BENT", 1.0),
             ("MIXED", 1.0),
+            ("LAYERED", 1.0),
         ];
         assert_eq!(constants, expected);
         assert!(features.constants("fn main() {}").is_empty());
@@ -188,5 +200,9 @@ mod tests {
         use hikari_core::test_scenes::{gltf_textures, smooth_wavy_grid_glb, wavy_grid_glb};
         assert!(SceneFeatures::of_scene(&gltf_textures::load("features-smooth", &smooth_wavy_grid_glb(200))).bent);
         assert!(!SceneFeatures::of_scene(&gltf_textures::load("features-flat", &wavy_grid_glb(200))).bent);
+        // Layer textures make a scene layered and textured.
+        let layered = SceneFeatures::of_scene(&gltf_textures::load("features-layered", &gltf_textures::layered_glb()));
+        assert!(layered.layered && layered.textured && layered.coated && layered.sheened, "{layered:?}");
+        assert!(!showcase.layered);
     }
 }

@@ -77,7 +77,29 @@ struct GBufferOut {
 
 @fragment
 fn fs_main(in: VertexOut) -> GBufferOut {
-    return shade(in);
+    return shade(in).g;
+}
+
+// LAYERED scenes' G-buffer: the four targets and the layer textures'
+// texels (layer_texels.wgsl) in a fifth.
+struct LayeredOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+    @location(3) emission: vec4<f32>,
+    @location(4) layers: vec4<u32>,
+}
+
+@fragment
+fn fs_main_layered(in: VertexOut) -> LayeredOut {
+    let s = shade(in);
+    return LayeredOut(s.g.position, s.g.normal, s.g.albedo, s.g.emission, s.layers);
+}
+
+// What `shade` stores: the four targets, and where LAYERED the fifth.
+struct Shaded {
+    g: GBufferOut,
+    layers: vec4<u32>,
 }
 
 // The surface at the fragment, textures applied; its footprint's change of
@@ -91,7 +113,7 @@ fn fragment_point(in: VertexOut) -> SurfacePoint {
 
 // What a pixel stores (fs_main's outputs; gbuffer_storage.wgsl stores the
 // same); a cut-out's fragment is discarded.
-fn shade(in: VertexOut) -> GBufferOut {
+fn shade(in: VertexOut) -> Shaded {
     // Derivatives in uniform control flow (the normal texture's frame),
     // taken only by pipelines of textured scenes.
     var px = vec3<f32>(0.0);
@@ -145,7 +167,13 @@ fn shade(in: VertexOut) -> GBufferOut {
     out.albedo = vec4<f32>(point.base, pack_kind(kind, shading * side, bumped));
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);
     out.emission = vec4<f32>(emitted, pack_metal_rough(point.metallic, point.roughness));
-    return out;
+    // The layer textures at the pixel's footprint, as the raster passes
+    // multiply the surface's factors by them.
+    var layers = vec4<u32>(0u);
+    if (LAYERED) {
+        layers = pack_layer_texels(layer_texels(surface, uv, dx, dy));
+    }
+    return Shaded(out, layers);
 }
 
 // The depth-only draw of the storage path: cut-outs leave no depth, and

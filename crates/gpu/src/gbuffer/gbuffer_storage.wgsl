@@ -9,13 +9,29 @@
 @group(0) @binding(5) var out_albedo: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(6) var out_emission: texture_storage_2d<rgba32float, write>;
 
+// LAYERED scenes' fifth target (gbuffer.wgsl's `fs_main_layered`), bound
+// only for `fs_storage_layered`.
+@group(0) @binding(7) var out_layers: texture_storage_2d<rgba32uint, write>;
+
+fn store_pixel(in: VertexOut) -> Shaded {
+    let s = shade(in);
+    let pixel = vec2<i32>(in.clip.xy);
+    textureStore(out_position, pixel, s.g.position);
+    textureStore(out_normal, pixel, s.g.normal);
+    textureStore(out_albedo, pixel, s.g.albedo);
+    textureStore(out_emission, pixel, s.g.emission);
+    return s;
+}
+
 @fragment
 @early_depth_test(force)
 fn fs_storage(in: VertexOut) {
-    let g = shade(in);
-    let pixel = vec2<i32>(in.clip.xy);
-    textureStore(out_position, pixel, g.position);
-    textureStore(out_normal, pixel, g.normal);
-    textureStore(out_albedo, pixel, g.albedo);
-    textureStore(out_emission, pixel, g.emission);
+    store_pixel(in);
+}
+
+@fragment
+@early_depth_test(force)
+fn fs_storage_layered(in: VertexOut) {
+    let s = store_pixel(in);
+    textureStore(out_layers, vec2<i32>(in.clip.xy), s.layers);
 }

@@ -2,6 +2,7 @@
 //! later passes shade (METHOD.md §4, step 1).
 
 pub mod geometric_normal;
+pub mod layer_texels;
 
 use crate::scene_upload::{GpuVertex, SceneBuffers};
 use bytemuck::{Pod, Zeroable};
@@ -24,7 +25,12 @@ pub fn shader_source() -> String {
     static GBUFFER: Module = Module {
         name: "gbuffer.wgsl",
         source: include_str!("gbuffer.wgsl"),
-        requires: &[&SURFACE, &crate::textures::SURFACE_POINT, &geometric_normal::GEOMETRIC_NORMAL],
+        requires: &[
+            &SURFACE,
+            &crate::textures::SURFACE_POINT,
+            &geometric_normal::GEOMETRIC_NORMAL,
+            &layer_texels::LAYER_TEXELS,
+        ],
     };
     compose(&[&GBUFFER])
 }
@@ -53,27 +59,33 @@ pub struct GBuffer {
     pub normal: wgpu::Texture,
     pub albedo: wgpu::Texture,
     pub emission: wgpu::Texture,
+    /// The layer textures' texels (`layer_texels`), where the scene is
+    /// LAYERED; else one texel, which the passes bind and never read.
+    pub layers: wgpu::Texture,
     pub depth: wgpu::Texture,
 }
 
 impl GBuffer {
     /// With `storage`, the targets are written as storage textures
-    /// (`GBufferPass` on adapters that cannot render to Rgba32Float).
-    pub fn new(device: &wgpu::Device, width: u32, height: u32, storage: bool) -> Self {
+    /// (`GBufferPass` on adapters that cannot render to Rgba32Float); with
+    /// `layered`, the fifth target is the image's size.
+    pub fn new(device: &wgpu::Device, width: u32, height: u32, storage: bool, layered: bool) -> Self {
         let written_as =
             if storage { wgpu::TextureUsages::STORAGE_BINDING } else { wgpu::TextureUsages::RENDER_ATTACHMENT };
-        let target = |label| {
+        let texture = |label, format, (width, height)| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: TARGET_FORMAT,
+                format,
                 usage: written_as | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC,
                 view_formats: &[],
             })
         };
+        let target = |label| texture(label, TARGET_FORMAT, (width, height));
+        let layers_size = if layered { (width, height) } else { (1, 1) };
         let depth = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("gbuffer depth"),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
@@ -91,6 +103,7 @@ impl GBuffer {
             normal: target("gbuffer normal"),
             albedo: target("gbuffer albedo"),
             emission: target("gbuffer emission"),
+            layers: texture("gbuffer layers", layer_texels::LAYERS_FORMAT, layers_size),
             depth,
         }
     }
@@ -106,11 +119,13 @@ pub struct GBufferBinding {
 pub struct GBufferPass {
     layout: wgpu::BindGroupLayout,
     mode: Mode,
+    /// The fifth target is written (`SceneFeatures::layered`).
+    layered: bool,
 }
 
 /// How the G-buffer is written.
 enum Mode {
-    /// Four Rgba32Float colour targets.
+    /// Four Rgba32Float colour targets (and the layers' Rgba32Uint).
     Targets(wgpu::RenderPipeline),
     /// A depth-only draw, then a draw whose nearest fragments store into
     /// storage textures (gbuffer_storage.wgsl).
@@ -132,10 +147,19 @@ impl GBufferPass {
             crate::binding::entry(1, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
             crate::binding::entry(2, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
         ];
+        let layered = features.layered;
         if storage {
             entries.extend((3..7).map(|b| {
                 crate::binding::entry(b, wgpu::ShaderStages::FRAGMENT, crate::binding::storage_texture_rgba32f())
             }));
+            if layered {
+                let ty = wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: layer_texels::LAYERS_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                };
+                entries.push(crate::binding::entry(7, wgpu::ShaderStages::FRAGMENT, ty));
+            }
         }
         let layout = device
             .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("gbuffer"), entries: &entries });
@@ -177,17 +201,22 @@ impl GBufferPass {
                 depth_compare: Some(wgpu::CompareFunction::Equal),
                 ..nearest.clone()
             };
+            let store = if layered { "fs_storage_layered" } else { "fs_storage" };
             Mode::Storage {
                 depth: pipeline("gbuffer depth", Some(("fs_depth", &[])), nearest),
-                store: pipeline("gbuffer store", Some(("fs_storage", &[])), equal),
+                store: pipeline("gbuffer store", Some((store, &[])), equal),
             }
         } else {
             let target =
-                Some(wgpu::ColorTargetState { format: TARGET_FORMAT, blend: None, write_mask: wgpu::ColorWrites::ALL });
-            let targets = [target.clone(), target.clone(), target.clone(), target];
-            Mode::Targets(pipeline("gbuffer", Some(("fs_main", &targets)), nearest))
+                |format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL });
+            let mut targets = vec![target(TARGET_FORMAT); 4];
+            if layered {
+                targets.push(target(layer_texels::LAYERS_FORMAT));
+            }
+            let entry = if layered { "fs_main_layered" } else { "fs_main" };
+            Mode::Targets(pipeline("gbuffer", Some((entry, &targets)), nearest))
         };
-        GBufferPass { layout, mode }
+        GBufferPass { layout, mode, layered }
     }
 
     /// The uniforms and bind group of frames into `gbuffer`, made once.
@@ -198,10 +227,11 @@ impl GBufferPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let views: Vec<wgpu::TextureView> = [&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission]
-            .iter()
-            .map(|t| t.create_view(&Default::default()))
-            .collect();
+        let mut targets = vec![&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission];
+        if self.layered {
+            targets.push(&gbuffer.layers);
+        }
+        let views: Vec<wgpu::TextureView> = targets.iter().map(|t| t.create_view(&Default::default())).collect();
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: scene.surfaces.as_entire_binding() },
@@ -274,7 +304,11 @@ impl GBufferPass {
                 draw(encoder, pipeline, &attachments, wgpu::LoadOp::Clear(1.0));
             }
             Mode::Storage { depth, store } => {
-                for texture in [&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission] {
+                let mut targets = vec![&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission];
+                if self.layered {
+                    targets.push(&gbuffer.layers);
+                }
+                for texture in targets {
                     encoder.clear_texture(texture, &Default::default());
                 }
                 draw(encoder, depth, &[], wgpu::LoadOp::Clear(1.0));

@@ -324,11 +324,13 @@ fn follows_lobe(s: Surface, b: Bsdf) -> bool {
 }
 
 // Whether surface `s` may follow its lobe somewhere: smooth enough, or
-// made so by a metallic–roughness texture.
+// made so by a metallic–roughness texture, or a coat made so by its
+// roughness texture (the layer textures only lower the factors).
 fn may_follow_lobe(s: Surface) -> bool {
+    let coat_may_be_smooth = s.clearcoat_roughness < GATHER_ROUGHNESS || (LAYERED && s.layer_textures != NO_TEXTURE);
     return GLOSSY && s.kind == 0u && s.glossy != 0u
         && (s.roughness < GATHER_ROUGHNESS || s.metallic_roughness_texture != NO_TEXTURE
-            || (COATED && s.clearcoat > 0.0 && s.clearcoat_roughness < GATHER_ROUGHNESS));
+            || (COATED && s.clearcoat > 0.0 && coat_may_be_smooth));
 }
 
 // Point, spot and sun light reaching rough glass `g` at x from either side
@@ -438,6 +440,9 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         // The surface here with its textures (level 0, as the CPU reads).
         let uv = primitive_uv(hit.prim, hit.b);
         var point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
+        if (LAYERED) {
+            s = with_layer_texels(s, layer_texels(s, uv, vec2<f32>(0.0), vec2<f32>(0.0)));
+        }
         let front = dot(b.dir, ng) < 0.0;
         // Glass mixed into the material: the eye's first hit is what the
         // G-buffer's pixel drew, the others draw per hit as the CPU

@@ -35,7 +35,7 @@ pub fn shader_source() -> String {
     use crate::wgsl::{ESTIMATE, Module, compose};
     static SPLAT: Module =
         Module { name: "splat.wgsl", source: include_str!("splat.wgsl"), requires: &[&depth_tiles::TILE_CONSTANTS] };
-    compose(&[&ESTIMATE, &crate::wgsl::PHOTON_BRDF, &FOOTPRINT, &SPLAT])
+    compose(&[&ESTIMATE, &crate::wgsl::PHOTON_BRDF, &crate::gbuffer::layer_texels::LAYER_TEXELS, &FOOTPRINT, &SPLAT])
 }
 
 /// A render pipeline (`vs_main`, `fs_main`) that adds its fragments into a
@@ -126,6 +126,7 @@ impl SplatPass {
                 entry(4, wgpu::ShaderStages::FRAGMENT, crate::binding::storage(true)),
                 entry(5, wgpu::ShaderStages::FRAGMENT, texture(D2)),
                 entry(6, wgpu::ShaderStages::VERTEX, texture(D2)),
+                entry(7, wgpu::ShaderStages::FRAGMENT, crate::binding::texture_uint()),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "splat", &layout);
@@ -168,7 +169,7 @@ impl SplatPass {
         });
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo) = (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo));
-        let emission = view(&gbuffer.emission);
+        let (emission, layers) = (view(&gbuffer.emission), view(&gbuffer.layers));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("splat"),
             layout: &self.layout,
@@ -180,6 +181,7 @@ impl SplatPass {
                 wgpu::BindGroupEntry { binding: 4, resource: surfaces.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&emission) },
                 wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(&view(depth_tiles)) },
+                wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&layers) },
             ],
         });
         SplatBinding { uniforms, bind_group, depth: view(&gbuffer.depth) }

@@ -21,6 +21,8 @@ struct SplatParams {
 @group(0) @binding(3) var gbuffer_albedo: texture_2d<f32>;
 @group(0) @binding(4) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(5) var gbuffer_emission: texture_2d<f32>;
+// The layer textures' texels (read where LAYERED; layer_texels.wgsl).
+@group(0) @binding(7) var gbuffer_layers: texture_2d<u32>;
 
 // Tiles of the G-buffer's depth range (depth_tiles.rs), read by the
 // vertex shader.
@@ -98,8 +100,11 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
         }
     }
     var weight = radiance_per_power(albedo.rgb, params.radius) * k;
-    let surface = surfaces.all[u32(g.w)];
+    var surface = surfaces.all[u32(g.w)];
     if (GLOSSY && surface.glossy != 0u) {
+        if (LAYERED) {
+            surface = pixel_surface(surface, textureLoad(gbuffer_layers, pixel, 0));
+        }
         let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
         let eye = unit(params.camera_position - position.xyz);
         weight = photon_brdf(b, eye, normal, direction, k) * radiance_per_weighted_power(params.radius);

@@ -23,6 +23,11 @@
 //!   sRGB-encoded, bit 1: transformed), the transform's six f32 (its columns: x axis, y axis,
 //!   translation), then the word offset of each level (a view shares its
 //!   image's levels).
+//! * per material with clear-coat, sheen or specular textures
+//!   (`LayerTextures`), in material order, six words: those textures' view
+//!   references (`texture_ref`; `NO_TEXTURE` for none) in `LayerTextures::all`'s
+//!   order; `GpuSurface::layer_textures` holds where its six start
+//!   (`TextureViews::layer_table`).
 //! * the levels' texels, row by row from the top, `pack4x8unorm` order
 //!   (r in the low byte).
 //! * per BVH primitive (`FlatBvh::prims` order), its three vertices' (u, v)
@@ -45,7 +50,13 @@ pub static TEXTURES: crate::wgsl::Module =
 pub static SURFACE_POINT: crate::wgsl::Module = crate::wgsl::Module {
     name: "surface_point.wgsl",
     source: include_str!("surface_point.wgsl"),
-    requires: &[&TEXTURES, &crate::wgsl::SURFACE, &crate::wgsl::BSDF, &crate::wgsl::RANDOM],
+    requires: &[
+        &TEXTURES,
+        &crate::wgsl::SURFACE,
+        &crate::wgsl::BSDF,
+        &crate::wgsl::RANDOM,
+        &crate::gbuffer::layer_texels::LAYER_TEXELS,
+    ],
 };
 
 /// A surface without this texture (`GpuSurface`'s texture fields).
@@ -78,14 +89,30 @@ pub fn texture_ref(view: u32, sampler: Sampler) -> u32 {
 pub struct TextureViews {
     images: u32,
     transformed: Vec<(u32, glam::Affine2)>,
+    /// Per material, the index of its layer-texture table (`layer_table`)
+    /// among the materials that have one.
+    layer_tables: Vec<Option<u32>>,
 }
+
+/// Words of one material's layer-texture table: `LayerTextures::all`.
+pub const LAYER_TABLE_WORDS: usize = 6;
 
 impl TextureViews {
     pub fn of(texturing: &Texturing) -> TextureViews {
-        let mut views = TextureViews { images: texturing.images.len() as u32, transformed: Vec::new() };
+        let mut views =
+            TextureViews { images: texturing.images.len() as u32, transformed: Vec::new(), layer_tables: Vec::new() };
+        let mut tables = 0;
+        for m in &texturing.materials {
+            let table = m.is_some_and(|m| m.layers.any()).then(|| {
+                tables += 1;
+                tables - 1
+            });
+            views.layer_tables.push(table);
+        }
         for m in texturing.materials.iter().flatten() {
             let transmission = m.transmission.and_then(|t| t.texture);
-            for t in [m.base_color, m.metallic_roughness, m.emissive, m.normal, transmission].into_iter().flatten() {
+            let own = [m.base_color, m.metallic_roughness, m.emissive, m.normal, transmission];
+            for t in own.into_iter().chain(m.layers.all()).flatten() {
                 if t.transform != glam::Affine2::IDENTITY && !views.transformed.contains(&(t.image, t.transform)) {
                     views.transformed.push((t.image, t.transform));
                 }
@@ -96,6 +123,21 @@ impl TextureViews {
 
     fn count(&self) -> usize {
         self.images as usize + self.transformed.len()
+    }
+
+    /// Words of the layer-texture tables after the views' headers.
+    fn layer_words(&self) -> usize {
+        LAYER_TABLE_WORDS * self.layer_tables.iter().flatten().count()
+    }
+
+    /// Where material `material`'s layer-texture table starts in the
+    /// packed words (`GpuSurface::layer_textures`); `NO_TEXTURE` where it
+    /// has no clear-coat, sheen or specular texture.
+    pub fn layer_table(&self, material: u32) -> u32 {
+        match self.layer_tables.get(material as usize).copied().flatten() {
+            Some(k) => (HEADER_WORDS + VIEW_WORDS * self.count() + LAYER_TABLE_WORDS * k as usize) as u32,
+            None => NO_TEXTURE,
+        }
     }
 
     /// Each view's image and transform.
@@ -118,11 +160,12 @@ impl TextureViews {
 }
 
 /// How each image is encoded: sRGB where some material reads it as colour
-/// (base colour, emission), linear where it holds data (metallic–roughness).
+/// (base colour, emission, the sheen's and the specular's colour), linear
+/// where it holds data (metallic–roughness, the layers' factors).
 fn color_spaces(texturing: &Texturing) -> Vec<ColorSpace> {
     let mut spaces = vec![ColorSpace::Linear; texturing.images.len()];
     for m in texturing.materials.iter().flatten() {
-        for t in [m.base_color, m.emissive].into_iter().flatten() {
+        for t in [m.base_color, m.emissive, m.layers.sheen_color, m.layers.specular_color].into_iter().flatten() {
             spaces[t.image as usize] = ColorSpace::Srgb;
         }
     }
@@ -214,8 +257,16 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
     let spaces = color_spaces(texturing);
     let images = &texturing.images;
     let views = TextureViews::of(texturing);
-    let mut words = vec![0u32; HEADER_WORDS + VIEW_WORDS * views.count()];
+    let mut words = vec![0u32; HEADER_WORDS + VIEW_WORDS * views.count() + views.layer_words()];
     words[0] = views.count() as u32;
+    for (material, m) in texturing.materials.iter().enumerate() {
+        let (Some(m), table) = (m, views.layer_table(material as u32)) else { continue };
+        if table != NO_TEXTURE {
+            for (k, t) in m.layers.all().into_iter().enumerate() {
+                words[table as usize + k] = views.reference(t);
+            }
+        }
+    }
     // The images' levels, and where each starts.
     let mut level_offsets = Vec::with_capacity(images.len());
     for (i, image) in images.iter().enumerate() {
@@ -315,8 +366,12 @@ pub fn packed_bytes(scene: &Scene, primitives: usize) -> u64 {
         .sum();
     let uvs = if texturing.uvs.is_empty() { 0 } else { primitives as u64 * 24 };
     let tangents = if texturing.tangents.is_empty() { 0 } else { primitives as u64 * 24 };
-    let views = TextureViews::of(texturing).count();
-    4 * (HEADER_WORDS + VIEW_WORDS * views) as u64 + 4 * texels + uvs + tangents + sky_bytes(scene)
+    let views = TextureViews::of(texturing);
+    4 * (HEADER_WORDS + VIEW_WORDS * views.count() + views.layer_words()) as u64
+        + 4 * texels
+        + uvs
+        + tangents
+        + sky_bytes(scene)
 }
 
 #[cfg(test)]

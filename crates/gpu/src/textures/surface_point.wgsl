@@ -57,6 +57,24 @@ fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Sur
     return p;
 }
 
+// The clear-coat, sheen and specular textures' texels at the point
+// (Texturing::apply's `LayerTextures::apply`), from the six references at
+// `s.layer_textures` (textures/mod.rs's layer-texture tables).
+fn layer_texels(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> LayerTexels {
+    var t = no_layer_texels();
+    if (!LAYERED || s.layer_textures == NO_TEXTURE || uv.z == 0.0) {
+        return t;
+    }
+    let table = s.layer_textures;
+    t.clearcoat = texture_lookup(texture_data[table], uv, dx, dy).value.r;
+    t.clearcoat_roughness = texture_lookup(texture_data[table + 1u], uv, dx, dy).value.g;
+    t.sheen_color = texture_lookup(texture_data[table + 2u], uv, dx, dy).value.rgb;
+    t.sheen_roughness = texture_lookup(texture_data[table + 3u], uv, dx, dy).value.a;
+    t.specular = texture_lookup(texture_data[table + 4u], uv, dx, dy).value.a;
+    t.specular_color = texture_lookup(texture_data[table + 5u], uv, dx, dy).value.rgb;
+    return t;
+}
+
 // scene_upload::ALPHA_BLEND: the cut-off of an alphaMode BLEND surface.
 const ALPHA_BLEND: f32 = 2.0;
 

@@ -58,6 +58,7 @@ pub fn shader_source(radiance_format: wgpu::TextureFormat) -> String {
             &crate::wgsl::UNCOUNTED_LOOPS,
             &ESTIMATE,
             &crate::wgsl::PHOTON_BRDF,
+            &crate::gbuffer::layer_texels::LAYER_TEXELS,
             &crate::splat::FOOTPRINT_RECT,
             &PREFIX_SUM,
             &crate::lod::LOD_PHOTON,
@@ -185,6 +186,7 @@ impl TiledPass {
                 compute(15, texture(wgpu::TextureViewDimension::D2Array)),
                 compute(16, storage(true)),
                 compute(17, texture(wgpu::TextureViewDimension::D2)),
+                compute(18, crate::binding::texture_uint()),
             ],
         });
         let pipeline_layout = crate::binding::pipeline_layout(device, "tiled", &layout);
@@ -249,7 +251,7 @@ impl TiledPass {
         let view = |t: &wgpu::Texture| t.create_view(&Default::default());
         let (position, normal, albedo, output) =
             (view(&gbuffer.position), view(&gbuffer.normal), view(&gbuffer.albedo), view(target));
-        let emission = view(&gbuffer.emission);
+        let (emission, layers) = (view(&gbuffer.emission), view(&gbuffer.layers));
         let slices_view = media.slices.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -289,6 +291,7 @@ impl TiledPass {
                 texture(15, &slices_view),
                 whole(16, surfaces),
                 texture(17, &emission),
+                texture(18, &layers),
             ],
         });
         TiledBinding {

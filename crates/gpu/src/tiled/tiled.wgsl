@@ -63,6 +63,8 @@ struct TiledParams {
 @group(0) @binding(15) var slices_tex: texture_2d_array<f32>;
 @group(0) @binding(16) var<storage, read> surfaces: Surfaces;
 @group(0) @binding(17) var gbuffer_emission: texture_2d<f32>;
+// The layer textures' texels (read where LAYERED; layer_texels.wgsl).
+@group(0) @binding(18) var gbuffer_layers: texture_2d<u32>;
 
 const TILE: u32 = 16u;
 
@@ -258,7 +260,10 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     let albedo = textureLoad(gbuffer_albedo, pixel, 0);
     // A glossy surface weights each photon by its BRDF (photon_brdf) in
     // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
-    let surface = surfaces.all[u32(g.w)];
+    var surface = surfaces.all[u32(g.w)];
+    if (LAYERED) {
+        surface = pixel_surface(surface, textureLoad(gbuffer_layers, pixel, 0));
+    }
     let glossy = GLOSSY && surface.glossy != 0u;
     let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
     let eye = unit(media.camera_position - position.xyz);

@@ -353,7 +353,7 @@ impl TraceScene {
             surfaces: storage_buffer(
                 device,
                 "trace surfaces",
-                &crate::scene_upload::surfaces_contents(&crate::scene_upload::scene_surfaces(scene)),
+                &crate::scene_upload::surfaces_contents(&crate::scene_upload::scene_surfaces(scene, true)),
             ),
             region_triangles: regions.len() as u32,
             global_mask: media.global_mask(),

@@ -478,6 +478,9 @@ fn trace_one(rng: ptr<function, Rng>) {
         // The surface here with its textures (Scene::material_at).
         let uv = primitive_uv(hit.prim, hit.b);
         var point = surface_point(s, uv, vec2<f32>(0.0), vec2<f32>(0.0));
+        if (LAYERED) {
+            s = with_layer_texels(s, layer_texels(s, uv, vec2<f32>(0.0), vec2<f32>(0.0)));
+        }
         // Normals on the side the photon arrives from; the shading one bent
         // by a normal texture first (Scene::bent, as the CPU tracer).
         let facing = select(-1.0, 1.0, dot(ray.dir, normals.geometric) < 0.0);

@@ -55,7 +55,10 @@ struct Surface {
     // KHR_materials_specular's colour, scaling the dielectric's F0; for
     // glass, its inside's absorption (`glass_absorption`).
     specular_color: vec3<f32>,
-    _pad3: u32,
+    // Where the clear-coat, sheen and specular textures' references start
+    // in the texture buffer (0xffffffff: none; surface_point.wgsl's
+    // `layer_texels`): they multiply the factors above per point.
+    layer_textures: u32,
 }
 
 // A glass surface's inside absorption per scene unit (kind 2 keeps it in

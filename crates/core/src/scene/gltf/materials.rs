@@ -50,7 +50,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut unread_maps = 0;
     let mut other_sets = 0;
     let mut mixed_volumes = 0;
-    let mut layer_textures = 0;
     let mut missing_layer_textures = 0;
     let mut coat_normals = 0;
     let mut malformed_coats = 0;
@@ -99,7 +98,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
             let sheen = Sheen::of(&m);
             malformed_sheens += sheen.malformed as usize;
             let (layers, unread_layers, missing) = layer_textures_of(doc, &m, images);
-            layer_textures += layers.any() as usize;
             other_sets += unread_layers as usize;
             missing_layer_textures += missing as usize;
             let transmits = transmission > 0.0;
@@ -189,12 +187,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
         notes.push(format!(
             "{mixed_volumes} partly transmissive material(s) have KHR_materials_volume attenuation, which only \
              materials that are glass throughout (transmission 1, metallic 0, no transmissionTexture) absorb by: ignored"
-        ));
-    }
-    if layer_textures > 0 {
-        notes.push(format!(
-            "{layer_textures} material(s) have clear-coat, sheen or specular textures: the CPU renderers read them at \
-             each point; the GPU renderer draws each with its mean over the image"
         ));
     }
     if missing_layer_textures > 0 {

@@ -499,13 +499,13 @@ fn the_specular_colour_is_read() {
     let again = super::export::scene_to_glb(&scene).unwrap();
     let reloaded = crate::scene::Scene::load(write(&dir, "again.glb", &again).to_str().unwrap()).unwrap();
     assert!(matches!(reloaded.materials[0], Material::Pbr(b) if b.specular_color == tint));
-    // A specular texture is read (white: the factors alone), with the
-    // note on what the GPU renderer does with it.
+    // A specular texture is read (white: the factors alone), by every
+    // renderer: no note.
     let ext = root.materials[0].extensions.as_mut().unwrap();
     ext.specular.as_mut().unwrap().specular_texture =
         Some(json::texture::Info { index: texture, tex_coord: 0, extensions: None, extras: Default::default() });
     let scene = crate::scene::Scene::load(write(&dir, "t.glb", &glb(&root, bin)).to_str().unwrap()).unwrap();
-    assert!(scene.notes.iter().any(|n| n.contains("the GPU renderer draws each with its mean")), "{:?}", scene.notes);
+    assert!(!scene.notes.iter().any(|n| n.contains("specular")), "{:?}", scene.notes);
     let textures = scene.texturing.as_ref().unwrap().materials[0].unwrap();
     assert!(textures.layers.specular.is_some() && textures.layers.specular_color.is_none());
 }
