@@ -7,9 +7,10 @@
 // (view_depth.wgsl adds the optical depth along view rays).
 
 struct MediaParams {
-    camera_position: vec3<f32>,
-    // Length of view rays that hit nothing (photon-cpu's: twice the scene diagonal).
-    max_distance: f32,
+    // σ_t of the media filling the whole scene. First, as values that stay
+    // from frame to frame (media/mod.rs: lavapipe bakes the first word in).
+    global_sigma_t: vec3<f32>,
+    region_triangles: u32,
     // The camera basis of hikari_core::camera::Camera::ray.
     forward: vec3<f32>,
     tan_half_fov: f32,
@@ -18,9 +19,9 @@ struct MediaParams {
     up: vec3<f32>,
     // Optical-depth slices along each view ray (0: no region meshes).
     slices: u32,
-    // σ_t of the media filling the whole scene.
-    global_sigma_t: vec3<f32>,
-    region_triangles: u32,
+    camera_position: vec3<f32>,
+    // Length of view rays that hit nothing (photon-cpu's: twice the scene diagonal).
+    max_distance: f32,
     // Per phase slot: x = kind (0 Schlick, 1 Henyey–Greenstein), y = k or g.
     phases: array<vec4<f32>, 4>,
     image_size: vec2<f32>,

@@ -37,16 +37,20 @@ pub fn optical_depth_shader_source() -> String {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct MediaParams {
-    pub camera_position: [f32; 3],
-    pub max_distance: f32,
+    /// First, values that stay from frame to frame (not the camera's):
+    /// Mesa 22.3's lavapipe bakes a uniform buffer's first word into
+    /// shaders that test its fields, compiling anew whenever it changes
+    /// (`SpecularParams`).
+    pub global_sigma_t: [f32; 3],
+    pub region_triangles: u32,
     pub forward: [f32; 3],
     pub tan_half_fov: f32,
     pub right: [f32; 3],
     pub aspect: f32,
     pub up: [f32; 3],
     pub slices: u32,
-    pub global_sigma_t: [f32; 3],
-    pub region_triangles: u32,
+    pub camera_position: [f32; 3],
+    pub max_distance: f32,
     pub phases: [[f32; 4]; 4],
     pub image_size: [f32; 2],
     /// The camera's sub-pixel jitter (`Camera::jitter`).

@@ -74,6 +74,15 @@ pub fn shader_source() -> String {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct SpecularParams {
+    /// First, values that stay from frame to frame: Mesa 22.3's lavapipe
+    /// bakes this buffer's first word into the shader at every dispatch
+    /// (its uniform inlining reads offset 0 of any uniform buffer but the
+    /// first), and a camera value there compiled the pass anew each time
+    /// the camera moved (5 s a frame on showcase.glb, BENCHMARKS.md).
+    pub width: u32,
+    pub height: u32,
+    pub normal_test: u32,
+    pub power_unit: f32,
     pub camera_position: [f32; 3],
     pub tan_half_fov: f32,
     pub camera_right: [f32; 3],
@@ -82,10 +91,6 @@ pub struct SpecularParams {
     pub epsilon: f32,
     pub camera_forward: [f32; 3],
     pub max_depth: u32,
-    pub width: u32,
-    pub height: u32,
-    pub normal_test: u32,
-    pub power_unit: f32,
     pub global_radius: f32,
     pub global_buckets: u32,
     pub global_start_offset: u32,

@@ -17,6 +17,15 @@
 // unsplit sum, and no invocation runs more than its loop budget.
 
 struct SpecularParams {
+    // First, values that stay from frame to frame: Mesa 22.3's lavapipe
+    // bakes this buffer's first word into the shader at every dispatch (its
+    // uniform inlining reads offset 0 of any buffer but the first), and a
+    // camera value there compiled the pass anew each time the camera moved
+    // (5 s a frame on showcase.glb).
+    width: u32,
+    height: u32,
+    normal_test: u32,
+    power_unit: f32,
     camera_position: vec3<f32>,
     tan_half_fov: f32,
     camera_right: vec3<f32>,
@@ -25,10 +34,6 @@ struct SpecularParams {
     epsilon: f32,
     camera_forward: vec3<f32>,
     max_depth: u32,
-    width: u32,
-    height: u32,
-    normal_test: u32,
-    power_unit: f32,
     global_radius: f32,
     global_buckets: u32,
     global_start_offset: u32,
