@@ -229,7 +229,6 @@ fn specular_inputs<'a>(
     }
 }
 
-/// The rasterizing passes' projection for `camera` in a scene within `bounds`.
 /// What `ctx`'s adapter draws of `scene` otherwise than the CPU renderers,
 /// one line each (the front ends print them with the scene's notes).
 pub fn adapter_notes(ctx: &GpuContext, scene: &Scene) -> Vec<String> {
@@ -259,6 +258,7 @@ fn within_adapter(ctx: &GpuContext, features: SceneFeatures) -> SceneFeatures {
     SceneFeatures { layered: features.layered && ctx.layer_texels, ..features }
 }
 
+/// The rasterizing passes' projection for `camera` in a scene within `bounds`.
 fn clip_from_world(camera: &hikari_core::camera::Camera, bounds: (Vec3, Vec3)) -> glam::Mat4 {
     let (near, far) = depth_range(bounds, camera.position);
     camera.clip_from_view(near, far) * camera.view_from_world()

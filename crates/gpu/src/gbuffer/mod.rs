@@ -219,6 +219,15 @@ impl GBufferPass {
         GBufferPass { layout, mode, layered }
     }
 
+    /// The targets of `gbuffer` this pass writes, in location order.
+    fn written<'a>(&self, gbuffer: &'a GBuffer) -> Vec<&'a wgpu::Texture> {
+        let mut targets = vec![&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission];
+        if self.layered {
+            targets.push(&gbuffer.layers);
+        }
+        targets
+    }
+
     /// The uniforms and bind group of frames into `gbuffer`, made once.
     pub fn bind(&self, device: &wgpu::Device, scene: &SceneBuffers, gbuffer: &GBuffer) -> GBufferBinding {
         let uniforms = device.create_buffer(&wgpu::BufferDescriptor {
@@ -227,11 +236,8 @@ impl GBufferPass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let mut targets = vec![&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission];
-        if self.layered {
-            targets.push(&gbuffer.layers);
-        }
-        let views: Vec<wgpu::TextureView> = targets.iter().map(|t| t.create_view(&Default::default())).collect();
+        let views: Vec<wgpu::TextureView> =
+            self.written(gbuffer).iter().map(|t| t.create_view(&Default::default())).collect();
         let mut entries = vec![
             wgpu::BindGroupEntry { binding: 0, resource: uniforms.as_entire_binding() },
             wgpu::BindGroupEntry { binding: 1, resource: scene.surfaces.as_entire_binding() },
@@ -304,11 +310,7 @@ impl GBufferPass {
                 draw(encoder, pipeline, &attachments, wgpu::LoadOp::Clear(1.0));
             }
             Mode::Storage { depth, store } => {
-                let mut targets = vec![&gbuffer.position, &gbuffer.normal, &gbuffer.albedo, &gbuffer.emission];
-                if self.layered {
-                    targets.push(&gbuffer.layers);
-                }
-                for texture in targets {
+                for texture in self.written(gbuffer) {
                     encoder.clear_texture(texture, &Default::default());
                 }
                 draw(encoder, depth, &[], wgpu::LoadOp::Clear(1.0));
