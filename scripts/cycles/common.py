@@ -15,6 +15,29 @@ def principled_material(name, inputs):
     return m
 
 
+def normal_image(out, name, normals):
+    """A non-colour PNG OUT/NAME.png of unit tangent-space `normals` (H×W×3,
+    row 0 at the bottom as Blender stores pixels), packed into the file."""
+    h, w, _ = normals.shape
+    img = bpy.data.images.new(name, w, h, alpha=False)
+    img.colorspace_settings.name = "Non-Color"
+    rgba = np.concatenate([normals * 0.5 + 0.5, np.ones((h, w, 1))], axis=2)
+    img.pixels.foreach_set(rgba.astype(np.float32).ravel())
+    img.filepath_raw = os.path.join(out, name + ".png"); img.file_format = "PNG"; img.save()
+    return img
+
+
+def bump_normals(n, waves, amplitude):
+    """The tangent-space normals (n×n×3, v up) of the height
+    h = amplitude·sin(2π·waves·u)·sin(2π·waves·v) over the image."""
+    u, v = np.meshgrid((np.arange(n) + 0.5) / n, (np.arange(n) + 0.5) / n)
+    k = 2 * math.pi * waves
+    dhdu = amplitude * k * np.cos(k * u) * np.sin(k * v)
+    dhdv = amplitude * k * np.sin(k * u) * np.cos(k * v)
+    bump = np.stack([-dhdu, -dhdv, np.ones_like(u)], axis=2)
+    return bump / np.linalg.norm(bump, axis=2, keepdims=True)
+
+
 def box(loc, size, material):
     bpy.ops.mesh.primitive_cube_add(location=loc)
     o = bpy.context.object

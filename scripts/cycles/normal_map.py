@@ -16,22 +16,11 @@
 import bpy, sys, os, math
 import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from common import box, constant_sky, export_and_render, grey_floor_and_wall, point_light_and_camera, principled_material
+from common import (bump_normals, constant_sky, export_and_render, grey_floor_and_wall, normal_image,
+                    point_light_and_camera, principled_material)
 out = sys.argv[sys.argv.index("--") + 1]
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
-
-
-def normal_image(name, normals):
-    """A non-colour PNG of unit tangent-space `normals` (H×W×3, row 0 at
-    the bottom as Blender stores pixels), packed into the file."""
-    h, w, _ = normals.shape
-    img = bpy.data.images.new(name, w, h, alpha=False)
-    img.colorspace_settings.name = "Non-Color"
-    rgba = np.concatenate([normals * 0.5 + 0.5, np.ones((h, w, 1))], axis=2)
-    img.pixels.foreach_set(rgba.astype(np.float32).ravel())
-    img.filepath_raw = os.path.join(out, name + ".png"); img.file_format = "PNG"; img.save()
-    return img
 
 
 def normal_mapped(name, image, color):
@@ -46,16 +35,9 @@ def normal_mapped(name, image, color):
 
 # Every normal tilted up and to the right of the image.
 tilt = np.array([0.45, 0.35, 0.0]); tilt[2] = math.sqrt(1 - tilt[0] ** 2 - tilt[1] ** 2)
-tilted = normal_image("tilted", np.broadcast_to(tilt, (8, 8, 3)).copy())
-# Bumps: h = sin(2π·4u)·sin(2π·4v) over the image, as normals (v up).
-n = 256
-u, v = np.meshgrid((np.arange(n) + 0.5) / n, (np.arange(n) + 0.5) / n)
-k, a = 2 * math.pi * 8, 0.02
-dhdu = a * k * np.cos(k * u) * np.sin(k * v)
-dhdv = a * k * np.sin(k * u) * np.cos(k * v)
-bump = np.stack([-dhdu, -dhdv, np.ones_like(u)], axis=2)
-bump /= np.linalg.norm(bump, axis=2, keepdims=True)
-bumps = normal_image("bumps", bump)
+tilted = normal_image(out, "tilted", np.broadcast_to(tilt, (8, 8, 3)).copy())
+# Bumps: h = 0.02·sin(2π·8u)·sin(2π·8v) over the image.
+bumps = normal_image(out, "bumps", bump_normals(256, 8, 0.02))
 
 grey_floor_and_wall()
 

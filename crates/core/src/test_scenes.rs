@@ -491,17 +491,33 @@ pub mod gltf_textures {
     /// `layered_glb`'s checker alpha (its RGB is `GREYS`).
     pub const LAYER_ALPHA: [u8; 4] = [64, 128, 0, 255];
 
+    /// `layered_glb`'s clear-coat normal texture: 2×2 texels tilting the
+    /// coat 22.5° toward +u, −u, +up and −up (REPEAT), read at scale 0.8.
+    pub const COAT_NORMAL_TEXELS: [[u8; 4]; 4] =
+        [[176, 128, 245, 255], [80, 128, 245, 255], [128, 176, 245, 255], [128, 80, 245, 255]];
+
+    /// The clear-coat normal texture's scale.
+    pub const COAT_NORMAL_SCALE: f32 = 0.8;
+
+    /// `COAT_NORMAL_TEXELS` as a texture of `b`.
+    fn coat_normals(b: &mut GltfBuilder) -> json::Index<json::Texture> {
+        let image = b.image(&png(2, 2, COAT_NORMAL_TEXELS.as_flattened()), "image/png");
+        b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat)
+    }
+
     /// One glossy quad as `transformed_checker_glb`'s (x, y in [0, 1], z =
     /// 0, texture coordinates (x, 1 − y)) with a clear coat, a sheen and
     /// `KHR_materials_specular` (`LAYER_FACTORS`), every one of their six
-    /// textures the grey checker with alpha `LAYER_ALPHA` (REPEAT).
+    /// textures the grey checker with alpha `LAYER_ALPHA` (REPEAT), the
+    /// coat's normal texture `COAT_NORMAL_TEXELS`.
     pub fn layered_glb() -> Vec<u8> {
         let mut b = GltfBuilder::new();
         let image = b.image(&grey_checker(LAYER_ALPHA), "image/png");
         let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let normals = coat_normals(&mut b);
         let m = b.material(&PbrMaterial { roughness: 0.4, ..Default::default() });
         let root = quad(&mut b, Vec3::Y, Vec3::X, -Vec3::Y, 1.0, m);
-        with_layers(b.finish(vec![root]), t.value())
+        with_layers(b.finish(vec![root]), t.value(), normals.value())
     }
 
     /// `layered_glb`'s material (its base a darker orange) on a floor
@@ -514,13 +530,14 @@ pub mod gltf_textures {
         let mut b = GltfBuilder::new();
         let image = b.image(&grey_checker(LAYER_ALPHA), "image/png");
         let t = b.texture(image, WrappingMode::Repeat, WrappingMode::Repeat);
+        let normals = coat_normals(&mut b);
         let m = b.material(&PbrMaterial { base_color: Vec3::new(0.5, 0.3, 0.1), roughness: 0.4, ..Default::default() });
         let white = b.material(&PbrMaterial { base_color: Vec3::splat(0.8), specular: 0.0, ..Default::default() });
         let floor = quad(&mut b, Vec3::new(-1.0, -1.0, 0.0), 2.0 * Vec3::X, 2.0 * Vec3::Y, 2.0, m);
         let wall = quad(&mut b, Vec3::new(-1.0, 1.0, 0.0), 2.0 * Vec3::X, 1.5 * Vec3::Z, 1.0, white);
         let light = b.light(Type::Point, Vec3::ONE, 4.0 * 683.0, None);
         let light = b.node(GltfBuilder::light_node(light, Vec3::new(0.0, -0.3, 0.4), glam::Quat::IDENTITY));
-        let glb = with_layers(b.finish(vec![floor, wall, light]), t.value());
+        let glb = with_layers(b.finish(vec![floor, wall, light]), t.value(), normals.value());
         let mut scene = load(tag, &glb);
         scene.camera =
             crate::camera::Camera::new(Vec3::new(0.0, -1.6, 2.2), Vec3::new(0.0, 0.2, 0.0), Vec3::Y, 50.0, size, size)
@@ -530,8 +547,9 @@ pub mod gltf_textures {
 
     /// The document `(root, bin)` with its material 0 under a clear coat,
     /// a sheen and `KHR_materials_specular` (`LAYER_FACTORS`), all six
-    /// textures texture `texture`.
-    fn with_layers((root, bin): (json::Root, Vec<u8>), texture: usize) -> Vec<u8> {
+    /// textures texture `texture`, the coat's normal texture
+    /// `coat_normal` (at `COAT_NORMAL_SCALE`).
+    fn with_layers((root, bin): (json::Root, Vec<u8>), texture: usize, coat_normal: usize) -> Vec<u8> {
         let (coat, coat_roughness, sheen, sheen_roughness, specular, specular_color) = LAYER_FACTORS;
         let [sr, sg, sb] = sheen;
         let [cr, cg, cb] = specular_color;
@@ -540,7 +558,8 @@ pub mod gltf_textures {
             r#"{{
                 "KHR_materials_clearcoat": {{
                     "clearcoatFactor": {coat}, "clearcoatTexture": {info},
-                    "clearcoatRoughnessFactor": {coat_roughness}, "clearcoatRoughnessTexture": {info}
+                    "clearcoatRoughnessFactor": {coat_roughness}, "clearcoatRoughnessTexture": {info},
+                    "clearcoatNormalTexture": {{"index": {coat_normal}, "scale": {COAT_NORMAL_SCALE}}}
                 }},
                 "KHR_materials_sheen": {{
                     "sheenColorFactor": [{sr}, {sg}, {sb}], "sheenColorTexture": {info},

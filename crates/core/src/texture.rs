@@ -336,6 +336,16 @@ pub struct MaterialTextures {
     /// their x and y.
     pub normal: Option<TextureRef>,
     pub normal_scale: f32,
+    /// `KHR_materials_clearcoat`'s `clearcoatNormalTexture`, as `normal`
+    /// but bending the coat alone (`Texturing::coat_normal`), with its scale.
+    pub coat_normal: Option<TextureRef>,
+    pub coat_normal_scale: f32,
+    /// A coat over a normal texture without one of its own: the coat lies
+    /// on the unbent normal (the extension: "no normal mapping is applied
+    /// to the clear coat layer, even if normal mapping is applied to the
+    /// base material"; Cycles' Coat Normal likewise defaults to the
+    /// surface's), not on the base's bent one.
+    pub coat_unbent: bool,
     /// The clear-coat, sheen and specular extensions' textures.
     pub layers: LayerTextures,
     /// A share let through as glass, drawn per hit.
@@ -343,11 +353,19 @@ pub struct MaterialTextures {
 }
 
 impl MaterialTextures {
+    /// The coat lies apart from the base's shading normal: on its own
+    /// normal texture, or on the unbent normal over a normal texture
+    /// (`coat_unbent`).
+    pub fn coat_apart(&self) -> bool {
+        self.coat_normal.is_some() || self.coat_unbent
+    }
+
     pub fn is_textured(&self) -> bool {
         self.base_color.is_some()
             || self.metallic_roughness.is_some()
             || self.emissive.is_some()
             || self.normal.is_some()
+            || self.coat_normal.is_some()
             || self.layers.any()
             || self.transmission.is_some_and(|t| t.texture.is_some())
     }
@@ -533,6 +551,12 @@ impl Texturing {
         self.materials.iter().flatten().any(|m| m.normal.is_some())
     }
 
+    /// Does any material's coat lie apart from its base's normal (a
+    /// clear-coat normal texture, or a coat over a normal texture)?
+    pub fn has_coats_apart(&self) -> bool {
+        self.materials.iter().flatten().any(MaterialTextures::coat_apart)
+    }
+
     /// Does any material let a share through as glass ([`Transmission`])?
     pub fn has_mixes(&self) -> bool {
         self.materials.iter().flatten().any(|m| m.transmission.is_some())
@@ -664,14 +688,42 @@ impl Texturing {
         ns: glam::Vec3,
     ) -> glam::Vec3 {
         let Some(t) = self.textures(material) else { return ns };
-        let (Some(normal), Some(uvs)) = (t.normal, self.uvs.triangle(prim)) else { return ns };
+        self.bent_by(t.normal, t.normal_scale, prim, b, corners, ns)
+    }
+
+    /// The clear coat's normal at the point, as [`Texturing::shading_normal`]
+    /// but bent by the material's `clearcoatNormalTexture` (from the same
+    /// unbent `ns`: the specification's coat normal ignores the base's
+    /// normal texture), `ns` itself for a coat over a normal texture
+    /// without one of its own. None where the coat lies on the base's
+    /// normal (`MaterialTextures::coat_apart`).
+    pub fn coat_normal(
+        &self,
+        material: u32,
+        prim: u32,
+        b: Vec2,
+        corners: [glam::Vec3; 3],
+        ns: glam::Vec3,
+    ) -> Option<glam::Vec3> {
+        let t = self.textures(material).filter(|t| t.coat_apart())?;
+        Some(self.bent_by(t.coat_normal, t.coat_normal_scale, prim, b, corners, ns))
+    }
+
+    /// `ns` bent by the tangent-space normal texture `normal` of x and y
+    /// scale `scale` (`shading_normal`'s arithmetic).
+    fn bent_by(
+        &self,
+        normal: Option<TextureRef>,
+        scale: f32,
+        prim: u32,
+        b: Vec2,
+        corners: [glam::Vec3; 3],
+        ns: glam::Vec3,
+    ) -> glam::Vec3 {
+        let (Some(normal), Some(uvs)) = (normal, self.uvs.triangle(prim)) else { return ns };
         let uv = self.uvs.at(prim, b).unwrap_or_default();
         let texel = self.images[normal.image as usize].sample(normal.image_uv(uv), normal.sampler);
-        let local = glam::Vec3::new(
-            (2.0 * texel.x - 1.0) * t.normal_scale,
-            (2.0 * texel.y - 1.0) * t.normal_scale,
-            2.0 * texel.z - 1.0,
-        );
+        let local = glam::Vec3::new((2.0 * texel.x - 1.0) * scale, (2.0 * texel.y - 1.0) * scale, 2.0 * texel.z - 1.0);
         let axes = match self.tangents.triangle(prim) {
             Some(corner_tangents) => stored_uv_axes(corner_tangents, b, ns),
             None => triangle_uv_axes(corners, uvs),

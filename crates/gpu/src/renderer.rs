@@ -244,7 +244,8 @@ pub fn adapter_notes(ctx: &GpuContext, scene: &Scene) -> Vec<String> {
         };
         notes.push(format!(
             "note: {} has no room for the G-buffer's layer texels ({lacks}): the GPU renderer draws clear-coat, sheen \
-             and specular textures with their means over the image",
+             and specular textures with their means over the image, and clear coats on the base's normal (no \
+             clearcoatNormalTexture)",
             ctx.describe()
         ));
     }

@@ -7,10 +7,10 @@ use hikari_core::sampling::{Rng, uniform_sphere};
 use hikari_gpu::test_support::{run_kernel, test_context};
 use hikari_gpu::wgsl::BSDF;
 
-/// Words per item: 25 inputs, then the outputs the kernel writes.
-const ITEM: usize = 50;
+/// Words per item: 28 inputs, then the outputs the kernel writes.
+const ITEM: usize = 53;
 /// Input words per item.
-const INPUTS: usize = 25;
+const INPUTS: usize = 28;
 
 /// A random material, roughness spread over the smooth, followed and
 /// gathered ranges, with the extremes (black, pure metal or dielectric,
@@ -79,8 +79,9 @@ fn bsdf_words(b: &Bsdf) -> [f32; 16] {
 }
 
 /// WGSL making `b` from the kernel's first 16 input words `w` (`bsdf_words`).
-const BSDF_FROM_WORDS: &str = "let b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[6], w[7], w[8], \
-     vec3<f32>(w[9], w[10], w[11]), w[12], vec3<f32>(w[13], w[14], w[15]));\n";
+/// Its coat lies on the base's normal (+z).
+const BSDF_FROM_WORDS: &str = "var b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[6], w[7], w[8], \
+     vec3<f32>(w[9], w[10], w[11]), w[12], vec3<f32>(w[13], w[14], w[15]), vec3<f32>(0.0, 0.0, 1.0));\n";
 
 fn flags(s: &Option<BsdfSample>) -> u32 {
     s.map_or(0, |s| 1 | (s.is_delta as u32) << 1 | (s.followed as u32) << 2)
@@ -95,13 +96,24 @@ fn wgsl_bsdf_matches_the_cpu() {
     let ctx = test_context("wgsl_bsdf_matches_the_cpu");
     let mut rng = Rng::for_item(18, 0);
     let mut colours = Rng::for_item(18, 1);
+    let mut tilts = Rng::for_item(18, 2);
     let n = 8192;
     let mut items = Vec::new();
     let mut input = vec![0u32; n * ITEM];
     for item in input.chunks_mut(ITEM) {
         let (b, wo, wi) = (random_bsdf(&mut rng, &mut colours), random_direction(&mut rng), random_direction(&mut rng));
+        // Half the coats tilted up to 45° by a clear-coat normal texture
+        // (a generator of their own, as `colours`).
+        let b = if b.has_coat() && tilts.next_f32() < 0.5 {
+            let off = uniform_sphere(tilts.next_2d());
+            b.with_coat_normal(Vec3::Z + Vec3::new(off.x, off.y, 0.0) * tilts.next_f32())
+        } else {
+            b
+        };
         let (u_lobe, u) = (rng.next_f32(), rng.next_2d());
-        let words = bsdf_words(&b).into_iter().chain([wo.x, wo.y, wo.z, wi.x, wi.y, wi.z, u_lobe, u.x, u.y]);
+        let c = b.coat_normal;
+        let words =
+            bsdf_words(&b).into_iter().chain([wo.x, wo.y, wo.z, wi.x, wi.y, wi.z, u_lobe, u.x, u.y, c.x, c.y, c.z]);
         for (k, w) in words.enumerate() {
             item[k] = w.to_bits();
         }
@@ -112,6 +124,7 @@ fn wgsl_bsdf_matches_the_cpu() {
          var w: array<f32, {INPUTS}>;\n\
          for (var k = 0u; k < {INPUTS}u; k++) {{ w[k] = bitcast<f32>(io[o + k]); }}\n\
          {BSDF_FROM_WORDS}\
+         b = with_coat_normal(b, vec3<f32>(w[25], w[26], w[27]));\n\
          let wo = vec3<f32>(w[16], w[17], w[18]);\n\
          let wi = vec3<f32>(w[19], w[20], w[21]);\n\
          let u = vec2<f32>(w[23], w[24]);\n\
@@ -146,7 +159,12 @@ fn wgsl_bsdf_matches_the_cpu() {
         let mut check = |name: &str, got: f32, want: f32| {
             let err = (got - want).abs() / want.abs().max(1.0);
             worst = worst.max(err);
-            assert!(close(got, want, TOLERANCE), "item {i} {b:?} wo {wo} wi {wi}: {name} {got} vs {want}");
+            // A tilted coat's turn into its frame and back adds rounding
+            // that a narrow lobe amplifies in what its samples carry (Mesa's
+            // GL rounds differently from Vulkan): wider there.
+            let tilted_sample = b.coat_normal != Vec3::Z && name.starts_with("sample");
+            let tolerance = if tilted_sample { 1e-3 } else { TOLERANCE };
+            assert!(close(got, want, tolerance), "item {i} {b:?} wo {wo} wi {wi}: {name} {got} vs {want}");
         };
         for k in 0..3 {
             check("f", g(k), f[k]);
@@ -183,6 +201,8 @@ fn wgsl_bsdf_matches_the_cpu() {
     assert!(smooth > 500 && followed > 500 && gathered > 500, "{smooth} {followed} {gathered}");
     let coats = |r: f32| items.iter().filter(|(b, ..)| b.has_coat() && b.clearcoat_roughness == r).count();
     assert!(coats(0.0) > 200 && coats(0.2) > 200 && coats(0.5) > 200, "{} {} {}", coats(0.0), coats(0.2), coats(0.5));
+    let tilted = |r: f32| items.iter().filter(|(b, ..)| b.coat_normal != Vec3::Z && b.clearcoat_roughness == r).count();
+    assert!(tilted(0.0) > 100 && tilted(0.2) > 100 && tilted(0.5) > 100, "{} {}", tilted(0.0), tilted(0.5));
     let tinted = items.iter().filter(|(b, ..)| b.specular_color != Vec3::ONE && b.specular > 0.0).count();
     assert!(tinted > 1000, "{tinted}");
     let sheens = |r: f32| items.iter().filter(|(b, ..)| b.has_sheen() && b.sheen_roughness == r).count();

@@ -349,11 +349,13 @@ fn metallic_roughness_textures_reach_the_gbuffer() {
 /// Clear-coat, sheen and specular textures on the GPU: at every pixel the
 /// G-buffer's fifth target holds the texels the CPU multiplies each factor
 /// by where its ray hits (`Scene::material_at`), within the packing's
-/// half step (16 bits a factor, 10 a colour channel); they are the
-/// checker's, not its mean, over much of the quad.
+/// half step (8 bits a factor, 10 a colour channel); they are the
+/// checker's, not its mean, over much of the quad. The coat's own normal
+/// there is the CPU's (`Scene::coat_tilted`), tilted over most of the quad.
 #[test]
 fn layer_textures_reach_the_gbuffer() {
     use glam::Vec3;
+    use hikari_core::bsdf::ShadingFrame;
     use hikari_core::material::Material;
     use hikari_core::photon::{TraceSettings, trace_photons};
     use hikari_core::progress::Silent;
@@ -378,13 +380,14 @@ fn layer_textures_reach_the_gbuffer() {
     let texturing = scene.texturing.as_ref().unwrap();
     let mut checked = 0;
     let mut off_the_mean = 0;
+    let mut tilted_coats = 0;
     for y in 0..size {
         for x in 0..size {
             let ray = scene.camera.ray(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             let Some(hit) = scene.accel.intersect(&ray) else { continue };
             let Material::Pbr(want) = *scene.material_at(&hit) else { panic!("a glossy quad") };
             let t = LayerTexels::unpack(words[(y * size + x) as usize]);
-            let factor_step = 0.5 / 65535.0 + 2e-6;
+            let factor_step = 0.5 / 255.0 + 2e-6;
             let colour_step = 0.5 / 1023.0 + 2e-6;
             let scalars = [
                 ("clear coat", coat * t.clearcoat, want.clearcoat),
@@ -402,6 +405,18 @@ fn layer_textures_reach_the_gbuffer() {
             for (what, got, want) in colours {
                 assert!((got - want).abs().max_element() <= colour_step, "({x}, {y}): {what} {got} vs {want}");
             }
+            // The coat's own normal in the frame of the shading normal
+            // (Scene::coat_tilted), its x and y at 16 bits.
+            let facing = if ray.dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+            let frame = ShadingFrame::new(scene.shading_normal_at(&hit, ray.dir) * facing);
+            let tilted = scene.coat_tilted(&want, &hit, hit.shading_normal, ray.dir, &frame).expect("a coat normal");
+            assert!(
+                (t.coat_normal - tilted.coat_normal).abs().max_element() <= 1e-3,
+                "({x}, {y}): coat normal {} vs {}",
+                t.coat_normal,
+                tilted.coat_normal
+            );
+            tilted_coats += (tilted.coat_normal.z < 0.99) as usize;
             let material = scene.surfaces[hit.surface as usize].material;
             let Material::Pbr(mean) = texturing.with_layer_means(scene.materials[material as usize], material) else {
                 panic!()
@@ -411,6 +426,7 @@ fn layer_textures_reach_the_gbuffer() {
         }
     }
     assert!(checked > 500, "{checked} pixels see the quad");
+    assert!(tilted_coats > checked / 2, "{tilted_coats} of {checked} pixels' coats tilted");
     assert!(off_the_mean > checked / 2, "{off_the_mean} of {checked} pixels away from the texture's mean");
 }
 

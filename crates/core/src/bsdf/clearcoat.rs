@@ -44,6 +44,18 @@
 //! weights at `wo`); a rougher one is estimated from the photon maps
 //! (`f_gathered`).
 //!
+//! # The coat's own normal
+//!
+//! `clearcoatNormalTexture` bends the coat apart from the base: the coat's
+//! lobe, its Fresnel and what it lets through are then functions of the
+//! directions in the coat's frame (+z [`Bsdf::coat_normal`], given in the
+//! shading frame), the base's lobes of those in the shading frame, as in
+//! Cycles' Principled BSDF (its coat closure takes the coat normal, the
+//! base's dimming the view's angle to it). Neither side is lit from below:
+//! a direction under either surface gets nothing from that surface's
+//! lobes. With the coat normal +z every function is the untilted one to
+//! the bit.
+//!
 //! The WGSL twin is in `crates/gpu/src/wgsl/bsdf.wgsl`, pinned by
 //! `crates/gpu/tests/bsdf.rs`; keep the arithmetic the same on both sides.
 
@@ -51,6 +63,7 @@ use super::{
     Bsdf, BsdfSample, DIELECTRIC_F0, GATHER_ROUGHNESS, Lobes, MIN_LOBE_WEIGHT, SMOOTH_ROUGHNESS, ggx, schlick_weight,
 };
 use crate::material::{Rgb, mean};
+use crate::sampling::orthonormal_basis;
 use glam::{Vec2, Vec3};
 
 /// The largest f32 below 1: where a reused random number must stay.
@@ -60,6 +73,38 @@ impl Bsdf {
     /// A coat is present (clearcoatFactor > 0).
     pub fn has_coat(&self) -> bool {
         self.clearcoat > 0.0
+    }
+
+    /// This material with its coat's normal `normal` (in the local shading
+    /// frame; normalised here): the coat's own, bent by
+    /// `clearcoatNormalTexture`. One at or below the base's horizon, or
+    /// not a direction, leaves the coat on the base's normal.
+    pub fn with_coat_normal(self, normal: Vec3) -> Self {
+        let n = normal.normalize_or_zero();
+        Bsdf { coat_normal: if n.z > 0.0 && n.is_finite() { n } else { Vec3::Z }, ..self }
+    }
+
+    /// The coat lies apart from the base (its normal is not +z).
+    fn coat_is_tilted(&self) -> bool {
+        self.coat_normal != Vec3::Z
+    }
+
+    /// `w` (shading frame) in the coat's frame, whose +z is the coat's normal.
+    pub(super) fn to_coat(&self, w: Vec3) -> Vec3 {
+        if !self.coat_is_tilted() {
+            return w;
+        }
+        let (t, b) = orthonormal_basis(self.coat_normal);
+        Vec3::new(w.dot(t), w.dot(b), w.dot(self.coat_normal))
+    }
+
+    /// `w` (coat's frame) in the shading frame.
+    fn from_coat(&self, w: Vec3) -> Vec3 {
+        if !self.coat_is_tilted() {
+            return w;
+        }
+        let (t, b) = orthonormal_basis(self.coat_normal);
+        t * w.x + b * w.y + self.coat_normal * w.z
     }
 
     /// The coat is a perfect mirror.
@@ -98,10 +143,11 @@ impl Bsdf {
         (self.coat_transmission(cos_o) * self.coat_transmission(cos_i)).sqrt()
     }
 
-    /// The coat's microfacet lobe c·F_c·D·V (zero when smooth: its mirror
-    /// is a delta); both directions above the surface.
+    /// The coat's microfacet lobe c·F_c·D·V between `wo` and `wi` in the
+    /// coat's frame (zero when smooth: its mirror is a delta; zero for a
+    /// direction below the coat).
     fn coat_lobe(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if self.coat_is_smooth() {
+        if self.coat_is_smooth() || wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
         let h = (wo + wi).normalize();
@@ -110,8 +156,12 @@ impl Bsdf {
         self.coat_fresnel(cos) * ggx::d(h, alpha) * ggx::visibility(wo, wi, alpha)
     }
 
-    /// Probability that `sample` picks the coat at `cos_o`.
+    /// Probability that `sample` picks the coat at `cos_o` (to the coat's
+    /// normal; none from below it).
     fn coat_probability(&self, cos_o: f32) -> f32 {
+        if cos_o <= 0.0 {
+            return 0.0;
+        }
         let coat = self.coat_fresnel(cos_o);
         let base = (1.0 - coat) * self.base_albedo_estimate().max_element();
         if coat + base <= 0.0 { 0.0 } else { coat / (coat + base) }
@@ -121,14 +171,16 @@ impl Bsdf {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
         }
-        self.under_coat(wo, wi, self.f_lobes(wo, wi, k)) + Rgb::splat(self.coat_lobe(wo, wi))
+        let (co, ci) = (self.to_coat(wo), self.to_coat(wi));
+        self.under_coat(co.z, ci.z, self.f_lobes(wo, wi, k)) + Rgb::splat(self.coat_lobe(co, ci))
     }
 
-    /// The base's lobes as the coat leaves them (the sheen dimmed like the
-    /// specular lobe).
-    fn under_coat(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> Rgb {
-        lobes.diffuse * self.coat_diffuse_through(wo.z, wi.z)
-            + (lobes.specular + lobes.sheen) * self.coat_specular_through(wo.z, wi.z)
+    /// The base's lobes as the coat leaves them between directions at
+    /// cosines `cos_o` and `cos_i` to the coat's normal (the sheen dimmed
+    /// like the specular lobe).
+    fn under_coat(&self, cos_o: f32, cos_i: f32, lobes: Lobes) -> Rgb {
+        lobes.diffuse * self.coat_diffuse_through(cos_o, cos_i)
+            + (lobes.specular + lobes.sheen) * self.coat_specular_through(cos_o, cos_i)
     }
 
     /// `f_gathered` under the coat: `lobes` are the base's gathered lobes.
@@ -136,18 +188,21 @@ impl Bsdf {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
         }
-        let coat = if self.coat_is_gathered() { self.coat_lobe(wo, wi) } else { 0.0 };
-        self.under_coat(wo, wi, lobes) + Rgb::splat(coat)
+        let (co, ci) = (self.to_coat(wo), self.to_coat(wi));
+        let coat = if self.coat_is_gathered() { self.coat_lobe(co, ci) } else { 0.0 };
+        self.under_coat(co.z, ci.z, lobes) + Rgb::splat(coat)
     }
 
     pub(super) fn coated_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let p = self.coat_probability(wo.z);
+        let co = self.to_coat(wo);
+        let p = self.coat_probability(co.z);
         let mut pdf = (1.0 - p) * self.base_pdf(wo, wi);
-        if !self.coat_is_smooth() {
-            pdf += p * ggx::reflection_pdf(wo, (wo + wi).normalize(), self.coat_alpha());
+        let ci = self.to_coat(wi);
+        if !self.coat_is_smooth() && ci.z > 0.0 && p > 0.0 {
+            pdf += p * ggx::reflection_pdf(co, (co + ci).normalize(), self.coat_alpha());
         }
         pdf
     }
@@ -156,36 +211,46 @@ impl Bsdf {
         if wo.z <= 0.0 {
             return None;
         }
-        let p = self.coat_probability(wo.z);
+        let co = self.to_coat(wo);
+        let p = self.coat_probability(co.z);
         if u_lobe < p {
             if self.coat_is_smooth() {
-                return Some(self.coat_mirror(wo, p));
+                return self.coat_mirror(co, p);
             }
-            let wi = ggx::reflect(wo, ggx::sample_visible_normal(wo, self.coat_alpha(), u));
-            return self.coated_finish(wo, wi, !self.coat_is_gathered());
+            let ci = ggx::reflect(co, ggx::sample_visible_normal(co, self.coat_alpha(), u));
+            return self.coated_finish(wo, self.from_coat(ci), !self.coat_is_gathered());
         }
         let s = self.base_sample(wo, ((u_lobe - p) / (1.0 - p)).min(ONE_BELOW), u)?;
         if s.is_delta {
-            // The base's mirror under the coat: √(T·T) at the mirror
-            // direction is T(θo).
-            let through = self.coat_transmission(wo.z);
+            // The base's mirror under the coat: √(T·T), which at the
+            // mirror direction of an untilted coat is T(θo).
+            let through = if self.coat_is_tilted() {
+                self.coat_specular_through(co.z, self.to_coat(s.wi).z)
+            } else {
+                self.coat_transmission(wo.z)
+            };
             let pdf = (1.0 - p) * s.pdf;
             return Some(BsdfSample { f: s.f * through, pdf, weight: s.f * (through * wo.z / pdf), ..s });
         }
         self.coated_finish(wo, s.wi, s.followed)
     }
 
-    /// The smooth coat's mirror at `wo`, chosen with probability `p`.
-    fn coat_mirror(&self, wo: Vec3, p: f32) -> BsdfSample {
-        let fc = self.coat_fresnel(wo.z);
-        BsdfSample {
-            wi: Vec3::new(-wo.x, -wo.y, wo.z),
-            f: Rgb::splat(fc / wo.z),
+    /// The smooth coat's mirror at `co` (the view in the coat's frame),
+    /// chosen with probability `p`; None where it leaves below the base.
+    fn coat_mirror(&self, co: Vec3, p: f32) -> Option<BsdfSample> {
+        let wi = self.from_coat(Vec3::new(-co.x, -co.y, co.z));
+        if wi.z <= 0.0 {
+            return None;
+        }
+        let fc = self.coat_fresnel(co.z);
+        Some(BsdfSample {
+            wi,
+            f: Rgb::splat(fc / wi.z),
             pdf: p,
             weight: Rgb::splat(fc / p),
             is_delta: true,
             followed: true,
-        }
+        })
     }
 
     fn coated_finish(&self, wo: Vec3, wi: Vec3, followed: bool) -> Option<BsdfSample> {
@@ -207,9 +272,10 @@ impl Bsdf {
         if wo.z <= 0.0 {
             return None;
         }
-        let coat = if self.coat_is_gathered() { 0.0 } else { self.coat_fresnel(wo.z) };
+        let co = self.to_coat(wo);
+        let coat = if self.coat_is_gathered() || co.z <= 0.0 { 0.0 } else { self.coat_fresnel(co.z) };
         let base = if self.has_specular() && !self.gathers_specular() {
-            self.coat_transmission(wo.z) * mean(self.specular_fresnel(wo.z)).max(MIN_LOBE_WEIGHT)
+            self.coat_transmission(co.z) * mean(self.specular_fresnel(wo.z)).max(MIN_LOBE_WEIGHT)
         } else {
             0.0
         };
@@ -220,21 +286,22 @@ impl Bsdf {
         if u.x < p {
             let u = Vec2::new((u.x / p).min(ONE_BELOW), u.y);
             if self.coat_is_smooth() {
-                return Some(self.coat_mirror(wo, p));
+                return self.coat_mirror(co, p);
             }
             let alpha = self.coat_alpha();
-            let h = ggx::sample_visible_normal(wo, alpha, u);
-            let wi = ggx::reflect(wo, h);
-            let pdf = p * ggx::reflection_pdf(wo, h, alpha);
-            if wi.z <= 0.0 || pdf <= 0.0 {
+            let h = ggx::sample_visible_normal(co, alpha, u);
+            let ci = ggx::reflect(co, h);
+            let wi = self.from_coat(ci);
+            let pdf = p * ggx::reflection_pdf(co, h, alpha);
+            if wi.z <= 0.0 || ci.z <= 0.0 || pdf <= 0.0 {
                 return None;
             }
-            let f = Rgb::splat(self.coat_lobe(wo, wi));
+            let f = Rgb::splat(self.coat_lobe(co, ci));
             return Some(BsdfSample { wi, f, pdf, weight: f * (wi.z / pdf), is_delta: false, followed: true });
         }
         let u = Vec2::new(((u.x - p) / (1.0 - p)).min(ONE_BELOW), u.y);
         let s = self.sample_specular_lobe(wo, u)?;
-        let through = self.coat_specular_through(wo.z, s.wi.z);
+        let through = self.coat_specular_through(co.z, self.to_coat(s.wi).z);
         Some(BsdfSample { f: s.f * through, pdf: (1.0 - p) * s.pdf, weight: s.weight * (through / (1.0 - p)), ..s })
     }
 
@@ -261,6 +328,52 @@ mod tests {
 
     fn mirror(wo: Vec3) -> Vec3 {
         Vec3::new(-wo.x, -wo.y, wo.z)
+    }
+
+    /// A coat normal 17° off the base's, as a clear-coat normal texture
+    /// bends it.
+    fn tilt() -> Vec3 {
+        Vec3::new(0.25, -0.15, 0.95).normalize()
+    }
+
+    /// Where `c`'s coat mirrors `wo` (about its own normal).
+    fn coat_mirror_of(c: &Bsdf, wo: Vec3) -> Vec3 {
+        c.from_coat(mirror(c.to_coat(wo)))
+    }
+
+    /// A tilted coat over a black base is the untilted coat turned: its f
+    /// between two directions is the untilted one's between them seen from
+    /// the coat's frame, its pdf too, and a smooth one mirrors the view
+    /// about the coat's normal with reflectance c·F_c(cos to that normal).
+    #[test]
+    fn a_tilted_coat_is_the_coat_turned() {
+        let n = tilt();
+        for roughness in [0.3, 0.6] {
+            let flat = coated(Bsdf::diffuse(Rgb::ZERO), 1.0, roughness);
+            let tilted = flat.with_coat_normal(n);
+            let mut rng = Rng::for_item(0xC0AB, 0);
+            for _ in 0..300 {
+                let (wo, wi) = (direction_at(75.0 * rng.next_f32()), direction_at(75.0 * rng.next_f32()));
+                let (wo, wi) = (Vec3::new(wo.x, wo.z * 0.3, wo.z).normalize(), wi);
+                let (co, ci) = (tilted.to_coat(wo), tilted.to_coat(wi));
+                let want = if co.z > 0.0 && ci.z > 0.0 { flat.f(co, ci).x } else { 0.0 };
+                let got = tilted.f(wo, wi).x;
+                assert!((got - want).abs() <= 1e-5 * want.max(1.0), "{wo} {wi}: {got} against {want}");
+                let want_pdf = if co.z > 0.0 && ci.z > 0.0 { flat.pdf(co, ci) } else { 0.0 };
+                assert!((tilted.pdf(wo, wi) - want_pdf).abs() <= 1e-4 * want_pdf.max(1.0));
+            }
+        }
+        let smooth = coated(Bsdf::diffuse(Rgb::ZERO), 1.0, 0.0).with_coat_normal(n);
+        let wo = direction_at(40.0);
+        let s = smooth.sample(wo, 0.0, Vec2::ZERO).unwrap();
+        let want = 2.0 * wo.dot(n) * n - wo;
+        assert!(s.is_delta && s.wi.abs_diff_eq(want, 1e-5), "{} against {want}", s.wi);
+        let fresnel = 0.04 + 0.96 * (1.0 - wo.dot(n)).powi(5);
+        assert!((s.weight.x - fresnel).abs() < 1e-5, "{} against {fresnel}", s.weight.x);
+        // Not a direction, or one below the base: the base's normal.
+        assert_eq!(smooth.with_coat_normal(Vec3::ZERO).coat_normal, Vec3::Z);
+        assert_eq!(smooth.with_coat_normal(Vec3::new(1.0, 0.0, -0.1)).coat_normal, Vec3::Z);
+        assert_eq!(smooth.with_coat_normal(Vec3::new(0.0, 0.0, 2.0)).coat_normal, Vec3::Z);
     }
 
     /// A smooth coat over black reflects c·F_c: 4% at normal incidence, all
@@ -298,7 +411,7 @@ mod tests {
         for deg in [0.0, 40.0, 75.0] {
             let wo = direction_at(deg);
             let under = integrate_about(Vec3::Z, |wi| {
-                (mean(lambert.under_coat(wo, wi, lambert.f_lobes(wo, wi, 1.0))) * wi.z.max(0.0)) as f64
+                (mean(lambert.under_coat(wo.z, wi.z, lambert.f_lobes(wo, wi, 1.0))) * wi.z.max(0.0)) as f64
             });
             let want = 0.5 * lambert.coat_transmission(wo.z) as f64;
             assert!((under - want).abs() < 1e-3, "{deg}°: {under} against {want}");
@@ -334,8 +447,13 @@ mod tests {
         for (base, clearcoat, roughness, deg) in [
             (Bsdf::new(Rgb::new(0.8, 0.3, 0.1), 0.0, 0.8, 1.0), 1.0, 0.2, 30.0),
             (Bsdf::new(Rgb::new(0.9, 0.9, 0.9), 1.0, 0.5, 1.0), 0.7, 0.4, 70.0),
+            (Bsdf::new(Rgb::new(0.8, 0.3, 0.1), 0.0, 0.8, 1.0), 1.0, 0.3, 31.0),
+            (Bsdf::new(Rgb::new(0.2, 0.2, 0.2), 1.0, 0.6, 1.0), 1.0, 0.4, 65.0),
         ] {
+            // Odd angles: under a coat tilted by a clear-coat normal texture.
+            let tilted = deg as u32 % 2 == 1;
             let c = coated(base, clearcoat, roughness);
+            let c = if tilted { c.with_coat_normal(tilt()) } else { c };
             let wo = direction_at(deg);
             let p_valid = integrate_about(mirror(wo), |wi| c.pdf(wo, wi) as f64) as f32;
             assert!(p_valid <= 1.0 + 1e-3 && p_valid > 0.9, "{p_valid}");
@@ -356,11 +474,13 @@ mod tests {
     /// base the coated albedo stays at most 1, and f is reciprocal.
     #[test]
     fn white_furnace_and_reciprocity() {
-        for base in [Bsdf::new(Rgb::ONE, 1.0, 0.3, 1.0), Bsdf::diffuse(Rgb::ONE)] {
-            let c = coated(base, 1.0, 0.3);
+        let bases = [Bsdf::new(Rgb::ONE, 1.0, 0.3, 1.0), Bsdf::diffuse(Rgb::ONE)];
+        for c in
+            bases.iter().flat_map(|&base| [coated(base, 1.0, 0.3), coated(base, 1.0, 0.3).with_coat_normal(tilt())])
+        {
             for deg in [0.0, 45.0, 80.0] {
                 let wo = direction_at(deg);
-                let albedo = integrate_about(mirror(wo), |wi| (mean(c.f(wo, wi)) * wi.z.max(0.0)) as f64);
+                let albedo = integrate_about(coat_mirror_of(&c, wo), |wi| (mean(c.f(wo, wi)) * wi.z.max(0.0)) as f64);
                 assert!(albedo <= 1.0 + 2e-3, "{deg}°: {albedo}");
             }
             let mut rng = Rng::for_item(0xC0A8, 0);
@@ -382,6 +502,9 @@ mod tests {
             (coated(Bsdf::new(Rgb::new(0.8, 0.4, 0.2), 0.0, 0.6, 1.0), 1.0, 0.25), 40.0),
             (coated(Bsdf::new(Rgb::new(0.9, 0.8, 0.7), 1.0, 0.4, 1.0), 0.8, 0.0), 60.0),
             (coated(Bsdf::new(Rgb::new(0.5, 0.6, 0.7), 1.0, 0.0, 1.0), 1.0, 0.0), 50.0),
+            (coated(Bsdf::new(Rgb::new(0.8, 0.4, 0.2), 0.0, 0.6, 1.0), 1.0, 0.25).with_coat_normal(tilt()), 41.0),
+            (coated(Bsdf::new(Rgb::new(0.9, 0.8, 0.7), 1.0, 0.4, 1.0), 0.8, 0.0).with_coat_normal(tilt()), 61.0),
+            (coated(Bsdf::new(Rgb::new(0.5, 0.6, 0.7), 1.0, 0.0, 1.0), 1.0, 0.0).with_coat_normal(tilt()), 51.0),
         ] {
             let wo = direction_at(deg);
             let quadrature = albedo_by_quadrature(&c, wo);
@@ -399,10 +522,13 @@ mod tests {
     /// the delta lobes (a smooth coat, a smooth base mirror under the coat)
     /// reflect.
     fn albedo_by_quadrature(c: &Bsdf, wo: Vec3) -> f64 {
-        let coat = if c.coat_is_smooth() { c.coat_fresnel(wo.z) } else { 0.0 };
-        let t = c.coat_transmission(wo.z);
+        let co = c.to_coat(wo);
+        let coat_mirror = coat_mirror_of(c, wo);
+        let coat = if c.coat_is_smooth() && coat_mirror.z > 0.0 { c.coat_fresnel(co.z) } else { 0.0 };
+        let t = c.coat_specular_through(co.z, c.to_coat(mirror(wo)).z);
         let base = if c.is_delta() { mean(c.specular_fresnel(wo.z)) * t } else { 0.0 };
-        integrate_about(mirror(wo), |wi| (mean(c.f(wo, wi)) * wi.z.max(0.0)) as f64) + (coat + base) as f64
+        let lobes = integrate_about(mirror(wo), |wi| (mean(c.f(wo, wi)) * wi.z.max(0.0)) as f64);
+        lobes + (coat + base) as f64
     }
 
     /// photon-cpu's split adds up: the gathered part's albedo plus the mean
@@ -416,6 +542,9 @@ mod tests {
             (coated(Bsdf::new(Rgb::new(0.9, 0.8, 0.7), 1.0, 0.2, 1.0), 1.0, 0.1), 45.0),
             (coated(Bsdf::new(Rgb::new(0.9, 0.8, 0.7), 1.0, 0.0, 1.0), 1.0, 0.5), 45.0),
             (coated(Bsdf::new(Rgb::new(0.3, 0.5, 0.9), 0.0, 0.8, 1.0), 1.0, 0.6), 70.0),
+            (coated(Bsdf::new(Rgb::new(0.8, 0.4, 0.2), 0.0, 0.6, 1.0), 0.7, 0.2).with_coat_normal(tilt()), 60.0),
+            (coated(Bsdf::new(Rgb::new(0.9, 0.8, 0.7), 1.0, 0.0, 1.0), 1.0, 0.5).with_coat_normal(tilt()), 45.0),
+            (coated(Bsdf::new(Rgb::new(0.9, 0.8, 0.7), 1.0, 0.2, 1.0), 1.0, 0.0).with_coat_normal(tilt()), 35.0),
         ] {
             let wo = direction_at(deg);
             let whole = albedo_by_quadrature(&c, wo);

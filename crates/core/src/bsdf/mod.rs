@@ -117,6 +117,10 @@ pub struct Bsdf {
     pub clearcoat: f32,
     /// The coat's perceptual roughness (α = roughness²).
     pub clearcoat_roughness: f32,
+    /// The coat's own normal in the local shading frame (unit, z > 0):
+    /// +z, the base's, but where `clearcoatNormalTexture` bends the coat
+    /// apart from the base ([`Bsdf::with_coat_normal`]).
+    pub coat_normal: Vec3,
     /// The dielectric's reflectance at normal incidence, F0 = ((η − 1)/(η +
     /// 1))² of KHR_materials_ior's index η: `DIELECTRIC_F0` at glTF's
     /// default 1.5 ([`Bsdf::with_ior`]).
@@ -194,6 +198,7 @@ impl Bsdf {
             specular: specular.clamp(0.0, 1.0),
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
+            coat_normal: Vec3::Z,
             f0: DIELECTRIC_F0,
             specular_color: Rgb::ONE,
             dielectric_f0: Rgb::splat(DIELECTRIC_F0),

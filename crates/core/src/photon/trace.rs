@@ -245,6 +245,8 @@ impl PathTracer<'_> {
                     // The bounce samples the whole BRDF; Russian roulette on
                     // the sample's weight keeps photons near constant power.
                     let frame = ShadingFrame::new(ns);
+                    let tilted = self.scene.coat_tilted(bsdf, &hit, smooth, ray.dir, &frame);
+                    let bsdf = tilted.as_ref().unwrap_or(bsdf);
                     let wo = frame.to_local(-ray.dir);
                     let Some(mut s) = bsdf.sample(wo, rng.next_f32(), rng.next_2d()) else { return };
                     if bump != 1.0 {

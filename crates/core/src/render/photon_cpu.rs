@@ -307,6 +307,8 @@ impl<'a> PhotonCpuRenderer<'a> {
             Material::Emitter => Rgb::ZERO,
             Material::Pbr(bsdf) => {
                 let frame = ShadingFrame::new(ns);
+                let tilted = self.scene.coat_tilted(bsdf, &hit, smooth, ray.dir, &frame);
+                let bsdf = tilted.as_ref().unwrap_or(bsdf);
                 let wo = frame.to_local(-ray.dir);
                 // A normal-mapped point's diffuse lobes: Cycles' bump
                 // shadowing of the light's direction (`wi` local here).

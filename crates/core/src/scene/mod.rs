@@ -207,6 +207,36 @@ impl Scene {
         crate::texture::valid_reflection_normal(hit.geometric_normal * facing, -dir, bent * facing) * facing
     }
 
+    /// `bsdf` at `hit` (reached along `dir`) with its clear coat on the
+    /// coat's own normal, where the material has a `clearcoatNormalTexture`
+    /// (`Texturing::coat_normal`, bent from `smooth`, the unbent shading
+    /// normal, and lifted as [`Scene::shading_normal_at`] lifts): in
+    /// `frame`, the shading frame the renderer shades `bsdf` in (+z the
+    /// bent shading normal on the side `dir` arrives from). None where
+    /// nothing changes (no coat, no such texture).
+    pub fn coat_tilted(
+        &self,
+        bsdf: &crate::bsdf::Bsdf,
+        hit: &Hit,
+        smooth: glam::Vec3,
+        dir: glam::Vec3,
+        frame: &crate::bsdf::ShadingFrame,
+    ) -> Option<crate::bsdf::Bsdf> {
+        if !bsdf.has_coat() {
+            return None;
+        }
+        let (t, triangle) = (self.texturing.as_ref()?, self.accel.triangle(hit.prim)?);
+        let material = self.surfaces[hit.surface as usize].material;
+        let coat = t.coat_normal(material, hit.prim, hit.barycentrics, triangle.v, smooth)?;
+        let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+        let lifted = if coat == smooth {
+            coat * facing
+        } else {
+            crate::texture::valid_reflection_normal(hit.geometric_normal * facing, -dir, coat * facing)
+        };
+        Some(bsdf.with_coat_normal(frame.to_local(lifted)))
+    }
+
     /// `hit` (reached along `dir`) with its shading normal bent by its
     /// material's normal texture (`shading_normal_at`): what every renderer
     /// and the photon tracer shade with, so a normal-mapped surface looks

@@ -32,10 +32,12 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let g = textureLoad(gbuffer_normal, pixel, 0);
     let n = g.xyz;
     var s = surfaces.all[u32(g.w)];
+    var layers = vec4<u32>(0u);
     if (LAYERED) {
-        s = pixel_surface(s, textureLoad(gbuffer_layers, pixel, 0));
+        layers = textureLoad(gbuffer_layers, pixel, 0);
+        s = pixel_surface(s, layers);
     }
-    let b = pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
+    let b = pixel_coat(pixel_bsdf(s, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w), s, layers);
     var r = surface_reflector(s, b, unit(media.camera_position - x), n);
     if (BENT && position.w < 0.0) {
         shaded_geometric_normal = unpack_geometric_normal(position.w, n);

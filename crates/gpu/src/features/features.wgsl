@@ -25,9 +25,10 @@ override MEDIA: bool = true;
 // Some glTF surface lets a share of its light through as glass
 // (`Surface::transmission`; surface_point.wgsl's `draw_layer`).
 override MIXED: bool = true;
-// Some glTF surface reads clear-coat, sheen or specular textures per point
-// (`Surface::layer_textures`; surface_point.wgsl's `layer_texels`), and
-// the G-buffer keeps their texels in its fifth target (`gbuffer_layers`).
+// Some glTF surface reads clear-coat, sheen, specular or clear-coat normal
+// textures per point (`Surface::layer_textures`; surface_point.wgsl's
+// `layer_texels` and `coat_normal`), and the G-buffer keeps their texels
+// and the coat's normal in its fifth target (`gbuffer_layers`).
 override LAYERED: bool = true;
 // Some diffuse surface shades with a normal off its facets' (smooth vertex
 // normals, spheres, normal textures): the G-buffer keeps its geometric

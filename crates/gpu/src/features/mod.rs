@@ -27,9 +27,9 @@ pub struct SceneFeatures {
     pub media: bool,
     pub bent: bool,
     pub mixed: bool,
-    /// Some surface reads clear-coat, sheen or specular textures per point
-    /// (`GpuSurface::layer_textures`), which the G-buffer keeps in a fifth
-    /// target (`GBuffer::layers`).
+    /// Some surface reads clear-coat, sheen, specular or clear-coat normal
+    /// textures per point (`GpuSurface::layer_textures`), which the
+    /// G-buffer keeps in a fifth target (`GBuffer::layers`).
     pub layered: bool,
 }
 

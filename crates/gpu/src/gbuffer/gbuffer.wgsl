@@ -168,10 +168,16 @@ fn shade(in: VertexOut) -> Shaded {
     let emitted = select(vec3<f32>(0.0), point.emission, front || surface.two_sided != 0u);
     out.emission = vec4<f32>(emitted, pack_metal_rough(point.metallic, point.roughness));
     // The layer textures at the pixel's footprint, as the raster passes
-    // multiply the surface's factors by them.
+    // multiply the surface's factors by them, and the coat's own normal in
+    // the frame of the normal stored (Scene::coat_tilted).
     var layers = vec4<u32>(0u);
     if (LAYERED) {
-        layers = pack_layer_texels(layer_texels(surface, uv, dx, dy));
+        var texels = layer_texels(surface, uv, dx, dy);
+        if (coat_apart(surface, uv)) {
+            let coat = coat_normal(surface, uv, dx, dy, px, py, tangent, shading, in.geometric_normal, normalize(view));
+            texels.coat_normal = to_shading(coat * side, n * side);
+        }
+        layers = pack_layer_texels(texels);
     }
     return Shaded(out, layers);
 }

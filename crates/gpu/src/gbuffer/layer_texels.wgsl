@@ -1,9 +1,12 @@
 // The clear-coat, sheen and specular textures' texels at a point, each
 // channel as hikari_core::texture::LayerTextures::apply reads it (1 where
-// the surface lacks that texture or the point has no coordinates): the
-// G-buffer's fifth target keeps them (`pack_layer_texels`, 16 bits a
-// factor, 10 a colour channel; layer_texels.rs is the Rust half), and
-// `with_layer_texels` multiplies a surface's factors by them.
+// the surface lacks that texture or the point has no coordinates), and the
+// coat's own normal (clearcoatNormalTexture) in the shading frame: the
+// G-buffer's fifth target keeps them (`pack_layer_texels`: 8 bits a
+// factor, as the images hold them; the coat normal's x and y at 16; 10
+// bits a colour channel; layer_texels.rs is the Rust half),
+// `with_layer_texels` multiplies a surface's factors by them and
+// `pixel_coat` turns a pixel's coat.
 
 struct LayerTexels {
     clearcoat: f32,
@@ -12,10 +15,12 @@ struct LayerTexels {
     specular: f32,
     sheen_color: vec3<f32>,
     specular_color: vec3<f32>,
+    // +z: the base's normal.
+    coat_normal: vec3<f32>,
 }
 
 fn no_layer_texels() -> LayerTexels {
-    return LayerTexels(1.0, 1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0));
+    return LayerTexels(1.0, 1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0));
 }
 
 fn pack_unorm10x3(c: vec3<f32>) -> u32 {
@@ -29,18 +34,23 @@ fn unpack_unorm10x3(w: u32) -> vec3<f32> {
 
 fn pack_layer_texels(t: LayerTexels) -> vec4<u32> {
     return vec4<u32>(
-        pack2x16unorm(vec2<f32>(t.clearcoat, t.clearcoat_roughness)),
-        pack2x16unorm(vec2<f32>(t.sheen_roughness, t.specular)),
+        pack4x8unorm(vec4<f32>(t.clearcoat, t.clearcoat_roughness, t.sheen_roughness, t.specular)),
+        pack2x16snorm(t.coat_normal.xy),
         pack_unorm10x3(t.sheen_color),
         pack_unorm10x3(t.specular_color),
     );
 }
 
+// The coat normal of the target's second word: z from x and y (≥ 0).
+fn unpack_coat_normal(w: u32) -> vec3<f32> {
+    let xy = unpack2x16snorm(w);
+    return vec3<f32>(xy, sqrt(max(1.0 - dot(xy, xy), 0.0)));
+}
+
 fn unpack_layer_texels(w: vec4<u32>) -> LayerTexels {
-    let coat = unpack2x16unorm(w.x);
-    let sheen_specular = unpack2x16unorm(w.y);
-    return LayerTexels(coat.x, coat.y, sheen_specular.x, sheen_specular.y, unpack_unorm10x3(w.z),
-        unpack_unorm10x3(w.w));
+    let factors = unpack4x8unorm(w.x);
+    return LayerTexels(factors.x, factors.y, factors.z, factors.w, unpack_unorm10x3(w.z), unpack_unorm10x3(w.w),
+        unpack_coat_normal(w.y));
 }
 
 // Surface `s` with its layer factors times the texels `t`, clamped as
@@ -64,4 +74,14 @@ fn pixel_surface(s: Surface, words: vec4<u32>) -> Surface {
         return s;
     }
     return with_layer_texels(s, unpack_layer_texels(words));
+}
+
+// The BRDF `b` of surface `s` at a G-buffer pixel whose fifth target holds
+// `words`: its coat on the coat's own normal there (LAYERED scenes only;
+// +z, the base's, but where a clearcoatNormalTexture bends it).
+fn pixel_coat(b: Bsdf, s: Surface, words: vec4<u32>) -> Bsdf {
+    if (!LAYERED || s.layer_textures == 0xffffffffu || words.y == 0u) {
+        return b;
+    }
+    return with_coat_normal(b, unpack_coat_normal(words.y));
 }

@@ -102,10 +102,12 @@ fn fs_main(in: SplatVertex) -> @location(0) vec4<f32> {
     var weight = radiance_per_power(albedo.rgb, params.radius) * k;
     var surface = surfaces.all[u32(g.w)];
     if (GLOSSY && surface.glossy != 0u) {
+        var layers = vec4<u32>(0u);
         if (LAYERED) {
-            surface = pixel_surface(surface, textureLoad(gbuffer_layers, pixel, 0));
+            layers = textureLoad(gbuffer_layers, pixel, 0);
+            surface = pixel_surface(surface, layers);
         }
-        let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
+        let b = pixel_coat(pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w), surface, layers);
         let eye = unit(params.camera_position - position.xyz);
         weight = photon_brdf(b, eye, normal, direction, k) * radiance_per_weighted_power(params.radius);
     }

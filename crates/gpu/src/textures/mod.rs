@@ -24,9 +24,12 @@
 //!   translation), then the word offset of each level (a view shares its
 //!   image's levels).
 //! * per material with clear-coat, sheen or specular textures
-//!   (`LayerTextures`), in material order, six words: those textures' view
-//!   references (`texture_ref`; `NO_TEXTURE` for none) in `LayerTextures::all`'s
-//!   order; `GpuSurface::layer_textures` holds where its six start
+//!   (`LayerTextures`) or a coat apart from its base's normal
+//!   (`MaterialTextures::coat_apart`), in material order,
+//!   eight words: those textures' view references (`texture_ref`;
+//!   `NO_TEXTURE` for none) in `LayerTextures::all`'s order, then the coat
+//!   normal texture's reference and its scale's f32 bits;
+//!   `GpuSurface::layer_textures` holds where its eight start
 //!   (`TextureViews::layer_table`).
 //! * the levels' texels, row by row from the top, `pack4x8unorm` order
 //!   (r in the low byte).
@@ -94,8 +97,9 @@ pub struct TextureViews {
     layer_tables: Vec<Option<u32>>,
 }
 
-/// Words of one material's layer-texture table: `LayerTextures::all`.
-pub const LAYER_TABLE_WORDS: usize = 6;
+/// Words of one material's layer-texture table: `LayerTextures::all`, the
+/// clear coat's normal texture and its scale.
+pub const LAYER_TABLE_WORDS: usize = 8;
 
 impl TextureViews {
     pub fn of(texturing: &Texturing) -> TextureViews {
@@ -103,7 +107,7 @@ impl TextureViews {
             TextureViews { images: texturing.images.len() as u32, transformed: Vec::new(), layer_tables: Vec::new() };
         let mut tables = 0;
         for m in &texturing.materials {
-            let table = m.is_some_and(|m| m.layers.any()).then(|| {
+            let table = m.is_some_and(|m| m.layers.any() || m.coat_apart()).then(|| {
                 tables += 1;
                 tables - 1
             });
@@ -111,7 +115,7 @@ impl TextureViews {
         }
         for m in texturing.materials.iter().flatten() {
             let transmission = m.transmission.and_then(|t| t.texture);
-            let own = [m.base_color, m.metallic_roughness, m.emissive, m.normal, transmission];
+            let own = [m.base_color, m.metallic_roughness, m.emissive, m.normal, transmission, m.coat_normal];
             for t in own.into_iter().chain(m.layers.all()).flatten() {
                 if t.transform != glam::Affine2::IDENTITY && !views.transformed.contains(&(t.image, t.transform)) {
                     views.transformed.push((t.image, t.transform));
@@ -132,7 +136,7 @@ impl TextureViews {
 
     /// Where material `material`'s layer-texture table starts in the
     /// packed words (`GpuSurface::layer_textures`); `NO_TEXTURE` where it
-    /// has no clear-coat, sheen or specular texture.
+    /// has no clear-coat, sheen, specular or coat normal texture.
     pub fn layer_table(&self, material: u32) -> u32 {
         match self.layer_tables.get(material as usize).copied().flatten() {
             Some(k) => (HEADER_WORDS + VIEW_WORDS * self.count() + LAYER_TABLE_WORDS * k as usize) as u32,
@@ -265,6 +269,8 @@ pub fn pack(texturing: &Texturing, bvh: Option<&FlatBvh>) -> Vec<u32> {
             for (k, t) in m.layers.all().into_iter().enumerate() {
                 words[table as usize + k] = views.reference(t);
             }
+            words[table as usize + 6] = views.reference(m.coat_normal);
+            words[table as usize + 7] = m.coat_normal_scale.to_bits();
         }
     }
     // The images' levels, and where each starts.

@@ -58,8 +58,9 @@ fn surface_point(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> Sur
 }
 
 // The clear-coat, sheen and specular textures' texels at the point
-// (Texturing::apply's `LayerTextures::apply`), from the six references at
-// `s.layer_textures` (textures/mod.rs's layer-texture tables).
+// (Texturing::apply's `LayerTextures::apply`), from the first six
+// references at `s.layer_textures` (textures/mod.rs's layer-texture
+// tables); the coat normal is the caller's (`coat_normal`, `coat_normal_at_hit`).
 fn layer_texels(s: Surface, uv: vec3<f32>, dx: vec2<f32>, dy: vec2<f32>) -> LayerTexels {
     var t = no_layer_texels();
     if (!LAYERED || s.layer_textures == NO_TEXTURE || uv.z == 0.0) {
@@ -165,11 +166,80 @@ fn bent_normal(
     if (!reads_normal_texture(s, uv)) {
         return n;
     }
-    var axes = stored_uv_axes(tangent.xyz, tangent.w, n);
-    if (!axes.found) {
-        axes = derived_uv_axes(dx, dy, px, py);
-    }
+    let axes = fragment_uv_axes(dx, dy, px, py, tangent, n);
     let bent = bend_by_texel(s, texture_lookup(s.normal_texture, uv, dx, dy).value, axes, n);
+    return lifted_for_view(bent, n, ng, dir);
+}
+
+// A fragment's texture frame: its interpolated `tangent` (w its triangle's
+// side) where the triangle has stored tangents, else solved from the
+// fragment's derivatives.
+fn fragment_uv_axes(dx: vec2<f32>, dy: vec2<f32>, px: vec3<f32>, py: vec3<f32>, tangent: vec4<f32>, n: vec3<f32>) -> UvAxes {
+    let stored = stored_uv_axes(tangent.xyz, tangent.w, n);
+    if (stored.found) {
+        return stored;
+    }
+    return derived_uv_axes(dx, dy, px, py);
+}
+
+// The texture frame at a ray's hit on BVH primitive `prim` (barycentrics
+// `b`, edges `e1`, `e2`): its stored tangents interpolated, else the frame
+// of its corners' coordinates.
+fn hit_uv_axes(prim: u32, b: vec2<f32>, e1: vec3<f32>, e2: vec3<f32>, n: vec3<f32>) -> UvAxes {
+    let t = primitive_corner_tangents(prim);
+    let tangent = t.t0.xyz * (1.0 - b.x - b.y) + t.t1.xyz * b.x + t.t2.xyz * b.y;
+    let stored = stored_uv_axes(tangent, t.t0.w, n);
+    if (stored.found) {
+        return stored;
+    }
+    let edges = primitive_uv_edges(prim);
+    return derived_uv_axes(edges.xy, edges.zw, e1, e2);
+}
+
+// Surface `s`'s clearcoatNormalTexture (the seventh word of its layer
+// table; NO_TEXTURE: none) and its scale (the eighth, as f32 bits).
+fn coat_normal_texture(s: Surface) -> u32 {
+    if (!LAYERED || s.layer_textures == NO_TEXTURE) {
+        return NO_TEXTURE;
+    }
+    return texture_data[s.layer_textures + 6u];
+}
+
+fn coat_normal_scale(s: Surface) -> f32 {
+    return bitcast<f32>(texture_data[s.layer_textures + 7u]);
+}
+
+// The surface's coat lies apart from its base's shading normal at a point
+// of coordinates `uv` (MaterialTextures::coat_apart): a layer table, and
+// a clear-coat normal texture or a normal texture (a coat over a normal
+// texture lies on the unbent normal).
+fn coat_apart(s: Surface, uv: vec3<f32>) -> bool {
+    return coat_normal_texture(s) != NO_TEXTURE && uv.z != 0.0
+        || (LAYERED && s.layer_textures != NO_TEXTURE && reads_normal_texture(s, uv));
+}
+
+// The clear coat's own normal at a fragment (`bent_normal`'s arguments):
+// the unbent `n` bent by the coat normal texture and lifted for the view
+// (hikari_core::texture::Texturing::coat_normal and Scene::coat_tilted);
+// `n` where the surface has none (a coat over a normal texture).
+fn coat_normal(
+    s: Surface,
+    uv: vec3<f32>,
+    dx: vec2<f32>,
+    dy: vec2<f32>,
+    px: vec3<f32>,
+    py: vec3<f32>,
+    tangent: vec4<f32>,
+    n: vec3<f32>,
+    ng: vec3<f32>,
+    dir: vec3<f32>,
+) -> vec3<f32> {
+    if (coat_normal_texture(s) == NO_TEXTURE || uv.z == 0.0) {
+        return n;
+    }
+    let axes = fragment_uv_axes(dx, dy, px, py, tangent, n);
+    let t = coat_normal_texture(s);
+    let bent = bend_by(t, coat_normal_scale(s), texture_lookup(t, uv, dx, dy).value, axes, n);
     return lifted_for_view(bent, n, ng, dir);
 }
 
@@ -230,15 +300,30 @@ fn bent_normal_at_hit(
     if (!reads_normal_texture(s, uv)) {
         return n;
     }
-    let t = primitive_corner_tangents(prim);
-    let tangent = t.t0.xyz * (1.0 - b.x - b.y) + t.t1.xyz * b.x + t.t2.xyz * b.y;
-    var axes = stored_uv_axes(tangent, t.t0.w, n);
-    if (!axes.found) {
-        let edges = primitive_uv_edges(prim);
-        axes = derived_uv_axes(edges.xy, edges.zw, e1, e2);
-    }
+    let axes = hit_uv_axes(prim, b, e1, e2, n);
     let texel = texture_lookup(s.normal_texture, uv, vec2<f32>(0.0), vec2<f32>(0.0)).value;
     return lifted_for_view(bend_by_texel(s, texel, axes, n), n, ng, dir);
+}
+
+// `coat_normal` at a ray's hit (`bent_normal_at_hit`'s arguments; `n` unbent).
+fn coat_normal_at_hit(
+    s: Surface,
+    uv: vec3<f32>,
+    prim: u32,
+    b: vec2<f32>,
+    e1: vec3<f32>,
+    e2: vec3<f32>,
+    n: vec3<f32>,
+    ng: vec3<f32>,
+    dir: vec3<f32>,
+) -> vec3<f32> {
+    if (coat_normal_texture(s) == NO_TEXTURE || uv.z == 0.0) {
+        return n;
+    }
+    let axes = hit_uv_axes(prim, b, e1, e2, n);
+    let texture = coat_normal_texture(s);
+    let texel = texture_lookup(texture, uv, vec2<f32>(0.0), vec2<f32>(0.0)).value;
+    return lifted_for_view(bend_by(texture, coat_normal_scale(s), texel, axes, n), n, ng, dir);
 }
 
 // The largest finite f32 (f32::MAX): `x <= F32_MAX` is Rust's is_finite for
@@ -300,18 +385,20 @@ fn image_axes(t: u32, axes: UvAxes) -> UvAxes {
 // `n` bent by the normal texture's `texel` in the frame `axes` of the
 // surface's coordinates: hikari_core::texture::bend, after image_axes.
 fn bend_by_texel(s: Surface, texel: vec4<f32>, surface_axes: UvAxes, n: vec3<f32>) -> vec3<f32> {
+    return bend_by(s.normal_texture, s.normal_scale, texel, surface_axes, n);
+}
+
+// `bend_by_texel` for the tangent-space normal texture `texture` of x and
+// y scale `scale` (the base's or the clear coat's).
+fn bend_by(texture: u32, scale: f32, texel: vec4<f32>, surface_axes: UvAxes, n: vec3<f32>) -> vec3<f32> {
     if (!surface_axes.found) {
         return n;
     }
-    let axes = image_axes(s.normal_texture, surface_axes);
+    let axes = image_axes(texture, surface_axes);
     if (!axes.found) {
         return n;
     }
-    let local = vec3<f32>(
-        (2.0 * texel.x - 1.0) * s.normal_scale,
-        (2.0 * texel.y - 1.0) * s.normal_scale,
-        2.0 * texel.z - 1.0,
-    );
+    let local = vec3<f32>((2.0 * texel.x - 1.0) * scale, (2.0 * texel.y - 1.0) * scale, 2.0 * texel.z - 1.0);
     // Gram–Schmidt against the shading normal; the bitangent keeps the side
     // of the image's up (mirrored textures). Normalised as glam's
     // normalize_or_zero (× the reciprocal length), so the tracer keeps the

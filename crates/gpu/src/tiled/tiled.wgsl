@@ -261,11 +261,13 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(global_invocation_id) 
     // A glossy surface weights each photon by its BRDF (photon_brdf) in
     // the sum; a Lambertian one applies ρ/(π² r²) to the sum of powers.
     var surface = surfaces.all[u32(g.w)];
+    var layers = vec4<u32>(0u);
     if (LAYERED) {
-        surface = pixel_surface(surface, textureLoad(gbuffer_layers, pixel, 0));
+        layers = textureLoad(gbuffer_layers, pixel, 0);
+        surface = pixel_surface(surface, layers);
     }
     let glossy = GLOSSY && surface.glossy != 0u;
-    let b = pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w);
+    let b = pixel_coat(pixel_bsdf(surface, albedo.rgb, textureLoad(gbuffer_emission, pixel, 0).w), surface, layers);
     let eye = unit(media.camera_position - position.xyz);
     // Only visible diffuse surfaces (kind 0) take photon light.
     if (position.w != 0.0 && pixel_kind(albedo.a) == 0u) {

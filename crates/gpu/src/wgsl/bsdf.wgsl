@@ -27,6 +27,9 @@ struct Bsdf {
     sheen_roughness: f32,
     // KHR_materials_specular's colour: scales F0 per channel.
     specular_color: vec3<f32>,
+    // The coat's own normal in the shading frame (+z: the base's; a
+    // clearcoatNormalTexture tilts it, `with_coat_normal`).
+    coat_normal: vec3<f32>,
 }
 
 // The largest f32 below 1 (clearcoat.rs's ONE_BELOW).
@@ -411,6 +414,45 @@ fn coat_is_gathered(b: Bsdf) -> bool {
     return b.clearcoat_roughness >= GATHER_ROUGHNESS;
 }
 
+// Bsdf::with_coat_normal: `n` (shading frame) normalised; +z where it is
+// at or below the base's horizon or not a direction.
+fn with_coat_normal(b: Bsdf, n: vec3<f32>) -> Bsdf {
+    var out = b;
+    let len2 = dot(n, n);
+    let recip = 1.0 / sqrt(len2);
+    out.coat_normal = vec3<f32>(0.0, 0.0, 1.0);
+    if (recip > 0.0 && recip <= 3.0e38) {
+        let unit_n = n * recip;
+        if (unit_n.z > 0.0) {
+            out.coat_normal = unit_n;
+        }
+    }
+    return out;
+}
+
+// The coat lies apart from the base. Only LAYERED scenes (clear-coat
+// normal textures among the layer textures) tilt a coat.
+fn coat_is_tilted(b: Bsdf) -> bool {
+    return LAYERED && any(b.coat_normal != vec3<f32>(0.0, 0.0, 1.0));
+}
+
+// `w` (shading frame) in the coat's frame (Bsdf::to_coat).
+fn to_coat(b: Bsdf, w: vec3<f32>) -> vec3<f32> {
+    if (!coat_is_tilted(b)) {
+        return w;
+    }
+    return to_shading(w, b.coat_normal);
+}
+
+// `w` (coat's frame) in the shading frame (Bsdf::from_coat).
+fn from_coat(b: Bsdf, w: vec3<f32>) -> vec3<f32> {
+    if (!coat_is_tilted(b)) {
+        return w;
+    }
+    let basis = orthonormal_basis(b.coat_normal);
+    return basis.t * w.x + basis.b * w.y + b.coat_normal * w.z;
+}
+
 fn coat_alpha(b: Bsdf) -> f32 {
     return max(b.clearcoat_roughness * b.clearcoat_roughness, ALPHA_MIN);
 }
@@ -432,14 +474,16 @@ fn coat_specular_through(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
     return sqrt(coat_transmission(b, cos_o) * coat_transmission(b, cos_i));
 }
 
-// The base's lobes as the coat leaves them (the sheen dimmed like the specular lobe).
-fn under_coat(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, lobes: Lobes) -> vec3<f32> {
-    return lobes.diffuse * coat_diffuse_through(b, wo.z, wi.z)
-        + (lobes.specular + lobes.sheen) * coat_specular_through(b, wo.z, wi.z);
+// The base's lobes as the coat leaves them between directions at cosines
+// `cos_o`, `cos_i` to the coat's normal (the sheen dimmed like the specular lobe).
+fn under_coat(b: Bsdf, cos_o: f32, cos_i: f32, lobes: Lobes) -> vec3<f32> {
+    return lobes.diffuse * coat_diffuse_through(b, cos_o, cos_i)
+        + (lobes.specular + lobes.sheen) * coat_specular_through(b, cos_o, cos_i);
 }
 
+// The coat's lobe between `wo` and `wi` in the coat's frame.
 fn coat_lobe(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if (coat_is_smooth(b)) {
+    if (coat_is_smooth(b) || wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
     let h = unit(wo + wi);
@@ -449,6 +493,9 @@ fn coat_lobe(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 }
 
 fn coat_probability(b: Bsdf, cos_o: f32) -> f32 {
+    if (cos_o <= 0.0) {
+        return 0.0;
+    }
     let coat = coat_fresnel(b, cos_o);
     let e = bsdf_base_albedo_estimate(b);
     let base = (1.0 - coat) * max(e.x, max(e.y, e.z));
@@ -462,25 +509,34 @@ fn coated_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3<f32> {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
-    return under_coat(b, wo, wi, bsdf_f_lobes(b, wo, wi, k)) + vec3<f32>(coat_lobe(b, wo, wi));
+    let co = to_coat(b, wo);
+    let ci = to_coat(b, wi);
+    return under_coat(b, co.z, ci.z, bsdf_f_lobes(b, wo, wi, k)) + vec3<f32>(coat_lobe(b, co, ci));
 }
 
 fn coated_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
-    let p = coat_probability(b, wo.z);
+    let co = to_coat(b, wo);
+    let p = coat_probability(b, co.z);
     var pdf = (1.0 - p) * bsdf_base_pdf(b, wo, wi);
-    if (!coat_is_smooth(b)) {
-        pdf += p * ggx_reflection_pdf(wo, unit(wo + wi), coat_alpha(b));
+    let ci = to_coat(b, wi);
+    if (!coat_is_smooth(b) && ci.z > 0.0 && p > 0.0) {
+        pdf += p * ggx_reflection_pdf(co, unit(co + ci), coat_alpha(b));
     }
     return pdf;
 }
 
-// The smooth coat's mirror at wo, chosen with probability p.
-fn coat_mirror(b: Bsdf, wo: vec3<f32>, p: f32) -> BsdfSample {
-    let fc = coat_fresnel(b, wo.z);
-    return BsdfSample(vec3<f32>(-wo.x, -wo.y, wo.z), p, vec3<f32>(fc / wo.z), true, vec3<f32>(fc / p), true, true);
+// The smooth coat's mirror at `co` (the view in the coat's frame), chosen
+// with probability p; none where it leaves below the base.
+fn coat_mirror(b: Bsdf, co: vec3<f32>, p: f32) -> BsdfSample {
+    let wi = from_coat(b, vec3<f32>(-co.x, -co.y, co.z));
+    if (wi.z <= 0.0) {
+        return no_bsdf_sample();
+    }
+    let fc = coat_fresnel(b, co.z);
+    return BsdfSample(wi, p, vec3<f32>(fc / wi.z), true, vec3<f32>(fc / p), true, true);
 }
 
 fn coated_finish(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, followed: bool) -> BsdfSample {
@@ -499,20 +555,24 @@ fn coated_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSampl
     if (wo.z <= 0.0) {
         return no_bsdf_sample();
     }
-    let p = coat_probability(b, wo.z);
+    let co = to_coat(b, wo);
+    let p = coat_probability(b, co.z);
     if (u_lobe < p) {
         if (coat_is_smooth(b)) {
-            return coat_mirror(b, wo, p);
+            return coat_mirror(b, co, p);
         }
-        let wi = ggx_reflect(wo, ggx_sample_visible_normal(wo, coat_alpha(b), u));
-        return coated_finish(b, wo, wi, !coat_is_gathered(b));
+        let ci = ggx_reflect(co, ggx_sample_visible_normal(co, coat_alpha(b), u));
+        return coated_finish(b, wo, from_coat(b, ci), !coat_is_gathered(b));
     }
     let s = bsdf_base_sample(b, wo, min((u_lobe - p) / (1.0 - p), ONE_BELOW), u);
     if (!s.valid) {
         return s;
     }
     if (s.is_delta) {
-        let through = coat_transmission(b, wo.z);
+        var through = coat_transmission(b, wo.z);
+        if (coat_is_tilted(b)) {
+            through = coat_specular_through(b, co.z, to_coat(b, s.wi).z);
+        }
         let pdf = (1.0 - p) * s.pdf;
         return BsdfSample(s.wi, pdf, s.f * through, true, s.f * (through * wo.z / pdf), s.followed, true);
     }
@@ -523,13 +583,14 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     if (wo.z <= 0.0) {
         return no_bsdf_sample();
     }
+    let co = to_coat(b, wo);
     var coat = 0.0;
-    if (!coat_is_gathered(b)) {
-        coat = coat_fresnel(b, wo.z);
+    if (!coat_is_gathered(b) && co.z > 0.0) {
+        coat = coat_fresnel(b, co.z);
     }
     var base = 0.0;
     if (bsdf_has_specular(b) && !bsdf_gathers_specular(b)) {
-        base = coat_transmission(b, wo.z) * max(rgb_mean(bsdf_specular_fresnel(b, wo.z)), MIN_LOBE_WEIGHT);
+        base = coat_transmission(b, co.z) * max(rgb_mean(bsdf_specular_fresnel(b, wo.z)), MIN_LOBE_WEIGHT);
     }
     if (coat + base <= 0.0) {
         return no_bsdf_sample();
@@ -538,16 +599,17 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     if (u.x < p) {
         let uc = vec2<f32>(min(u.x / p, ONE_BELOW), u.y);
         if (coat_is_smooth(b)) {
-            return coat_mirror(b, wo, p);
+            return coat_mirror(b, co, p);
         }
         let alpha = coat_alpha(b);
-        let h = ggx_sample_visible_normal(wo, alpha, uc);
-        let wi = ggx_reflect(wo, h);
-        let pdf = p * ggx_reflection_pdf(wo, h, alpha);
-        if (wi.z <= 0.0 || pdf <= 0.0) {
+        let h = ggx_sample_visible_normal(co, alpha, uc);
+        let ci = ggx_reflect(co, h);
+        let wi = from_coat(b, ci);
+        let pdf = p * ggx_reflection_pdf(co, h, alpha);
+        if (wi.z <= 0.0 || ci.z <= 0.0 || pdf <= 0.0) {
             return no_bsdf_sample();
         }
-        let f = vec3<f32>(coat_lobe(b, wo, wi));
+        let f = vec3<f32>(coat_lobe(b, co, ci));
         return BsdfSample(wi, pdf, f, false, f * (wi.z / pdf), true, true);
     }
     let ub = vec2<f32>(min((u.x - p) / (1.0 - p), ONE_BELOW), u.y);
@@ -555,7 +617,7 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     if (!s.valid) {
         return s;
     }
-    let through = coat_specular_through(b, wo.z, s.wi.z);
+    let through = coat_specular_through(b, co.z, to_coat(b, s.wi).z);
     return BsdfSample(s.wi, (1.0 - p) * s.pdf, s.f * through, s.is_delta, s.weight * (through / (1.0 - p)), s.followed, true);
 }
 
@@ -617,11 +679,13 @@ fn bsdf_f_gathered_bumped(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3
     if (wo.z <= 0.0 || wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
+    let co = to_coat(b, wo);
+    let ci = to_coat(b, wi);
     var coat = 0.0;
     if (coat_is_gathered(b)) {
-        coat = coat_lobe(b, wo, wi);
+        coat = coat_lobe(b, co, ci);
     }
-    return under_coat(b, wo, wi, lobes) + vec3<f32>(coat);
+    return under_coat(b, co.z, ci.z, lobes) + vec3<f32>(coat);
 }
 
 // Photons are stored here (Bsdf::stores_photons).
@@ -698,14 +762,14 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // G-buffer's, textures applied; `s.albedo` where no texture is).
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
     return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
-        s.sheen_color, s.sheen_roughness, s.specular_color);
+        s.sheen_color, s.sheen_roughness, s.specular_color, vec3<f32>(0.0, 0.0, 1.0));
 }
 
 // The BRDF of glossy surface `s` at a point whose textures gave `base`,
 // `metallic` and `roughness` (textures.wgsl's `surface_point`).
 fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsdf {
     return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
-        s.sheen_color, s.sheen_roughness, s.specular_color);
+        s.sheen_color, s.sheen_roughness, s.specular_color, vec3<f32>(0.0, 0.0, 1.0));
 }
 
 // The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the

@@ -192,6 +192,8 @@ fn advance(
         }
         Material::Pbr(bsdf) => {
             let frame = ShadingFrame::new(ns);
+            let tilted = scene.coat_tilted(bsdf, hit, hit.shading_normal, path.ray.dir, &frame);
+            let bsdf = tilted.as_ref().unwrap_or(bsdf);
             let wo = frame.to_local(-path.ray.dir);
             // A normal-mapped point's diffuse lobes: Cycles' bump shadowing
             // of the light's direction (none where nothing bends).

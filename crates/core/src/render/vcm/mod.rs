@@ -363,7 +363,8 @@ impl Pass<'_> {
             let (point, scatter) = match step.event {
                 Event::Escaped => break,
                 Event::Surface { hit, unbent } => {
-                    let scatter_of = |m: &Material| Scatter::at(*m, &hit, unbent, ray.dir, Transport::Importance);
+                    let scatter_of =
+                        |m: &Material| Scatter::in_scene(self.scene, *m, &hit, unbent, ray.dir, Transport::Importance);
                     if self.strategies.merge() && self.scene.mixes_at(&hit) {
                         let drawn = self.scene.drawn_material_at(&hit);
                         store_weight = drawn.store_weight(|m| scatter_of(m).is_some_and(|s| !s.is_delta()));
@@ -514,7 +515,7 @@ impl Pass<'_> {
                         color += throughput * found.radiance * weight;
                     }
                     let material = *self.scene.material_at(&hit);
-                    (hit.point, Scatter::at(material, &hit, unbent, ray.dir, Transport::Radiance))
+                    (hit.point, Scatter::in_scene(self.scene, material, &hit, unbent, ray.dir, Transport::Radiance))
                 }
                 Event::Medium { point, mask } => {
                     let scatter = Scatter::medium(&self.scene.media, mask, ray.dir);

@@ -190,6 +190,28 @@ impl Scatter {
         })
     }
 
+    /// [`Scatter::at`] for a vertex of `scene`: `material`'s clear coat on
+    /// its own normal where a `clearcoatNormalTexture` bends it
+    /// ([`crate::scene::Scene::coat_tilted`], in the frame `at` shades in).
+    pub fn in_scene(
+        scene: &crate::scene::Scene,
+        material: Material,
+        hit: &Hit,
+        unbent: Vec3,
+        dir: Vec3,
+        mode: Transport,
+    ) -> Option<Scatter> {
+        let material = match material {
+            Material::Pbr(bsdf) if bsdf.has_coat() => {
+                let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
+                let frame = ShadingFrame::new(hit.shading_normal * facing);
+                scene.coat_tilted(&bsdf, hit, unbent, dir, &frame).map_or(material, Material::Pbr)
+            }
+            other => other,
+        };
+        Scatter::at(material, hit, unbent, dir, mode)
+    }
+
     /// The vertex in the media of `mask`, reached along `dir`; None where
     /// nothing there scatters.
     pub fn medium(media: &Media, mask: u32, dir: Vec3) -> Option<Scatter> {

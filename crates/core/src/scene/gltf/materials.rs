@@ -21,7 +21,7 @@ use super::textures::Images;
 use crate::bsdf::Bsdf;
 use crate::bsdf::dielectric::Dielectric;
 use crate::material::{Material, Rgb};
-use crate::texture::{AlphaMode, ColorSpace, LayerTextures, MaterialTextures, Transmission};
+use crate::texture::{AlphaMode, ColorSpace, LayerTextures, MaterialTextures, TextureRef, Transmission};
 use glam::{Vec3, Vec4Swizzles};
 
 /// Light a surface emits: `emissiveFactor` × `KHR_materials_emissive_strength`,
@@ -51,7 +51,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
     let mut other_sets = 0;
     let mut mixed_volumes = 0;
     let mut missing_layer_textures = 0;
-    let mut coat_normals = 0;
     let mut malformed_coats = 0;
     let mut coated_glass = 0;
     let mut malformed_sheens = 0;
@@ -93,13 +92,14 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 transmission_info.as_ref().and_then(|info| images.texture(info, ColorSpace::Linear));
             other_sets += (transmission_info.is_some() && transmission_texture.is_none()) as usize;
             let coat = Clearcoat::of(&m);
-            coat_normals += coat.normal_textured as usize;
+            let (coat_normal, unread_coat_normal, missing_coat_normal) = coat_normal_of(doc, &m, images);
+            other_sets += unread_coat_normal as usize;
             malformed_coats += coat.malformed as usize;
             let sheen = Sheen::of(&m);
             malformed_sheens += sheen.malformed as usize;
             let (layers, unread_layers, missing) = layer_textures_of(doc, &m, images);
             other_sets += unread_layers as usize;
-            missing_layer_textures += missing as usize;
+            missing_layer_textures += (missing || missing_coat_normal) as usize;
             let transmits = transmission > 0.0;
             // Glass throughout: all of it transmits, nothing metallic
             // (`texture::Transmission` draws any other share per hit).
@@ -162,6 +162,10 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
                 alpha_mode,
                 normal: normal.map(|(t, _)| t),
                 normal_scale: normal.map_or(1.0, |(_, scale)| if scale.is_finite() { scale } else { 1.0 }),
+                // A coat normal matters only under a coat.
+                coat_normal: coat_normal.filter(|_| coat.factor > 0.0).map(|(t, _)| t),
+                coat_normal_scale: coat_normal.map_or(1.0, |(_, scale)| scale),
+                coat_unbent: coat.factor > 0.0 && coat_normal.is_none() && normal.is_some(),
                 layers,
                 transmission: mix,
             };
@@ -193,12 +197,6 @@ pub fn convert(doc: &gltf::Document, images: &Images, notes: &mut Vec<String>) -
         notes.push(format!(
             "{missing_layer_textures} material(s) have a clear-coat or sheen texture whose index names no texture of \
              the file: ignored (the factor applies alone)"
-        ));
-    }
-    if coat_normals > 0 {
-        notes.push(format!(
-            "{coat_normals} material(s) have a clearcoatNormalTexture, which is not read: the coat takes the base's \
-             shading normal"
         ));
     }
     if malformed_coats > 0 {
@@ -300,8 +298,6 @@ pub const CLEARCOAT: &str = "KHR_materials_clearcoat";
 struct Clearcoat {
     factor: f32,
     roughness: f32,
-    /// It names a coat normal texture (which hikari does not read).
-    normal_textured: bool,
     /// A factor is not a number (read as the default, 0).
     malformed: bool,
 }
@@ -309,19 +305,14 @@ struct Clearcoat {
 impl Clearcoat {
     fn of(m: &gltf::Material) -> Clearcoat {
         let Some(v) = m.extension_value(CLEARCOAT) else {
-            return Clearcoat { factor: 0.0, roughness: 0.0, normal_textured: false, malformed: false };
+            return Clearcoat { factor: 0.0, roughness: 0.0, malformed: false };
         };
         let malformed = ["clearcoatFactor", "clearcoatRoughnessFactor"]
             .iter()
             .any(|key| v.get(*key).is_some_and(|x| !x.is_number()));
         // The specification's defaults are 0.
         let number = |key: &str| sane(Vec3::splat(v.get(key).and_then(|x| x.as_f64()).unwrap_or(0.0) as f32), 1.0).x;
-        Clearcoat {
-            factor: number("clearcoatFactor"),
-            roughness: number("clearcoatRoughnessFactor"),
-            normal_textured: v.get("clearcoatNormalTexture").is_some(),
-            malformed,
-        }
+        Clearcoat { factor: number("clearcoatFactor"), roughness: number("clearcoatRoughnessFactor"), malformed }
     }
 }
 
@@ -398,6 +389,29 @@ fn layer_textures_of(doc: &gltf::Document, m: &gltf::Material, images: &Images) 
     }
     let read = layers.all().iter().flatten().count();
     (layers, read < named, missing)
+}
+
+/// A material's `clearcoatNormalTexture` and its `scale` (1 if absent or
+/// not a finite number), whether it is named but reads a texture coordinate
+/// set other than 0 (unread), and whether its index names no texture.
+fn coat_normal_of(
+    doc: &gltf::Document,
+    m: &gltf::Material,
+    images: &Images,
+) -> (Option<(TextureRef, f32)>, bool, bool) {
+    let Some(info) = m.extension_value(CLEARCOAT).and_then(|v| v.get("clearcoatNormalTexture")) else {
+        return (None, false, false);
+    };
+    let index = info.get("index").and_then(|i| i.as_u64());
+    if index.is_none_or(|i| i >= doc.textures().len() as u64) {
+        return (None, false, true);
+    }
+    let scale = info.get("scale").and_then(|s| s.as_f64()).map_or(1.0, |s| s as f32);
+    let scale = if scale.is_finite() { scale } else { 1.0 };
+    match images.from_json(doc, info, ColorSpace::Linear) {
+        Some(texture) => (Some((texture, scale)), false, false),
+        None => (None, true, false),
+    }
 }
 
 /// Each component made finite and clamped to [0, max] (the specification's

@@ -190,7 +190,8 @@ pub fn asset_from_bytes(
     let materials::Converted { materials, emissions, textures, names: material_names } =
         materials::convert(&gltf.document, &images, &mut notes);
     let textured: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.is_textured())).collect();
-    let normal_mapped: Vec<bool> = textures.iter().map(|t| t.is_some_and(|t| t.normal.is_some())).collect();
+    let normal_mapped: Vec<bool> =
+        textures.iter().map(|t| t.is_some_and(|t| t.normal.is_some() || t.coat_apart())).collect();
     let mut walk = Walk {
         file: &file,
         buffers: &buffers,

@@ -105,11 +105,15 @@ pub fn extension_textures<'v>(
 }
 
 /// The clear coat's and the sheen's textures hikari reads, with their
-/// colour spaces (the coat's normal texture is not read).
+/// colour spaces.
 pub const LAYER_JSON_TEXTURES: [(&str, &[(&str, ColorSpace)]); 2] = [
     (
         super::materials::CLEARCOAT,
-        &[("clearcoatTexture", ColorSpace::Linear), ("clearcoatRoughnessTexture", ColorSpace::Linear)],
+        &[
+            ("clearcoatTexture", ColorSpace::Linear),
+            ("clearcoatRoughnessTexture", ColorSpace::Linear),
+            ("clearcoatNormalTexture", ColorSpace::Linear),
+        ],
     ),
     (
         super::materials::SHEEN,
