@@ -695,8 +695,9 @@ impl Texturing {
     /// but bent by the material's `clearcoatNormalTexture` (from the same
     /// unbent `ns`: the specification's coat normal ignores the base's
     /// normal texture), `ns` itself for a coat over a normal texture
-    /// without one of its own. None where the coat lies on the base's
-    /// normal (`MaterialTextures::coat_apart`).
+    /// without one of its own; with whether the coat has its own texture.
+    /// None where the coat lies on the base's normal
+    /// (`MaterialTextures::coat_apart`).
     pub fn coat_normal(
         &self,
         material: u32,
@@ -704,9 +705,9 @@ impl Texturing {
         b: Vec2,
         corners: [glam::Vec3; 3],
         ns: glam::Vec3,
-    ) -> Option<glam::Vec3> {
+    ) -> Option<(glam::Vec3, bool)> {
         let t = self.textures(material).filter(|t| t.coat_apart())?;
-        Some(self.bent_by(t.coat_normal, t.coat_normal_scale, prim, b, corners, ns))
+        Some((self.bent_by(t.coat_normal, t.coat_normal_scale, prim, b, corners, ns), t.coat_normal.is_some()))
     }
 
     /// `ns` bent by the tangent-space normal texture `normal` of x and y

@@ -81,7 +81,7 @@ fn bsdf_words(b: &Bsdf) -> [f32; 16] {
 /// WGSL making `b` from the kernel's first 16 input words `w` (`bsdf_words`).
 /// Its coat lies on the base's normal (+z).
 const BSDF_FROM_WORDS: &str = "var b = Bsdf(vec3<f32>(w[0], w[1], w[2]), w[3], w[4], w[5], w[6], w[7], w[8], \
-     vec3<f32>(w[9], w[10], w[11]), w[12], vec3<f32>(w[13], w[14], w[15]), vec3<f32>(0.0, 0.0, 1.0));\n";
+     vec3<f32>(w[9], w[10], w[11]), w[12], vec3<f32>(w[13], w[14], w[15]), vec3<f32>(0.0, 0.0, 1.0), 1.0 / 21.0);\n";
 
 fn flags(s: &Option<BsdfSample>) -> u32 {
     s.map_or(0, |s| 1 | (s.is_delta as u32) << 1 | (s.followed as u32) << 2)

@@ -443,47 +443,50 @@ fn wgsl_layer_texel_packing_matches_the_cpu() {
     let ctx = test_context("wgsl_layer_texel_packing_matches_the_cpu");
     let mut rng = Rng::for_item(37, 0);
     let mut cases = Vec::new();
-    let mut input = vec![0u32; 4096 * 28];
-    for item in input.chunks_mut(28) {
-        // The coat normal's x and y from −0.7 to 0.7.
-        let t = LayerTexels::from_array(std::array::from_fn(|k| {
-            if k < 10 { rng.next_f32() } else { 1.4 * rng.next_f32() - 0.7 }
+    let mut input = vec![0u32; 4096 * 30];
+    for item in input.chunks_mut(30) {
+        // The coat normal's x and y from −0.7 to 0.7; on the unbent normal or not.
+        let t = LayerTexels::from_array(std::array::from_fn(|k| match k {
+            0..10 => rng.next_f32(),
+            10..12 => 1.4 * rng.next_f32() - 0.7,
+            _ => (rng.next_f32() < 0.5) as u32 as f32,
         }));
         for (slot, v) in item.iter_mut().zip(t.to_array()) {
             *slot = v.to_bits();
         }
         cases.push(t);
     }
-    let main = "let o = 28u * id.x; if (o >= arrayLength(&io)) { return; }\n\
-                var v: array<f32, 12>;\n\
-                for (var i = 0u; i < 12u; i++) { v[i] = bitcast<f32>(io[o + i]); }\n\
+    let main = "let o = 30u * id.x; if (o >= arrayLength(&io)) { return; }\n\
+                var v: array<f32, 13>;\n\
+                for (var i = 0u; i < 13u; i++) { v[i] = bitcast<f32>(io[o + i]); }\n\
                 let n = vec3<f32>(v[10], v[11], sqrt(max(1.0 - (v[10] * v[10] + v[11] * v[11]), 0.0)));\n\
-                let t = LayerTexels(v[0], v[1], v[2], v[3], vec3<f32>(v[4], v[5], v[6]), vec3<f32>(v[7], v[8], v[9]), n);\n\
+                let t = LayerTexels(v[0], v[1], v[2], v[3], vec3<f32>(v[4], v[5], v[6]), vec3<f32>(v[7], v[8], v[9]), n,\n\
+                    v[12] >= 0.5);\n\
                 let words = pack_layer_texels(t);\n\
-                for (var i = 0u; i < 4u; i++) { io[o + 12u + i] = words[i]; }\n\
+                for (var i = 0u; i < 4u; i++) { io[o + 13u + i] = words[i]; }\n\
                 let b = unpack_layer_texels(words);\n\
-                let back = array<f32, 12>(b.clearcoat, b.clearcoat_roughness, b.sheen_roughness, b.specular,\n\
+                let back = array<f32, 13>(b.clearcoat, b.clearcoat_roughness, b.sheen_roughness, b.specular,\n\
                     b.sheen_color.x, b.sheen_color.y, b.sheen_color.z, b.specular_color.x, b.specular_color.y,\n\
-                    b.specular_color.z, b.coat_normal.x, b.coat_normal.y);\n\
-                for (var i = 0u; i < 12u; i++) { io[o + 16u + i] = bitcast<u32>(back[i]); }";
+                    b.specular_color.z, b.coat_normal.x, b.coat_normal.y, select(0.0, 1.0, b.coat_unbent));\n\
+                for (var i = 0u; i < 13u; i++) { io[o + 17u + i] = bitcast<u32>(back[i]); }";
     let gpu = hikari_gpu::test_support::run_kernel(&ctx, &[&LAYER_TEXELS], main, &input);
     let fields = |w: [u32; 4]| {
         (0..4)
             .map(|k| w[0] >> (8 * k) & 255)
             .chain([w[1] & 0xffff, w[1] >> 16].map(|h| h as u16 as i16 as i32 as u32))
-            .chain([w[2], w[3]].into_iter().flat_map(|c| [c & 1023, c >> 10 & 1023, c >> 20 & 1023]))
+            .chain([w[2], w[3]].into_iter().flat_map(|c| [c & 1023, c >> 10 & 1023, c >> 20 & 1023, c >> 30]))
             .collect::<Vec<u32>>()
     };
     let mut exact = 0;
-    for (out, t) in gpu.chunks(28).zip(&cases) {
-        let words = [out[12], out[13], out[14], out[15]];
+    for (out, t) in gpu.chunks(30).zip(&cases) {
+        let words = [out[13], out[14], out[15], out[16]];
         let want = t.pack();
         exact += (words == want) as usize;
         for (got, want) in fields(words).into_iter().zip(fields(want)) {
             assert!((got as i32).abs_diff(want as i32) <= 1, "{t:?}: field {got} vs {want}");
         }
         for (k, want) in LayerTexels::unpack(words).to_array().into_iter().enumerate() {
-            let got = f32::from_bits(out[16 + k]);
+            let got = f32::from_bits(out[17 + k]);
             assert!((got - want).abs() <= 1e-6, "{t:?}: texel {k} read back {got} vs {want}");
         }
     }

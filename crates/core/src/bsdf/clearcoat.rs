@@ -47,14 +47,29 @@
 //! # The coat's own normal
 //!
 //! `clearcoatNormalTexture` bends the coat apart from the base: the coat's
-//! lobe, its Fresnel and what it lets through are then functions of the
-//! directions in the coat's frame (+z [`Bsdf::coat_normal`], given in the
-//! shading frame), the base's lobes of those in the shading frame, as in
-//! Cycles' Principled BSDF (its coat closure takes the coat normal, the
-//! base's dimming the view's angle to it). Neither side is lit from below:
+//! lobe, its Fresnel and what it lets through to the diffuse lobe are then
+//! functions of the directions in the coat's frame (+z
+//! [`Bsdf::coat_normal`], given in the shading frame), the base's lobes of
+//! those in the shading frame, as in Cycles' Principled BSDF (its coat
+//! closure takes the coat normal, the base's dimming the view's angle to
+//! it). The base's specular and sheen lobes are dimmed as under an
+//! untilted coat, by the cosines to the shading normal: taken to the
+//! coat's, √(T(θo)·T(θi)) darkened every mirror direction the tilt put
+//! near the coat's horizon (`scripts/cycles/coat_normal.py`'s metal ball
+//! under a bumpy coat 15% darker than Cycles, 7% so). Neither side is lit from below:
 //! a direction under either surface gets nothing from that surface's
-//! lobes. With the coat normal +z every function is the untilted one to
-//! the bit.
+//! lobes. Where the coat's own texture tilts it (`with_coat_normal`), the
+//! diffuse lobe's coupling keeps its normalisation: E becomes the coat's
+//! cosine-weighted mean reflectance over the base's hemisphere
+//! ([`tilted_schlick_mean`]), so that what the coat leaves of a Lambertian
+//! base is still T(θo) times its albedo, as in Cycles (without it a coat
+//! tilted 40° took 16% of the base's light: `scripts/cycles/coat_normal.py`'s
+//! orange-peel ball was 13% darker than Cycles). Where the coat lies on the
+//! unbent normal over a normal-mapped base (`with_unbent_coat`), E stays
+//! the untilted one: the directions below the coat's horizon are below the
+//! surface, lit by nothing anyway (normalising over them drew that ball 18%
+//! brighter than Cycles). With the coat normal +z every function is the
+//! untilted one to the bit.
 //!
 //! The WGSL twin is in `crates/gpu/src/wgsl/bsdf.wgsl`, pinned by
 //! `crates/gpu/tests/bsdf.rs`; keep the arithmetic the same on both sides.
@@ -80,8 +95,17 @@ impl Bsdf {
     /// `clearcoatNormalTexture`. One at or below the base's horizon, or
     /// not a direction, leaves the coat on the base's normal.
     pub fn with_coat_normal(self, normal: Vec3) -> Self {
+        let b = self.with_unbent_coat(normal);
+        Bsdf { coat_schlick_mean: tilted_schlick_mean(b.coat_normal.z), ..b }
+    }
+
+    /// This material with its coat on the surface's unbent normal
+    /// `normal` (shading frame) over a base a normal texture bent: tilted
+    /// as `with_coat_normal`, its mean reflectance the untilted coat's.
+    pub fn with_unbent_coat(self, normal: Vec3) -> Self {
         let n = normal.normalize_or_zero();
-        Bsdf { coat_normal: if n.z > 0.0 && n.is_finite() { n } else { Vec3::Z }, ..self }
+        let coat_normal = if n.z > 0.0 && n.is_finite() { n } else { Vec3::Z };
+        Bsdf { coat_normal, coat_schlick_mean: 1.0 / 21.0, ..self }
     }
 
     /// The coat lies apart from the base (its normal is not +z).
@@ -132,9 +156,14 @@ impl Bsdf {
     }
 
     /// What the coat leaves of the base's diffuse lobe between `cos_o` and
-    /// `cos_i`: T(θo)·T(θi)/(1 − E).
+    /// `cos_i`: T(θo)·T(θi)/(1 − E), E the coat's cosine-weighted mean
+    /// reflectance over the base's hemisphere.
     fn coat_diffuse_through(&self, cos_o: f32, cos_i: f32) -> f32 {
-        let mean_reflectance = self.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+        let mean_reflectance = if self.coat_is_tilted() {
+            self.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * self.coat_schlick_mean)
+        } else {
+            self.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0)
+        };
         self.coat_transmission(cos_o) * self.coat_transmission(cos_i) / (1.0 - mean_reflectance)
     }
 
@@ -172,15 +201,16 @@ impl Bsdf {
             return Rgb::ZERO;
         }
         let (co, ci) = (self.to_coat(wo), self.to_coat(wi));
-        self.under_coat(co.z, ci.z, self.f_lobes(wo, wi, k)) + Rgb::splat(self.coat_lobe(co, ci))
+        self.under_coat(wo, wi, co, ci, self.f_lobes(wo, wi, k)) + Rgb::splat(self.coat_lobe(co, ci))
     }
 
-    /// The base's lobes as the coat leaves them between directions at
-    /// cosines `cos_o` and `cos_i` to the coat's normal (the sheen dimmed
-    /// like the specular lobe).
-    fn under_coat(&self, cos_o: f32, cos_i: f32, lobes: Lobes) -> Rgb {
-        lobes.diffuse * self.coat_diffuse_through(cos_o, cos_i)
-            + (lobes.specular + lobes.sheen) * self.coat_specular_through(cos_o, cos_i)
+    /// The base's lobes between `wo` and `wi` (shading frame; `co`, `ci`
+    /// in the coat's) as the coat leaves them: the diffuse lobe by the
+    /// cosines to the coat's normal, the specular and the sheen (dimmed
+    /// like it) by those to the shading normal.
+    fn under_coat(&self, wo: Vec3, wi: Vec3, co: Vec3, ci: Vec3, lobes: Lobes) -> Rgb {
+        lobes.diffuse * self.coat_diffuse_through(co.z, ci.z)
+            + (lobes.specular + lobes.sheen) * self.coat_specular_through(wo.z, wi.z)
     }
 
     /// `f_gathered` under the coat: `lobes` are the base's gathered lobes.
@@ -190,7 +220,7 @@ impl Bsdf {
         }
         let (co, ci) = (self.to_coat(wo), self.to_coat(wi));
         let coat = if self.coat_is_gathered() { self.coat_lobe(co, ci) } else { 0.0 };
-        self.under_coat(co.z, ci.z, lobes) + Rgb::splat(coat)
+        self.under_coat(wo, wi, co, ci, lobes) + Rgb::splat(coat)
     }
 
     pub(super) fn coated_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
@@ -222,13 +252,9 @@ impl Bsdf {
         }
         let s = self.base_sample(wo, ((u_lobe - p) / (1.0 - p)).min(ONE_BELOW), u)?;
         if s.is_delta {
-            // The base's mirror under the coat: √(T·T), which at the
-            // mirror direction of an untilted coat is T(θo).
-            let through = if self.coat_is_tilted() {
-                self.coat_specular_through(co.z, self.to_coat(s.wi).z)
-            } else {
-                self.coat_transmission(wo.z)
-            };
+            // The base's mirror under the coat: √(T·T) at the mirror
+            // direction is T(θo).
+            let through = self.coat_transmission(wo.z);
             let pdf = (1.0 - p) * s.pdf;
             return Some(BsdfSample { f: s.f * through, pdf, weight: s.f * (through * wo.z / pdf), ..s });
         }
@@ -275,7 +301,7 @@ impl Bsdf {
         let co = self.to_coat(wo);
         let coat = if self.coat_is_gathered() || co.z <= 0.0 { 0.0 } else { self.coat_fresnel(co.z) };
         let base = if self.has_specular() && !self.gathers_specular() {
-            self.coat_transmission(co.z) * mean(self.specular_fresnel(wo.z)).max(MIN_LOBE_WEIGHT)
+            self.coat_transmission(wo.z) * mean(self.specular_fresnel(wo.z)).max(MIN_LOBE_WEIGHT)
         } else {
             0.0
         };
@@ -301,7 +327,7 @@ impl Bsdf {
         }
         let u = Vec2::new(((u.x - p) / (1.0 - p)).min(ONE_BELOW), u.y);
         let s = self.sample_specular_lobe(wo, u)?;
-        let through = self.coat_specular_through(co.z, self.to_coat(s.wi).z);
+        let through = self.coat_specular_through(wo.z, s.wi.z);
         Some(BsdfSample { f: s.f * through, pdf: (1.0 - p) * s.pdf, weight: s.weight * (through / (1.0 - p)), ..s })
     }
 
@@ -311,6 +337,17 @@ impl Bsdf {
         let coat = self.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
         Rgb::splat(coat) + self.base_albedo_estimate() * (1.0 - coat)
     }
+}
+
+/// The cosine-weighted mean over the base's hemisphere of Schlick's
+/// (1 − cos)^5, cos taken to a coat normal tilted θ = acos(z) from the
+/// base's (and 0 below the coat's horizon, where the coat reflects all):
+/// 1/21 untilted, 0.60 at 90°. A degree-5 polynomial in θ fitted to the
+/// quadrature, within 2.5·10⁻⁴ of it (`tilted_schlick_mean_fits_the_quadrature`).
+pub(super) fn tilted_schlick_mean(z: f32) -> f32 {
+    const FIT: [f32; 6] = [0.047376793, 0.007523404, 0.42324913, -0.20406739, 0.072868034, -0.015920898];
+    let theta = z.clamp(-1.0, 1.0).acos();
+    FIT.iter().rev().fold(0.0, |sum, &c| sum * theta + c)
 }
 
 #[cfg(test)]
@@ -339,6 +376,23 @@ mod tests {
     /// Where `c`'s coat mirrors `wo` (about its own normal).
     fn coat_mirror_of(c: &Bsdf, wo: Vec3) -> Vec3 {
         c.from_coat(mirror(c.to_coat(wo)))
+    }
+
+    /// `tilted_schlick_mean` against quadrature over the base's hemisphere
+    /// at tilts from 0° to 90°.
+    #[test]
+    fn tilted_schlick_mean_fits_the_quadrature() {
+        for deg in [0.0f32, 5.0, 17.0, 30.0, 45.0, 60.0, 75.0, 89.0] {
+            let n = Vec3::new(deg.to_radians().sin(), 0.0, deg.to_radians().cos());
+            let quadrature = integrate_about(Vec3::Z, |w| {
+                if w.z <= 0.0 {
+                    return 0.0;
+                }
+                schlick_weight(n.dot(w).max(0.0)) as f64 * w.z as f64 / std::f64::consts::PI
+            });
+            let fit = tilted_schlick_mean(n.z) as f64;
+            assert!((fit - quadrature).abs() < 3e-4, "{deg}°: fit {fit} against {quadrature}");
+        }
     }
 
     /// A tilted coat over a black base is the untilted coat turned: its f
@@ -411,10 +465,24 @@ mod tests {
         for deg in [0.0, 40.0, 75.0] {
             let wo = direction_at(deg);
             let under = integrate_about(Vec3::Z, |wi| {
-                (mean(lambert.under_coat(wo.z, wi.z, lambert.f_lobes(wo, wi, 1.0))) * wi.z.max(0.0)) as f64
+                (mean(lambert.under_coat(wo, wi, wo, wi, lambert.f_lobes(wo, wi, 1.0))) * wi.z.max(0.0)) as f64
             });
             let want = 0.5 * lambert.coat_transmission(wo.z) as f64;
             assert!((under - want).abs() < 1e-3, "{deg}°: {under} against {want}");
+        }
+        // Under a coat tilted 17° (and one tilted 40°) still T(θo), θo
+        // taken to the coat's normal.
+        for n in [tilt(), Vec3::new(0.0, 40f32.to_radians().sin(), 40f32.to_radians().cos())] {
+            let tilted = lambert.with_coat_normal(n);
+            for deg in [0.0, 40.0, 75.0] {
+                let wo = direction_at(deg);
+                let under = integrate_about(Vec3::Z, |wi| {
+                    let (co, ci) = (tilted.to_coat(wo), tilted.to_coat(wi));
+                    (mean(tilted.under_coat(wo, wi, co, ci, tilted.f_lobes(wo, wi, 1.0))) * wi.z.max(0.0)) as f64
+                });
+                let want = 0.5 * tilted.coat_transmission(tilted.to_coat(wo).z) as f64;
+                assert!((under - want).abs() < 1e-3, "tilt {n}, {deg}°: {under} against {want}");
+            }
         }
         for base in [Bsdf::diffuse(Rgb::ONE), Bsdf::mirror(Rgb::ONE)] {
             let c = coated(base, 1.0, 0.0);
@@ -471,7 +539,12 @@ mod tests {
     }
 
     /// Nothing is created: over a white rough metal and a white diffuse
-    /// base the coated albedo stays at most 1, and f is reciprocal.
+    /// base the coated albedo stays at most 1, and f is reciprocal. Under
+    /// a tilted coat the coat's lobe is weighed by the cosine to the
+    /// shading normal, not to its own: seen at 80° it reflects up to 1.6%
+    /// more than arrives (the gain of any bent normal kept reciprocal;
+    /// Cycles weighs each closure by its own normal's cosine and gives up
+    /// reciprocity instead), hence 2% there.
     #[test]
     fn white_furnace_and_reciprocity() {
         let bases = [Bsdf::new(Rgb::ONE, 1.0, 0.3, 1.0), Bsdf::diffuse(Rgb::ONE)];
@@ -481,7 +554,8 @@ mod tests {
             for deg in [0.0, 45.0, 80.0] {
                 let wo = direction_at(deg);
                 let albedo = integrate_about(coat_mirror_of(&c, wo), |wi| (mean(c.f(wo, wi)) * wi.z.max(0.0)) as f64);
-                assert!(albedo <= 1.0 + 2e-3, "{deg}°: {albedo}");
+                let bound = if c.coat_normal != Vec3::Z && deg > 60.0 { 1.02 } else { 1.0 + 2e-3 };
+                assert!(albedo <= bound, "{deg}°: {albedo}");
             }
             let mut rng = Rng::for_item(0xC0A8, 0);
             for _ in 0..500 {
@@ -525,7 +599,7 @@ mod tests {
         let co = c.to_coat(wo);
         let coat_mirror = coat_mirror_of(c, wo);
         let coat = if c.coat_is_smooth() && coat_mirror.z > 0.0 { c.coat_fresnel(co.z) } else { 0.0 };
-        let t = c.coat_specular_through(co.z, c.to_coat(mirror(wo)).z);
+        let t = c.coat_transmission(wo.z);
         let base = if c.is_delta() { mean(c.specular_fresnel(wo.z)) * t } else { 0.0 };
         let lobes = integrate_about(mirror(wo), |wi| (mean(c.f(wo, wi)) * wi.z.max(0.0)) as f64);
         lobes + (coat + base) as f64

@@ -121,6 +121,10 @@ pub struct Bsdf {
     /// +z, the base's, but where `clearcoatNormalTexture` bends the coat
     /// apart from the base ([`Bsdf::with_coat_normal`]).
     pub coat_normal: Vec3,
+    /// The coat's mean reflectance's (1 − cos)^5 term over the light's
+    /// directions ([`clearcoat`]): 1/21, or for a coat its own texture
+    /// tilts, `clearcoat::tilted_schlick_mean` of its tilt.
+    pub coat_schlick_mean: f32,
     /// The dielectric's reflectance at normal incidence, F0 = ((η − 1)/(η +
     /// 1))² of KHR_materials_ior's index η: `DIELECTRIC_F0` at glTF's
     /// default 1.5 ([`Bsdf::with_ior`]).
@@ -199,6 +203,7 @@ impl Bsdf {
             clearcoat: 0.0,
             clearcoat_roughness: 0.0,
             coat_normal: Vec3::Z,
+            coat_schlick_mean: 1.0 / 21.0,
             f0: DIELECTRIC_F0,
             specular_color: Rgb::ONE,
             dielectric_f0: Rgb::splat(DIELECTRIC_F0),

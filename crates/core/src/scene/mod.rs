@@ -227,14 +227,15 @@ impl Scene {
         }
         let (t, triangle) = (self.texturing.as_ref()?, self.accel.triangle(hit.prim)?);
         let material = self.surfaces[hit.surface as usize].material;
-        let coat = t.coat_normal(material, hit.prim, hit.barycentrics, triangle.v, smooth)?;
+        let (coat, own) = t.coat_normal(material, hit.prim, hit.barycentrics, triangle.v, smooth)?;
         let facing = if dir.dot(hit.geometric_normal) < 0.0 { 1.0 } else { -1.0 };
         let lifted = if coat == smooth {
             coat * facing
         } else {
             crate::texture::valid_reflection_normal(hit.geometric_normal * facing, -dir, coat * facing)
         };
-        Some(bsdf.with_coat_normal(frame.to_local(lifted)))
+        let local = frame.to_local(lifted);
+        Some(if own { bsdf.with_coat_normal(local) } else { bsdf.with_unbent_coat(local) })
     }
 
     /// `hit` (reached along `dir`) with its shading normal bent by its

@@ -176,6 +176,7 @@ fn shade(in: VertexOut) -> Shaded {
         if (coat_apart(surface, uv)) {
             let coat = coat_normal(surface, uv, dx, dy, px, py, tangent, shading, in.geometric_normal, normalize(view));
             texels.coat_normal = to_shading(coat * side, n * side);
+            texels.coat_unbent = coat_normal_texture(surface) == NO_TEXTURE;
         }
         layers = pack_layer_texels(texels);
     }

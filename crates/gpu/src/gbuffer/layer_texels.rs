@@ -11,7 +11,9 @@
 //! specular factor's texels at 8 bits each (the images' own precision:
 //! glTF's PNG and JPEG images hold 8 bits a channel); the coat normal's x
 //! and y at 16 bits (snorm; z ≥ 0 from them); the sheen's and the
-//! specular's colour at 10 bits a channel. layer_texels.wgsl is the GPU's
+//! specular's colour at 10 bits a channel, the sheen's word's bit 30 set
+//! where the coat lies on the unbent normal over a normal texture
+//! (`Bsdf::with_unbent_coat`) rather than on its own texture's. layer_texels.wgsl is the GPU's
 //! half; this Rust one reads a G-buffer back (the tests).
 
 use glam::Vec3;
@@ -44,7 +46,13 @@ pub struct LayerTexels {
     pub specular_color: Vec3,
     /// The coat's own normal in the shading frame (+z: the base's).
     pub coat_normal: Vec3,
+    /// The coat lies on the unbent normal over a normal texture (no
+    /// texture of its own tilts it).
+    pub coat_unbent: bool,
 }
+
+/// The sheen colour word's bit marking `LayerTexels::coat_unbent`.
+const COAT_UNBENT_BIT: u32 = 1 << 30;
 
 /// WGSL's `pack4x8unorm`: floor(0.5 + 255·clamp(v, 0, 1)), x in the low byte.
 fn unorm8x4(v: [f32; 4]) -> u32 {
@@ -80,32 +88,23 @@ impl LayerTexels {
         sheen_color: Vec3::ONE,
         specular_color: Vec3::ONE,
         coat_normal: Vec3::Z,
+        coat_unbent: false,
     };
 
     /// The texels in the order of the fields, colours' channels in turn,
-    /// then the coat normal's x and y.
-    pub fn to_array(&self) -> [f32; 12] {
+    /// then the coat normal's x and y and `coat_unbent` (1 or 0).
+    pub fn to_array(&self) -> [f32; 13] {
         let [sr, sg, sb] = self.sheen_color.to_array();
         let [cr, cg, cb] = self.specular_color.to_array();
-        let n = self.coat_normal;
-        [
-            self.clearcoat,
-            self.clearcoat_roughness,
-            self.sheen_roughness,
-            self.specular,
-            sr,
-            sg,
-            sb,
-            cr,
-            cg,
-            cb,
-            n.x,
-            n.y,
-        ]
+        let (n, unbent) = (self.coat_normal, self.coat_unbent as u32 as f32);
+        let factors = [self.clearcoat, self.clearcoat_roughness, self.sheen_roughness, self.specular];
+        let rest = [sr, sg, sb, cr, cg, cb, n.x, n.y, unbent];
+        std::array::from_fn(|k| if k < 4 { factors[k] } else { rest[k - 4] })
     }
 
-    /// `to_array`'s inverse (the coat normal's z ≥ 0 from its x and y).
-    pub fn from_array(v: [f32; 12]) -> LayerTexels {
+    /// `to_array`'s inverse (the coat normal's z ≥ 0 from its x and y;
+    /// `coat_unbent` from 0.5 up).
+    pub fn from_array(v: [f32; 13]) -> LayerTexels {
         LayerTexels {
             clearcoat: v[0],
             clearcoat_roughness: v[1],
@@ -114,6 +113,7 @@ impl LayerTexels {
             sheen_color: Vec3::new(v[4], v[5], v[6]),
             specular_color: Vec3::new(v[7], v[8], v[9]),
             coat_normal: Vec3::new(v[10], v[11], (1.0 - (v[10] * v[10] + v[11] * v[11])).max(0.0).sqrt()),
+            coat_unbent: v[12] >= 0.5,
         }
     }
 
@@ -129,7 +129,11 @@ impl LayerTexels {
         b.sheen_roughness = (b.sheen_roughness * self.sheen_roughness).clamp(0.0, 1.0);
         b.specular = (b.specular * self.specular).clamp(0.0, 1.0);
         let b = b.with_specular_color(b.specular_color * self.specular_color);
-        if self.coat_normal == Vec3::Z { b } else { b.with_coat_normal(self.coat_normal) }
+        match (self.coat_normal == Vec3::Z, self.coat_unbent) {
+            (true, _) => b,
+            (false, false) => b.with_coat_normal(self.coat_normal),
+            (false, true) => b.with_unbent_coat(self.coat_normal),
+        }
     }
 
     /// The target's four words.
@@ -137,7 +141,7 @@ impl LayerTexels {
         [
             unorm8x4([self.clearcoat, self.clearcoat_roughness, self.sheen_roughness, self.specular]),
             snorm16x2(self.coat_normal.x, self.coat_normal.y),
-            unorm10x3(self.sheen_color),
+            unorm10x3(self.sheen_color) | if self.coat_unbent { COAT_UNBENT_BIT } else { 0 },
             unorm10x3(self.specular_color),
         ]
     }
@@ -154,6 +158,7 @@ impl LayerTexels {
             sheen_color: colour(words[2]),
             specular_color: colour(words[3]),
             coat_normal: if words[1] == 0 { Vec3::Z } else { coat_normal_of(words[1]) },
+            coat_unbent: words[2] & COAT_UNBENT_BIT != 0,
         }
     }
 }
@@ -170,13 +175,18 @@ mod tests {
     fn texels_survive_packing_within_half_a_step() {
         let mut rng = Rng::for_item(5, 0);
         for _ in 0..1000 {
-            let v: [f32; 12] = std::array::from_fn(|k| if k < 10 { rng.next_f32() } else { rng.next_f32() - 0.5 });
+            let v: [f32; 13] = std::array::from_fn(|k| match k {
+                0..10 => rng.next_f32(),
+                10..12 => rng.next_f32() - 0.5,
+                _ => (rng.next_f32() < 0.5) as u32 as f32,
+            });
             let texels = LayerTexels::from_array(v);
             let back = LayerTexels::unpack(texels.pack());
             for (k, (got, want)) in back.to_array().into_iter().zip(texels.to_array()).enumerate() {
                 let step = match k {
                     0..4 => 255.0,
-                    10.. => 32767.0,
+                    10..12 => 32767.0,
+                    12 => f32::INFINITY,
                     _ => 1023.0,
                 };
                 assert!((got - want).abs() <= 0.5 / step + 1e-7, "texel {k}: {got} vs {want}");

@@ -17,10 +17,16 @@ struct LayerTexels {
     specular_color: vec3<f32>,
     // +z: the base's normal.
     coat_normal: vec3<f32>,
+    // The coat lies on the unbent normal over a normal texture (no texture
+    // of its own tilts it: Bsdf::with_unbent_coat).
+    coat_unbent: bool,
 }
 
+// The sheen colour word's bit marking `coat_unbent`.
+const COAT_UNBENT_BIT: u32 = 0x40000000u;
+
 fn no_layer_texels() -> LayerTexels {
-    return LayerTexels(1.0, 1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0));
+    return LayerTexels(1.0, 1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0), false);
 }
 
 fn pack_unorm10x3(c: vec3<f32>) -> u32 {
@@ -36,7 +42,7 @@ fn pack_layer_texels(t: LayerTexels) -> vec4<u32> {
     return vec4<u32>(
         pack4x8unorm(vec4<f32>(t.clearcoat, t.clearcoat_roughness, t.sheen_roughness, t.specular)),
         pack2x16snorm(t.coat_normal.xy),
-        pack_unorm10x3(t.sheen_color),
+        pack_unorm10x3(t.sheen_color) | select(0u, COAT_UNBENT_BIT, t.coat_unbent),
         pack_unorm10x3(t.specular_color),
     );
 }
@@ -50,7 +56,7 @@ fn unpack_coat_normal(w: u32) -> vec3<f32> {
 fn unpack_layer_texels(w: vec4<u32>) -> LayerTexels {
     let factors = unpack4x8unorm(w.x);
     return LayerTexels(factors.x, factors.y, factors.z, factors.w, unpack_unorm10x3(w.z), unpack_unorm10x3(w.w),
-        unpack_coat_normal(w.y));
+        unpack_coat_normal(w.y), (w.z & COAT_UNBENT_BIT) != 0u);
 }
 
 // Surface `s` with its layer factors times the texels `t`, clamped as
@@ -82,6 +88,9 @@ fn pixel_surface(s: Surface, words: vec4<u32>) -> Surface {
 fn pixel_coat(b: Bsdf, s: Surface, words: vec4<u32>) -> Bsdf {
     if (!LAYERED || s.layer_textures == 0xffffffffu || words.y == 0u) {
         return b;
+    }
+    if ((words.z & COAT_UNBENT_BIT) != 0u) {
+        return with_unbent_coat(b, unpack_coat_normal(words.y));
     }
     return with_coat_normal(b, unpack_coat_normal(words.y));
 }

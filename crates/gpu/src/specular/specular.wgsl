@@ -500,7 +500,7 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
                 // The coat on its own normal (Scene::coat_tilted).
                 if (coat_apart(s, uv) && p.is_sphere == 0u) {
                     let coat = coat_normal_at_hit(s, uv, hit.prim, hit.b, p.b, p.c, normals.shading, ng, b.dir);
-                    bsdf = with_coat_normal(bsdf, to_shading(select(-coat, coat, front), ns));
+                    bsdf = with_coat_apart(bsdf, s, to_shading(select(-coat, coat, front), ns));
                 }
                 let glossy = GLOSSY && s.glossy != 0u;
                 if (b.depth > 0u) {

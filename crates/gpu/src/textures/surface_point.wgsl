@@ -218,6 +218,16 @@ fn coat_apart(s: Surface, uv: vec3<f32>) -> bool {
         || (LAYERED && s.layer_textures != NO_TEXTURE && reads_normal_texture(s, uv));
 }
 
+// The BRDF `b` of surface `s` with its coat apart on `n` (shading frame;
+// Scene::coat_tilted): tilted by its own texture, or lying on the unbent
+// normal over a normal texture.
+fn with_coat_apart(b: Bsdf, s: Surface, n: vec3<f32>) -> Bsdf {
+    if (coat_normal_texture(s) != NO_TEXTURE) {
+        return with_coat_normal(b, n);
+    }
+    return with_unbent_coat(b, n);
+}
+
 // The clear coat's own normal at a fragment (`bent_normal`'s arguments):
 // the unbent `n` bent by the coat normal texture and lifted for the view
 // (hikari_core::texture::Texturing::coat_normal and Scene::coat_tilted);

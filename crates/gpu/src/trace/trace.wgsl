@@ -565,7 +565,7 @@ fn trace_one(rng: ptr<function, Rng>) {
             // The coat on its own normal (Scene::coat_tilted).
             if (coat_apart(s, uv) && prim.is_sphere == 0u) {
                 let coat = coat_normal_at_hit(s, uv, hit.prim, hit.b, prim.b, prim.c, normals.shading, normals.geometric, ray.dir);
-                b = with_coat_normal(b, to_shading(coat * facing, ns));
+                b = with_coat_apart(b, s, to_shading(coat * facing, ns));
             }
             if (bsdf_stores_photons(b) && store_weight > 0.0) {
                 store_surface(x, power * store_weight, ray.dir, diffuse_bounces, specular_bounces);

@@ -30,6 +30,8 @@ struct Bsdf {
     // The coat's own normal in the shading frame (+z: the base's; a
     // clearcoatNormalTexture tilts it, `with_coat_normal`).
     coat_normal: vec3<f32>,
+    // The coat's mean reflectance's (1 − cos)^5 term (Bsdf::coat_schlick_mean).
+    coat_schlick_mean: f32,
 }
 
 // The largest f32 below 1 (clearcoat.rs's ONE_BELOW).
@@ -414,10 +416,19 @@ fn coat_is_gathered(b: Bsdf) -> bool {
     return b.clearcoat_roughness >= GATHER_ROUGHNESS;
 }
 
-// Bsdf::with_coat_normal: `n` (shading frame) normalised; +z where it is
-// at or below the base's horizon or not a direction.
+// Bsdf::with_coat_normal: the coat on its own normal `n` (shading frame),
+// tilted by its texture.
 fn with_coat_normal(b: Bsdf, n: vec3<f32>) -> Bsdf {
+    var out = with_unbent_coat(b, n);
+    out.coat_schlick_mean = tilted_schlick_mean(out.coat_normal.z);
+    return out;
+}
+
+// Bsdf::with_unbent_coat: `n` (shading frame) normalised; +z where it is
+// at or below the base's horizon or not a direction.
+fn with_unbent_coat(b: Bsdf, n: vec3<f32>) -> Bsdf {
     var out = b;
+    out.coat_schlick_mean = 1.0 / 21.0;
     let len2 = dot(n, n);
     let recip = 1.0 / sqrt(len2);
     out.coat_normal = vec3<f32>(0.0, 0.0, 1.0);
@@ -465,8 +476,23 @@ fn coat_transmission(b: Bsdf, cos: f32) -> f32 {
     return 1.0 - coat_fresnel(b, cos);
 }
 
+// clearcoat::tilted_schlick_mean: the cosine-weighted mean of (1 − cos)^5
+// to a coat normal tilted acos(z) from the base's, its fit in the angle.
+fn tilted_schlick_mean(z: f32) -> f32 {
+    let theta = acos(clamp(z, -1.0, 1.0));
+    var sum = -0.015920898;
+    sum = sum * theta + 0.072868034;
+    sum = sum * theta - 0.20406739;
+    sum = sum * theta + 0.42324913;
+    sum = sum * theta + 0.007523404;
+    return sum * theta + 0.047376793;
+}
+
 fn coat_diffuse_through(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
-    let mean_reflectance = b.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+    var mean_reflectance = b.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) / 21.0);
+    if (coat_is_tilted(b)) {
+        mean_reflectance = b.clearcoat * (DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * b.coat_schlick_mean);
+    }
     return coat_transmission(b, cos_o) * coat_transmission(b, cos_i) / (1.0 - mean_reflectance);
 }
 
@@ -474,11 +500,13 @@ fn coat_specular_through(b: Bsdf, cos_o: f32, cos_i: f32) -> f32 {
     return sqrt(coat_transmission(b, cos_o) * coat_transmission(b, cos_i));
 }
 
-// The base's lobes as the coat leaves them between directions at cosines
-// `cos_o`, `cos_i` to the coat's normal (the sheen dimmed like the specular lobe).
-fn under_coat(b: Bsdf, cos_o: f32, cos_i: f32, lobes: Lobes) -> vec3<f32> {
-    return lobes.diffuse * coat_diffuse_through(b, cos_o, cos_i)
-        + (lobes.specular + lobes.sheen) * coat_specular_through(b, cos_o, cos_i);
+// The base's lobes between `wo` and `wi` (`co`, `ci` in the coat's frame)
+// as the coat leaves them: the diffuse lobe by the cosines to the coat's
+// normal, the specular and the sheen (dimmed like it) by those to the
+// shading normal.
+fn under_coat(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, co: vec3<f32>, ci: vec3<f32>, lobes: Lobes) -> vec3<f32> {
+    return lobes.diffuse * coat_diffuse_through(b, co.z, ci.z)
+        + (lobes.specular + lobes.sheen) * coat_specular_through(b, wo.z, wi.z);
 }
 
 // The coat's lobe between `wo` and `wi` in the coat's frame.
@@ -511,7 +539,7 @@ fn coated_f(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3<f32> {
     }
     let co = to_coat(b, wo);
     let ci = to_coat(b, wi);
-    return under_coat(b, co.z, ci.z, bsdf_f_lobes(b, wo, wi, k)) + vec3<f32>(coat_lobe(b, co, ci));
+    return under_coat(b, wo, wi, co, ci, bsdf_f_lobes(b, wo, wi, k)) + vec3<f32>(coat_lobe(b, co, ci));
 }
 
 fn coated_pdf(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
@@ -569,10 +597,7 @@ fn coated_sample(b: Bsdf, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> BsdfSampl
         return s;
     }
     if (s.is_delta) {
-        var through = coat_transmission(b, wo.z);
-        if (coat_is_tilted(b)) {
-            through = coat_specular_through(b, co.z, to_coat(b, s.wi).z);
-        }
+        let through = coat_transmission(b, wo.z);
         let pdf = (1.0 - p) * s.pdf;
         return BsdfSample(s.wi, pdf, s.f * through, true, s.f * (through * wo.z / pdf), s.followed, true);
     }
@@ -590,7 +615,7 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     }
     var base = 0.0;
     if (bsdf_has_specular(b) && !bsdf_gathers_specular(b)) {
-        base = coat_transmission(b, co.z) * max(rgb_mean(bsdf_specular_fresnel(b, wo.z)), MIN_LOBE_WEIGHT);
+        base = coat_transmission(b, wo.z) * max(rgb_mean(bsdf_specular_fresnel(b, wo.z)), MIN_LOBE_WEIGHT);
     }
     if (coat + base <= 0.0) {
         return no_bsdf_sample();
@@ -617,7 +642,7 @@ fn coated_sample_followed(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> BsdfSample {
     if (!s.valid) {
         return s;
     }
-    let through = coat_specular_through(b, co.z, to_coat(b, s.wi).z);
+    let through = coat_specular_through(b, wo.z, s.wi.z);
     return BsdfSample(s.wi, (1.0 - p) * s.pdf, s.f * through, s.is_delta, s.weight * (through / (1.0 - p)), s.followed, true);
 }
 
@@ -685,7 +710,7 @@ fn bsdf_f_gathered_bumped(b: Bsdf, wo: vec3<f32>, wi: vec3<f32>, k: f32) -> vec3
     if (coat_is_gathered(b)) {
         coat = coat_lobe(b, co, ci);
     }
-    return under_coat(b, co.z, ci.z, lobes) + vec3<f32>(coat);
+    return under_coat(b, wo, wi, co, ci, lobes) + vec3<f32>(coat);
 }
 
 // Photons are stored here (Bsdf::stores_photons).
@@ -762,14 +787,14 @@ fn to_shading(w: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // G-buffer's, textures applied; `s.albedo` where no texture is).
 fn surface_bsdf(s: Surface, base: vec3<f32>) -> Bsdf {
     return Bsdf(base, s.metallic, s.roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
-        s.sheen_color, s.sheen_roughness, s.specular_color, vec3<f32>(0.0, 0.0, 1.0));
+        s.sheen_color, s.sheen_roughness, s.specular_color, vec3<f32>(0.0, 0.0, 1.0), 1.0 / 21.0);
 }
 
 // The BRDF of glossy surface `s` at a point whose textures gave `base`,
 // `metallic` and `roughness` (textures.wgsl's `surface_point`).
 fn point_bsdf(s: Surface, base: vec3<f32>, metallic: f32, roughness: f32) -> Bsdf {
     return Bsdf(base, metallic, roughness, s.specular_factor, s.clearcoat, s.clearcoat_roughness, s.dielectric_f0,
-        s.sheen_color, s.sheen_roughness, s.specular_color, vec3<f32>(0.0, 0.0, 1.0));
+        s.sheen_color, s.sheen_roughness, s.specular_color, vec3<f32>(0.0, 0.0, 1.0), 1.0 / 21.0);
 }
 
 // The BRDF at a G-buffer pixel of glossy surface `s`: base colour from the
