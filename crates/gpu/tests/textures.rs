@@ -441,15 +441,20 @@ fn layer_textures_reach_the_gbuffer() {
 /// (no filtering between texels to differ by); at scale 0 the normal is
 /// the flat one. Seen at a grazing angle from the side the texel tilts
 /// away from, normals that would reflect the eye below the quad are
-/// lifted (`valid_reflection_normal`) on both alike.
+/// lifted (`valid_reflection_normal`) on both alike. The quad's clear coat
+/// (no normal texture of its own) lies on the unbent normal: the layer
+/// target keeps it in the bent normal's frame as `Scene::coat_tilted`.
 #[test]
 fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
     use glam::Vec3;
+    use hikari_core::bsdf::ShadingFrame;
+    use hikari_core::material::Material;
     use hikari_core::photon::{TraceSettings, trace_photons};
     use hikari_core::progress::Silent;
     use hikari_core::render::photon_cpu::PhotonCpuSettings;
     use hikari_core::scene::gltf::export::{GltfBuilder, PbrMaterial, png};
     use hikari_core::test_scenes::gltf_textures::{load, quad};
+    use hikari_gpu::gbuffer::layer_texels::LayerTexels;
     let ctx = test_context("a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu");
     for (scale, stored_tangents, grazing) in
         [(1.0, true, false), (1.0, false, false), (0.0, true, false), (1.0, true, true)]
@@ -458,10 +463,14 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
         let image = b.image(&png(1, 1, &[191, 160, 218, 255]), "image/png");
         let repeat = gltf::json::texture::WrappingMode::Repeat;
         let t = b.texture(image, repeat, repeat);
+        // Under a clear coat without a normal texture of its own: the coat
+        // lies on the unbent normal (the G-buffer's layer target keeps it).
         let m = b.material(&PbrMaterial {
             base_color: Vec3::splat(0.5),
             specular: 0.0,
             normal_texture: Some((t, scale)),
+            clearcoat: 1.0,
+            clearcoat_roughness: 0.3,
             ..Default::default()
         });
         let (eu, ev) = (Vec3::new(1.0, 0.2, 0.3), Vec3::new(0.4, 1.0, -0.2));
@@ -496,7 +505,9 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
                 .expect("GPU renderer");
         gpu.render().unwrap();
         let normals = gpu.read(&gpu.targets.gbuffer.normal).unwrap();
+        let layers = hikari_gpu::readback::read_rgba32uint(&gpu.ctx, &gpu.targets.gbuffer.layers).unwrap();
         let (mut seen, mut worst, mut tilt, mut lifted) = (0, 0.0f32, 0.0f32, 0);
+        let mut worst_coat = 0.0f32;
         for y in 0..height {
             for x in 0..width {
                 let ray = scene.camera.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
@@ -509,6 +520,13 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
                 lifted += ((unlifted * facing).dot(want) < 0.9999) as u32;
                 let got = normals[(y * width + x) as usize].truncate();
                 worst = worst.max((got - want).length());
+                // The coat's normal: the unbent one in the frame of the bent.
+                let texels = LayerTexels::unpack(layers[(y * width + x) as usize]);
+                let Material::Pbr(bsdf) = *scene.material_at(&hit) else { panic!("a coated material") };
+                let frame = ShadingFrame::new(want);
+                let coat = scene.coat_tilted(&bsdf, &hit, hit.shading_normal, ray.dir, &frame).expect("coat apart");
+                assert!(texels.coat_unbent, "({x}, {y}): the coat lies on the unbent normal");
+                worst_coat = worst_coat.max((texels.coat_normal - coat.coat_normal).abs().max_element());
                 tilt = tilt.max(want.angle_between(hit.geometric_normal * facing));
                 seen += 1;
             }
@@ -519,6 +537,7 @@ fn a_normal_texture_bends_the_gbuffer_normal_as_on_the_cpu() {
         );
         assert!(seen > if grazing { 100 } else { 300 }, "{seen} pixels see the quad");
         assert!(worst < 2e-3, "scale {scale}: the G-buffer's normal differs from the CPU's by {worst}");
+        assert!(worst_coat < 2e-3, "scale {scale}: the coat's normal differs from the CPU's by {worst_coat}");
         if grazing {
             assert!(lifted > 20, "{lifted} pixels' normals are lifted");
         } else {
