@@ -214,7 +214,8 @@ fn coat_normal_scale(s: Surface) -> f32 {
 // a clear-coat normal texture or a normal texture (a coat over a normal
 // texture lies on the unbent normal).
 fn coat_apart(s: Surface, uv: vec3<f32>) -> bool {
-    return coat_normal_texture(s) != NO_TEXTURE && uv.z != 0.0
+    // Parenthesised: WGSL (Chromium's compiler, unlike naga) refuses && and || mixed bare.
+    return (coat_normal_texture(s) != NO_TEXTURE && uv.z != 0.0)
         || (LAYERED && s.layer_textures != NO_TEXTURE && reads_normal_texture(s, uv));
 }
 
