@@ -56,6 +56,59 @@ fn every_shader_validates() {
     }
 }
 
+/// The line of the first expression in `source` that mixes `&&` and `||`
+/// without parentheses between them, which WGSL's grammar forbids and
+/// Chromium's compiler (Tint) refuses while naga takes it (the web page's
+/// shaders once failed so). Comments are skipped; each parenthesis or
+/// bracket level, argument and statement is its own expression.
+fn bare_mixed_logic(source: &str) -> Option<usize> {
+    let mut levels = vec![(false, false)];
+    for (number, line) in source.lines().enumerate() {
+        let code = line.split("//").next().unwrap_or("").as_bytes();
+        let mut k = 0;
+        while k < code.len() {
+            let pair = code.get(k + 1) == Some(&code[k]);
+            match code[k] {
+                b'(' | b'[' => levels.push((false, false)),
+                b')' | b']' => {
+                    levels.pop();
+                    if levels.is_empty() {
+                        levels.push((false, false));
+                    }
+                }
+                b';' | b'{' | b'}' | b',' => *levels.last_mut().unwrap() = (false, false),
+                b'&' | b'|' if pair => {
+                    let level = levels.last_mut().unwrap();
+                    if code[k] == b'&' {
+                        level.0 = true
+                    } else {
+                        level.1 = true
+                    }
+                    if level.0 && level.1 {
+                        return Some(number + 1);
+                    }
+                    k += 1;
+                }
+                _ => {}
+            }
+            k += 1;
+        }
+    }
+    None
+}
+
+#[test]
+fn no_shader_mixes_and_with_or_unparenthesised() {
+    assert_eq!(bare_mixed_logic("let a = x && y\n    || z;"), Some(2));
+    assert_eq!(bare_mixed_logic("let a = (x && y) || z; // a && b || c"), None);
+    assert_eq!(bare_mixed_logic("f(x && y, z || w); if (a || b) { c = d && e; }"), None);
+    for (name, source) in shaders() {
+        if let Some(line) = bare_mixed_logic(&source) {
+            panic!("{name}:{line}: && and || mixed without parentheses: {}", source.lines().nth(line - 1).unwrap());
+        }
+    }
+}
+
 /// (size, [(field, offset)]) of the WGSL struct `name` in `source`.
 fn wgsl_layout(source: &str, name: &str) -> (u32, Vec<(String, u32)>) {
     let module = parse(name, source);
