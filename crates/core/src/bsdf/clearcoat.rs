@@ -52,24 +52,27 @@
 //! [`Bsdf::coat_normal`], given in the shading frame), the base's lobes of
 //! those in the shading frame, as in Cycles' Principled BSDF (its coat
 //! closure takes the coat normal, the base's dimming the view's angle to
-//! it). The base's specular and sheen lobes are dimmed as under an
-//! untilted coat, by the cosines to the shading normal: taken to the
-//! coat's, √(T(θo)·T(θi)) darkened every mirror direction the tilt put
-//! near the coat's horizon (`scripts/cycles/coat_normal.py`'s metal ball
-//! under a bumpy coat 15% darker than Cycles, 7% so). Neither side is lit from below:
-//! a direction under either surface gets nothing from that surface's
-//! lobes. Where the coat's own texture tilts it (`with_coat_normal`), the
-//! diffuse lobe's coupling keeps its normalisation: E becomes the coat's
-//! cosine-weighted mean reflectance over the base's hemisphere
-//! ([`tilted_schlick_mean`]), so that what the coat leaves of a Lambertian
-//! base is still T(θo) times its albedo, as in Cycles (without it a coat
-//! tilted 40° took 16% of the base's light: `scripts/cycles/coat_normal.py`'s
-//! orange-peel ball was 13% darker than Cycles). Where the coat lies on the
-//! unbent normal over a normal-mapped base (`with_unbent_coat`), E stays
-//! the untilted one: the directions below the coat's horizon are below the
-//! surface, lit by nothing anyway (normalising over them drew that ball 18%
-//! brighter than Cycles). With the coat normal +z every function is the
-//! untilted one to the bit.
+//! it). Neither side is lit from below: a direction under either surface
+//! gets nothing from that surface's lobes.
+//!
+//! * The diffuse lobe's coupling keeps its normalisation where the coat's
+//!   own texture tilts it (`with_coat_normal`): E becomes the coat's
+//!   cosine-weighted mean reflectance over the base's hemisphere
+//!   ([`tilted_schlick_mean`]), so what the coat leaves of a Lambertian
+//!   base is still T(θo) times its albedo, as in Cycles. Without it a coat
+//!   tilted 40° took 16% of the base's light (`scripts/cycles/coat_normal.py`'s
+//!   orange-peel ball 13% darker than Cycles).
+//! * Where the coat lies on the unbent normal over a normal-mapped base
+//!   (`with_unbent_coat`), E stays the untilted one: the directions below
+//!   the coat's horizon are below the surface, lit by nothing anyway
+//!   (normalising over them drew that ball 18% brighter than Cycles).
+//! * The base's specular and sheen lobes are dimmed as under an untilted
+//!   coat, by the cosines to the shading normal: with the coat's,
+//!   √(T(θo)·T(θi)) darkened every mirror direction the tilt put near the
+//!   coat's horizon (the metal ball under a bumpy coat 15% darker than
+//!   Cycles; 7% with the shading normal's).
+//!
+//! With the coat normal +z every function is the untilted one to the bit.
 //!
 //! The WGSL twin is in `crates/gpu/src/wgsl/bsdf.wgsl`, pinned by
 //! `crates/gpu/tests/bsdf.rs`; keep the arithmetic the same on both sides.
